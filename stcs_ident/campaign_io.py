@@ -1,0 +1,453 @@
+"""Read and write campaign files (``campaign.toml``).
+
+:func:`load_campaign` parses a campaign file exactly as the interface
+contract describes it and builds the frozen model objects of
+:mod:`stcs_ident.model`; :func:`campaign_to_toml` writes a campaign back in
+the same format. Units other than SI live only here: the file gives the
+inclination in degrees, the model holds radians.
+
+Every problem with the file raises :class:`~stcs_ident.errors.CampaignError`
+whose text is one line, ``"<file>: field '<field>': <what is wrong>"``.
+Fields are named in dotted form: ``cable.length``, ``campaign.name``,
+``setup[case2].attachment[W1].position``, ``test[case1-L4].tension``. An
+item whose name is missing or invalid is named by its 1-based place in the
+file instead, ``setup[#2].name``; a key outside any table by itself.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from .errors import CampaignError, ModelError
+from .model import Attachment, Boundary, Cable, Campaign, Setup, Test
+
+__all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
+
+#: Name of the campaign file inside a campaign directory.
+CAMPAIGN_FILE = "campaign.toml"
+
+_TOP_KEYS = ("campaign", "cable", "setup", "test")
+_CAMPAIGN_KEYS = ("name", "description")
+_CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
+_SETUP_KEYS = ("name", "attachment")
+_ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
+_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record")
+
+_BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
+
+# Numbers from this size up are written in exponent form (1.2487e6 N).
+_EXPONENT_FROM = 1e6
+
+
+# --------------------------------------------------------------------------
+# Reading
+# --------------------------------------------------------------------------
+
+
+def load_campaign(path: str | os.PathLike) -> Campaign:
+    """Read a campaign from its directory or from its TOML file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A campaign directory holding ``campaign.toml``, or the TOML file
+        itself (its directory is then the campaign directory).
+
+    Returns
+    -------
+    Campaign
+        The validated campaign; ``directory`` is the absolute campaign
+        directory, against which a test's ``record`` path is resolved.
+
+    Raises
+    ------
+    CampaignError
+        If the file is missing, unreadable or not TOML, or if a key is
+        unknown, a field missing, mistyped, out of range or inconsistent.
+        The error carries ``.file`` and ``.field``.
+    """
+    file = _campaign_file(Path(path))
+    data = _read_toml(file)
+    try:
+        return _parse_campaign(data, directory=str(file.parent.absolute()))
+    except CampaignError as err:
+        raise err.with_file(str(file)) from err
+    except ModelError as err:
+        raise CampaignError(err.message, field=err.field, file=str(file)) from err
+
+
+def _campaign_file(path: Path) -> Path:
+    """The TOML file named by ``path`` (a campaign directory or the file)."""
+    if path.is_dir():
+        file = path / CAMPAIGN_FILE
+        if not file.is_file():
+            raise CampaignError(f"no {CAMPAIGN_FILE} in the campaign directory", file=str(file))
+        return file
+    return path
+
+
+def _read_toml(file: Path) -> dict[str, Any]:
+    """Parse ``file`` as TOML; any failure names the file."""
+    try:
+        with open(file, "rb") as stream:
+            return tomllib.load(stream)
+    except FileNotFoundError:
+        raise CampaignError("file not found", file=str(file)) from None
+    except OSError as err:
+        raise CampaignError(f"cannot read the file: {err.strerror or err}", file=str(file)) from err
+    except UnicodeDecodeError as err:
+        raise CampaignError(f"not a TOML file: not UTF-8 text ({err.reason})", file=str(file)) from err
+    except tomllib.TOMLDecodeError as err:
+        raise CampaignError(f"not a valid TOML file: {_one_line(err)}", file=str(file)) from err
+
+
+def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
+    """Build the campaign from the parsed TOML document."""
+    _check_keys(data, _TOP_KEYS, where="")
+    head = _table(_required(data, "campaign", ""), "campaign")
+    _check_keys(head, _CAMPAIGN_KEYS, "campaign")
+    name = _string(_required(head, "name", "campaign"), "campaign.name")
+    description = _string(head.get("description", ""), "campaign.description", empty_ok=True)
+    cable = _parse_cable(_table(_required(data, "cable", ""), "cable"))
+    found = _tables(data.get("setup", []), "setup")
+    setups = [_parse_setup(t, i, cable.length) for i, t in enumerate(found, 1)]
+    tests = [_parse_test(t, i) for i, t in enumerate(_tables(data.get("test", []), "test"), 1)]
+    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory)
+
+
+def _parse_cable(table: dict[str, Any]) -> Cable:
+    """Build the cable from the ``[cable]`` table (inclination in degrees)."""
+    _check_keys(table, _CABLE_KEYS, "cable")
+    EA = table.get("EA")
+    boundary_a, boundary_b = _parse_boundary(table.get("boundary", "clamped"))
+    return Cable(
+        length=_number(_required(table, "length", "cable"), "cable.length"),
+        mass_per_length=_number(_required(table, "mass_per_length", "cable"), "cable.mass_per_length"),
+        EI=_number(_required(table, "EI", "cable"), "cable.EI"),
+        EA=None if EA is None else _number(EA, "cable.EA"),
+        inclination=math.radians(_inclination(table.get("inclination", 0.0))),
+        gravity=_number(table.get("gravity", 9.81), "cable.gravity"),
+        boundary_a=boundary_a,
+        boundary_b=boundary_b,
+    )
+
+
+def _inclination(value: Any) -> float:
+    """Check the chord angle in degrees, |value| < 90."""
+    degrees = _number(value, "cable.inclination")
+    if not abs(degrees) < 90:
+        raise CampaignError(
+            f"must satisfy |inclination| < 90 degrees, got {value!r}", field="cable.inclination"
+        )
+    return degrees
+
+
+def _parse_boundary(value: Any) -> tuple[Boundary, Boundary]:
+    """Boundaries at ends A and B from one value or a list ``[A, B]``."""
+    if isinstance(value, list):
+        if len(value) != 2:
+            raise CampaignError(
+                f"must be {_BOUNDARY_HELP}, or a list [A, B] of two such values; got a list of {len(value)}",
+                field="cable.boundary",
+            )
+        return _boundary_end(value[0], "end A: "), _boundary_end(value[1], "end B: ")
+    end = _boundary_end(value, "")
+    return end, end
+
+
+def _boundary_end(value: Any, which: str) -> Boundary:
+    """One end's boundary: ``"clamped"``, ``"pinned"`` or a stiffness >= 0."""
+    if value == "clamped" and isinstance(value, str):
+        return Boundary.clamped()
+    if value == "pinned" and isinstance(value, str):
+        return Boundary.pinned()
+    if _is_number(value) and value >= 0:
+        return Boundary(value)
+    raise CampaignError(f"{which}must be {_BOUNDARY_HELP}, got {_show(value)}", field="cable.boundary")
+
+
+def _parse_setup(table: dict[str, Any], index: int, length: float) -> Setup:
+    """Build one ``[[setup]]`` with its attachments on a span of ``length`` m."""
+    name = _item_name(table, "setup", index)
+    where = f"setup[{name}]"
+    _check_keys(table, _SETUP_KEYS, where)
+    kind = f"{where}.attachment"
+    found = _tables(table.get("attachment", []), kind)
+    attachments = [_parse_attachment(t, i, kind, length) for i, t in enumerate(found, 1)]
+    return Setup(name, tuple(attachments))
+
+
+def _parse_attachment(table: dict[str, Any], index: int, kind: str, length: float) -> Attachment:
+    """Build one ``[[setup.attachment]]``; ``kind`` is ``setup[<name>].attachment``."""
+    name = _item_name(table, kind, index)
+    where = f"{kind}[{name}]"
+    _check_keys(table, _ATTACHMENT_KEYS, where)
+    if "damping" in table:
+        raise CampaignError("damping is not supported yet; remove the key", field=f"{where}.damping")
+    position = _number(_required(table, "position", where), f"{where}.position")
+    if not 0 < position < length:
+        message = f"position {position} m is outside the span (0, {length}) m"
+        raise CampaignError(message, field=f"{where}.position")
+    mass = _number(table.get("mass", 0.0), f"{where}.mass")
+    stiffness = _number(table.get("stiffness", 0.0), f"{where}.stiffness")
+    try:
+        return Attachment(name, position, mass, stiffness)
+    except ModelError as err:
+        # The model names the field from the attachment down; add the setup.
+        setup_where = kind.rsplit(".", 1)[0]
+        raise CampaignError(err.message, field=f"{setup_where}.{err.field}") from err
+
+
+def _parse_test(table: dict[str, Any], index: int) -> Test:
+    """Build one ``[[test]]``."""
+    name = _item_name(table, "test", index)
+    where = f"test[{name}]"
+    _check_keys(table, _TEST_KEYS, where)
+    frequencies = table.get("frequencies")
+    modes = table.get("modes")
+    record = table.get("record")
+    return Test(
+        name=name,
+        setup=_string(_required(table, "setup", where), f"{where}.setup"),
+        tension=_number(_required(table, "tension", where), f"{where}.tension"),
+        frequencies=None if frequencies is None else _numbers(frequencies, f"{where}.frequencies"),
+        modes=None if modes is None else _integers(modes, f"{where}.modes"),
+        record=None if record is None else _string(record, f"{where}.record"),
+    )
+
+
+# --------------------------------------------------------------------------
+# Field checks: each raises CampaignError naming the field
+# --------------------------------------------------------------------------
+
+
+def _field(where: str, key: str) -> str:
+    return f"{where}.{key}" if where else key
+
+
+def _check_keys(table: dict[str, Any], allowed: tuple[str, ...], where: str) -> None:
+    """Refuse any key of ``table`` not in ``allowed``."""
+    for key in table:
+        if key not in allowed:
+            raise CampaignError(
+                f"unknown key {key!r}; expected one of: {', '.join(allowed)}", field=_field(where, key)
+            )
+
+
+def _required(table: dict[str, Any], key: str, where: str) -> Any:
+    if key not in table:
+        raise CampaignError("is required but missing", field=_field(where, key))
+    return table[key]
+
+
+def _item_name(table: dict[str, Any], kind: str, index: int) -> str:
+    """The ``name`` of the ``index``-th item of ``kind``, checked."""
+    field = f"{kind}[#{index}].name"
+    return _string(_required(table, "name", f"{kind}[#{index}]"), field)
+
+
+def _table(value: Any, field: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise CampaignError(f"must be a table [{field}], got {_show(value)}", field=field)
+    return value
+
+
+def _tables(value: Any, field: str) -> list[dict[str, Any]]:
+    """An array of tables, ``[[setup]]`` and the like."""
+    header = re.sub(r"\[[^\]]*\]", "", field)  # setup[case2].attachment -> setup.attachment
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        raise CampaignError(f"must be an array of tables [[{header}]], got {_show(value)}", field=field)
+    return value
+
+
+def _string(value: Any, field: str, empty_ok: bool = False) -> str:
+    if not isinstance(value, str) or not (value or empty_ok):
+        kind = "a string" if empty_ok else "a non-empty string"
+        raise CampaignError(f"must be {kind}, got {_show(value)}", field=field)
+    return value
+
+
+def _is_number(value: Any) -> bool:
+    """True for TOML integers and floats; booleans are not numbers."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _number(value: Any, field: str) -> int | float:
+    if not _is_number(value):
+        raise CampaignError(f"must be a number, got {_show(value)}", field=field)
+    return value
+
+
+def _numbers(value: Any, field: str) -> tuple[int | float, ...]:
+    if not isinstance(value, list) or not all(_is_number(v) for v in value):
+        raise CampaignError(f"must be a list of numbers, got {_show(value)}", field=field)
+    return tuple(value)
+
+
+def _integers(value: Any, field: str) -> tuple[int, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+        raise CampaignError(f"must be a list of integers, got {_show(value)}", field=field)
+    return tuple(value)
+
+
+def _show(value: Any) -> str:
+    """A short, one-line description of a TOML value for a message."""
+    if isinstance(value, dict):
+        return "a table"
+    text = repr(value)
+    kind = {str: "string", bool: "boolean", list: "list"}.get(type(value), type(value).__name__)
+    text = text if len(text) <= 40 else text[:37] + "..."
+    return f"{kind} {_one_line(text)}"
+
+
+def _one_line(message: Any) -> str:
+    return " ".join(str(message).split())
+
+
+# --------------------------------------------------------------------------
+# Writing
+# --------------------------------------------------------------------------
+
+
+def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
+    """Write a campaign in the ``campaign.toml`` format.
+
+    Reading the text back with :func:`load_campaign` gives an equal
+    campaign (apart from ``directory``, which is where the file is put).
+    Every field is written out, defaults included, so the file shows what
+    the toolkit will use.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    header : str, optional
+        Text put first as TOML comments, one ``#`` line per line.
+
+    Returns
+    -------
+    str
+        The TOML text, ending with a newline.
+    """
+    lines = [("# " + line).rstrip() for line in header.splitlines()]
+    if lines:
+        lines.append("")
+    lines += _campaign_lines(campaign)
+    lines += ["", *_cable_lines(campaign.cable)]
+    for setup in campaign.setups:
+        lines += ["", *_setup_lines(setup)]
+    for test in campaign.tests:
+        lines += ["", *_test_lines(test)]
+    return "\n".join(lines) + "\n"
+
+
+def _campaign_lines(campaign: Campaign) -> list[str]:
+    lines = ["[campaign]", f"name = {_toml_string(campaign.name)}"]
+    if campaign.description:
+        lines.append(f"description = {_toml_string(campaign.description)}")
+    return lines
+
+
+def _cable_lines(cable: Cable) -> list[str]:
+    lines = [
+        "[cable]",
+        f"length = {_toml_float(cable.length)}",
+        f"mass_per_length = {_toml_float(cable.mass_per_length)}",
+        f"EI = {_toml_float(cable.EI)}",
+    ]
+    if cable.EA is not None:
+        lines.append(f"EA = {_toml_float(cable.EA)}")
+    lines += [
+        f"inclination = {_toml_float(_degrees(cable.inclination))}",
+        f"gravity = {_toml_float(cable.gravity)}",
+        f"boundary = {_toml_boundary(cable.boundary_a, cable.boundary_b)}",
+    ]
+    return lines
+
+
+def _setup_lines(setup: Setup) -> list[str]:
+    lines = ["[[setup]]", f"name = {_toml_string(setup.name)}"]
+    for a in setup.attachments:
+        lines += [
+            "",
+            "  [[setup.attachment]]",
+            f"  name = {_toml_string(a.name)}",
+            f"  position = {_toml_float(a.position)}",
+            f"  mass = {_toml_float(a.mass)}",
+            f"  stiffness = {_toml_float(a.stiffness)}",
+        ]
+    return lines
+
+
+def _test_lines(test: Test) -> list[str]:
+    lines = [
+        "[[test]]",
+        f"name = {_toml_string(test.name)}",
+        f"setup = {_toml_string(test.setup)}",
+        f"tension = {_toml_float(test.tension)}",
+    ]
+    if test.frequencies is not None:
+        lines.append(f"frequencies = [{', '.join(_toml_float(f) for f in test.frequencies)}]")
+        lines.append(f"modes = [{', '.join(str(k) for k in test.modes)}]")
+    if test.record is not None:
+        lines.append(f"record = {_toml_string(test.record)}")
+    return lines
+
+
+def _toml_boundary(a: Boundary, b: Boundary) -> str:
+    if a == b:
+        return _toml_boundary_end(a)
+    return f"[{_toml_boundary_end(a)}, {_toml_boundary_end(b)}]"
+
+
+def _toml_boundary_end(end: Boundary) -> str:
+    if end.kind == "spring":
+        return _toml_float(end.rotational_stiffness)
+    return _toml_string(end.kind)
+
+
+def _degrees(radians: float) -> float:
+    """The shortest angle in degrees that reads back as exactly ``radians``."""
+    exact = math.degrees(radians)
+    for digits in range(1, 18):
+        candidate = float(f"{exact:.{digits}g}")
+        if math.radians(candidate) == radians:
+            return candidate
+    return exact
+
+
+def _toml_float(value: float) -> str:
+    """A TOML float with the fewest digits that read back exactly."""
+    value = float(value)
+    if math.isnan(value):
+        return "nan"
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    if abs(value) < _EXPONENT_FROM:
+        return repr(value)
+    for digits in range(17):
+        text = f"{value:.{digits}e}"
+        if float(text) == value:
+            mantissa, exponent = text.split("e")
+            return f"{mantissa}e{int(exponent)}"
+    return repr(value)
+
+
+_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
+
+
+def _toml_string(text: str) -> str:
+    """A TOML basic string, escaped."""
+    out = []
+    for ch in text:
+        if ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'

@@ -1,0 +1,58 @@
+"""Exceptions and warnings of stcs-ident, in one place.
+
+Every error a user can cause carries what they need to fix it: the file,
+the field and what is wrong. The command line turns them into one line on
+standard error and exit status 2.
+"""
+
+from __future__ import annotations
+
+
+class InputError(ValueError):
+    """Bad input: a file, a field or a value the toolkit cannot accept.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, in plain words.
+    field : str, optional
+        Dotted name of the offending field (``"cable.length"``,
+        ``"setup[case2].attachment[W1].position"``).
+    file : str, optional
+        The file that holds the field.
+    """
+
+    def __init__(self, message: str, *, field: str | None = None, file: str | None = None):
+        self.message = message
+        self.field = field
+        self.file = file
+        super().__init__(self._text())
+
+    def _text(self) -> str:
+        parts = []
+        if self.file:
+            parts.append(str(self.file))
+        if self.field:
+            parts.append(f"field '{self.field}'")
+        head = ": ".join(parts)
+        return f"{head}: {self.message}" if head else self.message
+
+    def with_file(self, file: str) -> "InputError":
+        """Return the same error, attributed to ``file``."""
+        return type(self)(self.message, field=self.field, file=file)
+
+
+class CampaignError(InputError):
+    """A campaign file that is unreadable, incomplete or inconsistent."""
+
+
+class ModelError(InputError):
+    """A model object built with an invalid value (names the field)."""
+
+
+class ComputationError(RuntimeError):
+    """A computation that failed, for example a root that did not converge."""
+
+
+class StcsWarning(UserWarning):
+    """Base class of the toolkit's warnings."""

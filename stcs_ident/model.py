@@ -1,0 +1,306 @@
+"""Model objects: cable, boundary, attachment, setup, test, campaign.
+
+Frozen dataclasses in SI units (lengths in m, masses in kg, forces in N,
+angles in radians), validated when built; an invalid value raises
+:class:`~stcs_ident.errors.ModelError` naming the field. Units other than
+SI appear only at the edges (campaign files give the inclination in
+degrees; tables print kN).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Iterable
+
+from .errors import ModelError
+
+
+def _finite(value, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"must be a number, got {value!r}", field=name) from None
+    if isinstance(value, bool) or not math.isfinite(v):
+        raise ModelError(f"must be a finite number, got {value!r}", field=name)
+    return v
+
+
+def _positive(value, name: str) -> float:
+    v = _finite(value, name)
+    if v <= 0:
+        raise ModelError(f"must be > 0, got {value!r}", field=name)
+    return v
+
+
+def _non_negative(value, name: str) -> float:
+    v = _finite(value, name)
+    if v < 0:
+        raise ModelError(f"must be >= 0, got {value!r}", field=name)
+    return v
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """Rotational restraint of one anchorage (transverse displacement is zero).
+
+    Parameters
+    ----------
+    rotational_stiffness : float
+        N m/rad; ``math.inf`` is a clamped end, ``0`` a pinned end.
+    """
+
+    rotational_stiffness: float = math.inf
+
+    def __post_init__(self):
+        k = self.rotational_stiffness
+        if isinstance(k, bool):
+            raise ModelError(f"must be a number, got {k!r}", field="boundary")
+        try:
+            k = float(k)
+        except (TypeError, ValueError):
+            raise ModelError(f"must be a number, got {k!r}", field="boundary") from None
+        if math.isnan(k) or k < 0:
+            raise ModelError(f"rotational stiffness must be >= 0, got {k!r}", field="boundary")
+        object.__setattr__(self, "rotational_stiffness", k)
+
+    @classmethod
+    def clamped(cls) -> "Boundary":
+        return cls(math.inf)
+
+    @classmethod
+    def pinned(cls) -> "Boundary":
+        return cls(0.0)
+
+    @property
+    def is_clamped(self) -> bool:
+        return math.isinf(self.rotational_stiffness)
+
+    @property
+    def kind(self) -> str:
+        """``"clamped"``, ``"pinned"`` or ``"spring"``."""
+        if self.is_clamped:
+            return "clamped"
+        return "pinned" if self.rotational_stiffness == 0 else "spring"
+
+    def describe(self) -> str:
+        if self.kind == "spring":
+            return f"rotational spring {self.rotational_stiffness:.4g} N m/rad"
+        return self.kind
+
+
+@dataclass(frozen=True)
+class Cable:
+    """A tensioned, shallow-sag cable with bending stiffness.
+
+    Parameters
+    ----------
+    length : float
+        Chord length l between anchorages A (x = 0) and B (x = l), m.
+    mass_per_length : float
+        m, kg/m.
+    EI : float
+        Bending stiffness, N m^2 (0 for a string).
+    EA : float or None
+        Axial stiffness, N; ``None`` ignores sag-extensibility.
+    inclination : float
+        Chord angle from horizontal, radians, |θ| < π/2.
+    gravity : float
+        m/s^2.
+    boundary_a, boundary_b : Boundary
+        Rotational restraint at A and at B.
+    """
+
+    length: float
+    mass_per_length: float
+    EI: float
+    EA: float | None = None
+    inclination: float = 0.0
+    gravity: float = 9.81
+    boundary_a: Boundary = field(default_factory=Boundary.clamped)
+    boundary_b: Boundary = field(default_factory=Boundary.clamped)
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "length", _positive(self.length, "cable.length"))
+        set_(self, "mass_per_length", _positive(self.mass_per_length, "cable.mass_per_length"))
+        set_(self, "EI", _non_negative(self.EI, "cable.EI"))
+        if self.EA is not None:
+            set_(self, "EA", _positive(self.EA, "cable.EA"))
+        theta = _finite(self.inclination, "cable.inclination")
+        if abs(theta) >= math.pi / 2:
+            raise ModelError("must satisfy |inclination| < 90 degrees", field="cable.inclination")
+        set_(self, "inclination", theta)
+        set_(self, "gravity", _non_negative(self.gravity, "cable.gravity"))
+        for name in ("boundary_a", "boundary_b"):
+            if not isinstance(getattr(self, name), Boundary):
+                raise ModelError("must be a Boundary", field=f"cable.{name}")
+
+    @property
+    def weight_per_length(self) -> float:
+        """w = m g cos θ, the weight per unit length normal to the chord (N/m)."""
+        return self.mass_per_length * self.gravity * math.cos(self.inclination)
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """A point mass and/or transverse spring clamped on the cable.
+
+    Parameters
+    ----------
+    name : str
+    position : float
+        Distance from end A along the chord, m.
+    mass : float
+        kg.
+    stiffness : float
+        Transverse spring to ground, N/m.
+    """
+
+    name: str
+    position: float
+    mass: float = 0.0
+    stiffness: float = 0.0
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ModelError("must be a non-empty string", field="attachment.name")
+        where = f"attachment[{self.name}]"
+        object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
+        object.__setattr__(self, "mass", _non_negative(self.mass, f"{where}.mass"))
+        object.__setattr__(self, "stiffness", _non_negative(self.stiffness, f"{where}.stiffness"))
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What is attached where: a named, position-ordered set of attachments."""
+
+    name: str
+    attachments: tuple[Attachment, ...] = ()
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ModelError("must be a non-empty string", field="setup.name")
+        atts = tuple(self.attachments)
+        for a in atts:
+            if not isinstance(a, Attachment):
+                raise ModelError("must hold Attachment objects", field=f"setup[{self.name}].attachment")
+        names = [a.name for a in atts]
+        for n in names:
+            if names.count(n) > 1:
+                raise ModelError(f"duplicate attachment name {n!r}", field=f"setup[{self.name}].attachment[{n}].name")
+        atts = tuple(sorted(atts, key=lambda a: a.position))
+        for a, b in zip(atts, atts[1:]):
+            if a.position == b.position:
+                raise ModelError(
+                    f"attachments {a.name!r} and {b.name!r} are at the same position {a.position} m",
+                    field=f"setup[{self.name}].attachment[{b.name}].position",
+                )
+        object.__setattr__(self, "attachments", atts)
+
+    def check_span(self, length: float) -> None:
+        """Raise if an attachment is not strictly inside the span (0, length)."""
+        for a in self.attachments:
+            if not 0 < a.position < length:
+                raise ModelError(
+                    f"position {a.position} m is outside the span (0, {length}) m",
+                    field=f"setup[{self.name}].attachment[{a.name}].position",
+                )
+
+
+@dataclass(frozen=True)
+class Test:
+    """One tension level of one setup, with measured data.
+
+    Parameters
+    ----------
+    name, setup : str
+    tension : float
+        Measured static tension H along the chord, N.
+    frequencies : tuple of float or None
+        Measured natural frequencies, Hz.
+    modes : tuple of int or None
+        Mode numbers of ``frequencies`` (default 1..N).
+    record : str or None
+        Path of an acceleration record, relative to the campaign directory.
+    """
+
+    __test__ = False  # not a pytest class
+
+    name: str
+    setup: str
+    tension: float
+    frequencies: tuple[float, ...] | None = None
+    modes: tuple[int, ...] | None = None
+    record: str | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ModelError("must be a non-empty string", field="test.name")
+        where = f"test[{self.name}]"
+        object.__setattr__(self, "tension", _positive(self.tension, f"{where}.tension"))
+        if self.frequencies is not None:
+            freqs = tuple(_positive(f, f"{where}.frequencies") for f in self.frequencies)
+            if not freqs:
+                raise ModelError("must not be empty", field=f"{where}.frequencies")
+            object.__setattr__(self, "frequencies", freqs)
+            modes = self.modes if self.modes is not None else tuple(range(1, len(freqs) + 1))
+            modes = tuple(modes)
+            if len(modes) != len(freqs):
+                raise ModelError(
+                    f"has {len(modes)} entries but frequencies has {len(freqs)}", field=f"{where}.modes"
+                )
+            for k in modes:
+                if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+                    raise ModelError(f"mode numbers must be integers >= 1, got {k!r}", field=f"{where}.modes")
+            if len(set(modes)) != len(modes):
+                raise ModelError("mode numbers must be distinct", field=f"{where}.modes")
+            object.__setattr__(self, "modes", modes)
+        elif self.modes is not None:
+            raise ModelError("given without frequencies", field=f"{where}.modes")
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """One cable, its setups and its tests."""
+
+    name: str
+    cable: Cable
+    setups: tuple[Setup, ...] = ()
+    tests: tuple[Test, ...] = ()
+    description: str = ""
+    directory: str | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ModelError("must be a non-empty string", field="campaign.name")
+        object.__setattr__(self, "setups", tuple(self.setups))
+        object.__setattr__(self, "tests", tuple(self.tests))
+        _unique((s.name for s in self.setups), "setup")
+        _unique((t.name for t in self.tests), "test")
+        for s in self.setups:
+            s.check_span(self.cable.length)
+        known = {s.name for s in self.setups}
+        for t in self.tests:
+            if t.setup not in known:
+                raise ModelError(f"names unknown setup {t.setup!r}", field=f"test[{t.name}].setup")
+
+    def setup(self, name: str) -> Setup:
+        for s in self.setups:
+            if s.name == name:
+                return s
+        raise KeyError(name)
+
+    def test(self, name: str) -> Test:
+        for t in self.tests:
+            if t.name == name:
+                return t
+        raise KeyError(name)
+
+
+def _unique(names: Iterable[str], kind: str) -> None:
+    seen = set()
+    for n in names:
+        if n in seen:
+            raise ModelError(f"duplicate {kind} name {n!r}", field=f"{kind}[{n}].name")
+        seen.add(n)
