@@ -96,6 +96,9 @@ class CableBatch:
         )
         self.stretched = stretched_lengths(self.seg_len, self.slope_start, self.slope_end)
         self.v_dof, self.t_dof, self.h_dof, self.n_dof = topology.dof_map()
+        self._scatter = self._scatter_matrix()
+        self._constant = self._constant_part()
+        self._scale = self._dof_scales()
 
     def __len__(self):
         return len(self.length)
@@ -103,81 +106,152 @@ class CableBatch:
     def segments(self, idx, omega):
         """Segment quantities for configurations ``idx`` at ``omega``, shape (len(idx), n_segments)."""
         L = self.seg_len[idx]
-        col = (lambda a: a[idx, None])
         if self.topology.string:
-            return StringSegment(L, col(self.H), col(self.m), omega[:, None])
-        return BeamSegment(L, col(self.EI), col(self.H), col(self.m), omega[:, None])
+            return StringSegment(L, self.H[idx, None], self.m[idx, None], omega[:, None])
+        return BeamSegment(L, self.EI[idx, None], self.H[idx, None], self.m[idx, None], omega[:, None])
 
     def element_dofs(self, j):
         if self.topology.string:
             return np.array([self.v_dof[j], self.v_dof[j + 1]])
         return np.array([self.v_dof[j], self.t_dof[j], self.v_dof[j + 1], self.t_dof[j + 1]])
 
-    def assemble(self, idx, omega, segments=None):
-        """K(ω) of shape (len(idx), n_dof, n_dof), and the J0 count."""
-        topo = self.topology
-        n = len(idx)
-        K = np.zeros((n, self.n_dof, self.n_dof))
-        seg = self.segments(idx, omega) if segments is None else segments
-        J0 = seg.clamped_count().sum(axis=1)
-        Ke = seg.matrix()
-        with_h = topo.tension_model != "none"
-        if with_h:
-            H = self.H[idx]
-            gamma = self.w[idx] / (H * self.m[idx] * omega * omega)
-            force = -gamma[:, None, None] * seg.translation_force()
-            residual = gamma[:, None] ** 2 * seg.translation_residual
+    def _h_of(self, j):
+        return self.h_dof[0] if self.topology.tension_model == "uniform" else self.h_dof[j]
+
+    def _scatter_matrix(self):
+        """0/1 matrix S such that vec K = vec K_const + V S, where V holds, per
+        item, the frequency-dependent values in the order of :meth:`assemble`:
+        element matrices, ĥ couplings, ĥ diagonals, −M ω² of the attachments."""
+        topo, nd = self.topology, self.n_dof
+        ne = 2 if topo.string else 4
+        targets = []  # one list of (row, col) per column of V
         for j in range(topo.n_segments):
             dofs = self.element_dofs(j)
-            keep = np.flatnonzero(dofs >= 0)
-            d = dofs[keep]
-            K[:, d[:, None], d[None, :]] += Ke[:, j, keep[:, None], keep[None, :]]
-            if not with_h:
-                continue
-            h = self.h_dof[0] if topo.tension_model == "uniform" else self.h_dof[j]
-            K[:, d, h] += force[:, j, keep]
-            K[:, h, d] += force[:, j, keep]
-            K[:, h, h] += residual[:, j]
-            if topo.tension_model == "per-segment":
-                K[:, h, h] -= self.stretched[idx, j] / self.EA[idx]
-                for node, slope in ((j, -self.slope_start[idx, j]), (j + 1, self.slope_end[idx, j])):
-                    v = self.v_dof[node]
-                    if v >= 0:
-                        K[:, v, h] += slope
-                        K[:, h, v] += slope
-        if topo.tension_model == "uniform":
-            h = self.h_dof[0]
-            K[:, h, h] -= self.stretched[idx].sum(axis=1) / self.EA[idx]
+            for r in range(ne):
+                for c in range(ne):
+                    ok = dofs[r] >= 0 and dofs[c] >= 0
+                    targets.append([(dofs[r], dofs[c])] if ok else [])
+        if topo.tension_model != "none":
+            for j in range(topo.n_segments):
+                h = self._h_of(j)
+                for r, d in enumerate(self.element_dofs(j)):
+                    targets.append([(d, h), (h, d)] if d >= 0 else [])
+            for j in range(topo.n_segments):
+                h = self._h_of(j)
+                targets.append([(h, h)])
+        for k in range(topo.n_attachments):
+            v = self.v_dof[k + 1]
+            targets.append([(v, v)])
+        S = np.zeros((len(targets), nd * nd))
+        for col, pairs in enumerate(targets):
+            for r, c in pairs:
+                S[col, r * nd + c] += 1.0
+        return S
+
+    def _constant_part(self):
+        """The ω-independent part of K per configuration: springs, end
+        restraints, the −L_e/EA diagonal and the static-slope couplings."""
+        topo = self.topology
+        K = np.zeros((len(self.length), self.n_dof, self.n_dof))
         if topo.n_attachments:
             v = self.v_dof[1:-1]
-            K[:, v, v] += self.springs[idx] - self.masses[idx] * (omega * omega)[:, None]
-            if topo.tension_model == "uniform":
-                K[:, v, self.h_dof[0]] += self.kinks[idx]
-                K[:, self.h_dof[0], v] += self.kinks[idx]
+            K[:, v, v] += self.springs
         if not topo.string:
             for node, end in ((0, self.end_a), (topo.n_attachments + 1, self.end_b)):
                 t = self.t_dof[node]
                 if t >= 0:
-                    K[:, t, t] += end[idx]
-        return K, J0
+                    K[:, t, t] += end
+        if topo.tension_model == "uniform":
+            h = self.h_dof[0]
+            K[:, h, h] -= self.stretched.sum(axis=1) / self.EA
+            if topo.n_attachments:
+                K[:, self.v_dof[1:-1], h] += self.kinks
+                K[:, h, self.v_dof[1:-1]] += self.kinks
+        elif topo.tension_model == "per-segment":
+            for j in range(topo.n_segments):
+                h = self.h_dof[j]
+                K[:, h, h] -= self.stretched[:, j] / self.EA
+                for node, slope in ((j, -self.slope_start[:, j]), (j + 1, self.slope_end[:, j])):
+                    v = self.v_dof[node]
+                    if v >= 0:
+                        K[:, v, h] += slope
+                        K[:, h, v] += slope
+        return K.reshape(len(self.length), -1)
+
+    def _dof_scales(self):
+        """Fixed (ω-independent) scale of every unknown, so that the scaled
+        matrix s_i K_ij s_j has entries of order one: displacement rows are
+        of order H p, rotation rows EI p (p ≈ √(H/EI), at least 1/l), the ĥ
+        rows L_e/EA. A congruence keeps the inertia, and a fixed scaling
+        only multiplies det K by a positive constant."""
+        topo = self.topology
+        n = len(self.length)
+        if topo.string:
+            p = 1.0 / self.length
+        else:
+            with np.errstate(divide="ignore"):
+                p = np.maximum(np.sqrt(self.H / self.EI), 1.0 / self.length)
+        scale = np.ones((n, self.n_dof))
+        v = self.v_dof[self.v_dof >= 0]
+        scale[:, v] = 1.0 / np.sqrt(self.H * p)[:, None]
+        t = self.t_dof[self.t_dof >= 0]
+        if t.size:
+            scale[:, t] = 1.0 / np.sqrt(self.EI * p)[:, None]
+        if topo.n_h:
+            scale[:, self.h_dof] = np.sqrt(self.EA / self.stretched.sum(axis=1))[:, None]
+        return scale
+
+    def assemble(self, idx, omega, segments=None):
+        """K(ω) of shape (len(idx), n_dof, n_dof), and the J0 count."""
+        topo = self.topology
+        n = len(idx)
+        seg = self.segments(idx, omega) if segments is None else segments
+        J0 = seg.clamped_count().sum(axis=1)
+        parts = [seg.matrix().reshape(n, -1)]
+        if topo.tension_model != "none":
+            gamma = self.w[idx] / (self.H[idx] * self.m[idx] * omega * omega)
+            parts.append((-gamma[:, None, None] * seg.translation_force()).reshape(n, -1))
+            parts.append(gamma[:, None] ** 2 * seg.translation_residual)
+        if topo.n_attachments:
+            parts.append(-self.masses[idx] * (omega * omega)[:, None])
+        V = np.concatenate(parts, axis=1)
+        K = self._constant[idx] + V @ self._scatter
+        return K.reshape(n, self.n_dof, self.n_dof), J0
 
     def evaluate(self, idx, omega):
         """Wittrick–Williams count J(ω), det K(ω) and J0(ω) for configurations ``idx``."""
         K, J0 = self.assemble(idx, omega)
-        negative, det = negative_pivots(K)
+        s = self._scale[idx]
+        negative, det = negative_pivots(K * s[:, :, None] * s[:, None, :])
         return J0 + negative - self.topology.n_h, det, J0
 
 
+#: Below this many matrices one batched LAPACK call is faster than
+#: elimination vectorised across the batch.
+SMALL_BATCH = 256
+
+
 def negative_pivots(K):
-    """Negative pivots and determinant of symmetric matrices, by elimination
-    without row interchanges (Sylvester's law of inertia: the count equals
-    the number of negative eigenvalues)."""
+    """Number of negative eigenvalues and determinant of symmetric matrices.
+
+    Small batches use LAPACK's symmetric eigenvalues; large ones Gaussian
+    elimination without row interchanges, vectorised across the batch (by
+    Sylvester's law of inertia the negative pivots count the negative
+    eigenvalues). An exactly zero pivot (a matrix evaluated exactly at a
+    root) is replaced by a relative 1e-14, which keeps the count and
+    leaves the determinant at round-off size.
+    """
+    if K.shape[0] <= SMALL_BATCH:
+        lam = np.linalg.eigvalsh(K)
+        return np.count_nonzero(lam < 0, axis=-1), np.prod(lam, axis=-1)
     A = K.copy()
     n = A.shape[-1]
     negative = np.zeros(A.shape[0], dtype=np.int64)
     det = np.ones(A.shape[0])
+    floor = 1e-14 * np.abs(K).max(axis=(1, 2))
     for k in range(n):
         d = A[:, k, k]
+        d = np.where(d == 0, floor, d)
         negative += d < 0
         det *= d
         if k + 1 < n:

@@ -18,22 +18,22 @@ so the rotational end restraints are ignored.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import ModelError
+from ..errors import ComputationError, ModelError
 from ..model import Attachment, Cable
 
 __all__ = [
     "FEModel",
-    "fe_matrices",
     "fe_eigen",
     "fe_frequencies",
+    "fe_matrices",
     "fe_modes",
 ]
 
@@ -44,16 +44,13 @@ SOLVERS = ("dense", "sparse")
 # (u1, θ1, u2, θ2): entry (i, j) carries h**(_H_POW[i] + _H_POW[j]).
 _H_POW = np.array([0, 1, 0, 1])
 _H_SCALE_POW = _H_POW[:, None] + _H_POW[None, :]
-_KB_HAT = np.array(
-    [[12.0, 6.0, -12.0, 6.0], [6.0, 4.0, -6.0, 2.0], [-12.0, -6.0, 12.0, -6.0], [6.0, 2.0, -6.0, 4.0]]
-)
-_KG_HAT = np.array(
-    [[36.0, 3.0, -36.0, 3.0], [3.0, 4.0, -3.0, -1.0], [-36.0, -3.0, 36.0, -3.0], [3.0, -1.0, -3.0, 4.0]]
-)
+_KB_HAT = np.array([[12.0, 6.0, -12.0, 6.0], [6.0, 4.0, -6.0, 2.0], [-12.0, -6.0, 12.0, -6.0], [6.0, 2.0, -6.0, 4.0]])
+_KG_HAT = np.array([[36.0, 3.0, -36.0, 3.0], [3.0, 4.0, -3.0, -1.0], [-36.0, -3.0, 36.0, -3.0], [3.0, -1.0, -3.0, 4.0]])
 _M_HAT = np.array(
     [[156.0, 22.0, 54.0, -13.0], [22.0, 4.0, 13.0, -3.0], [54.0, 13.0, 156.0, -22.0], [-13.0, -3.0, -22.0, 4.0]]
 )
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(16)
+_V0_SEED = 20200638  # fixed ARPACK start vector: reproducible to the last bit
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,22 +159,25 @@ def fe_matrices(
     ----------
     cable : Cable
     attachments : sequence of Attachment
-        Any order; attachments at the same position are merged.
+        Any order; attachments at the same position are merged into one.
     tension : float
-        Static tension H along the chord, N (> 0; 0 is accepted for a
-        beam, EI > 0, without the sag term).
+        Static tension H along the chord, N. Must be > 0, except for a
+        beam (EI > 0) without the sag term, where 0 is accepted.
     n_elements : int
         Total number of elements. Each segment between consecutive nodes
         (ends and attachments) gets a share proportional to its length,
-        at least 2, so the mesh may hold a few more.
+        and at least 2, so a mesh may hold a few more than asked.
     tension_model : {"uniform", "none"}
         ``"uniform"`` adds the rank-one sag-extensibility term when
         ``cable.EA`` is given; ``"none"`` omits it.
     grading : float
-        Mesh refinement near restrained ends (clamped or rotational
-        spring), where the mode shapes have a boundary layer of width
+        Refinement near restrained ends (clamped or rotational spring,
+        EI > 0), where the modes have a boundary layer of width
         δ = √(EI/H): the element density is ``1 + grading·exp(-d/δ)`` at
-        distance d from such an end. 0 gives a mesh uniform in each segment.
+        distance d from such an end, so the elements there shrink by up to
+        ``1 + grading`` and grow smoothly into the span. 0 (default) keeps
+        the elements of a segment equal. ``grading=2`` lowers the error of
+        the low modes of a clamped strand about tenfold at equal size.
 
     Returns
     -------
@@ -185,48 +185,23 @@ def fe_matrices(
     """
     tension = _check_inputs(cable, tension, n_elements, tension_model, grading)
     atts = _merge_attachments(cable, attachments)
-    breaks = np.concatenate(([0.0], [a[0] for a in atts], [cable.length]))
-    layer = math.sqrt(cable.EI / tension) if cable.EI > 0 and tension > 0 else 0.0
-    restrained = _restrained_ends(cable)
-    node_x, att_nodes = _mesh(breaks, n_elements, grading if layer > 0 else 0.0, layer, restrained)
-
-    beam = cable.EI > 0
-    dofs = _dof_map(len(node_x), att_nodes, split=not beam)
+    breaks = np.concatenate(([0.0], atts[:, 0], [cable.length]))
+    node_x, att_nodes = _mesh(breaks, n_elements, _density(cable, tension, grading))
+    dofs = _number_dofs(cable, len(node_x), att_nodes)
     h = np.diff(node_x)
-    ke = _element_stiffness(h, cable.EI, tension)
-    me = _element_mass(h, cable.mass_per_length)
-    n_full = dofs.n_full
-    K = _assemble(ke, dofs.element_dofs, n_full)
-    M = _assemble(me, dofs.element_dofs, n_full)
-    diag_k = np.zeros(n_full)
-    diag_m = np.zeros(n_full)
-    for (x, mass, stiffness), node in zip(atts, att_nodes):
-        diag_k[dofs.disp[node]] += stiffness
-        diag_m[dofs.disp[node]] += mass
-    fixed = [dofs.disp[0], dofs.disp[-1]]
-    if beam:
-        for end, boundary in ((0, cable.boundary_a), (len(node_x) - 1, cable.boundary_b)):
-            rot = dofs.rot_right[end] if end == 0 else dofs.rot_left[end]
-            if boundary.is_clamped:
-                fixed.append(rot)
-            else:
-                diag_k[rot] += boundary.rotational_stiffness
-    K = (K + sp.diags(diag_k)).tocsr()
-    M = (M + sp.diags(diag_m)).tocsr()
 
-    free = np.setdiff1d(np.arange(n_full), fixed)
-    K = K[free][:, free].tocsr()
-    M = M[free][:, free].tocsr()
-    reduced = np.full(n_full, -1)
-    reduced[free] = np.arange(len(free))
-    disp_index = reduced[dofs.disp]
+    k_diag = [(dofs.disp[att_nodes], atts[:, 2])]
+    if cable.EI > 0:
+        for rot, boundary in ((dofs.end_rot[0], cable.boundary_a), (dofs.end_rot[1], cable.boundary_b)):
+            if rot >= 0:
+                k_diag.append((np.array([rot]), np.array([boundary.rotational_stiffness])))
+    K = _assemble(_element_stiffness(h, cable.EI, tension), dofs, k_diag)
+    M = _assemble(_element_mass(h, cable.mass_per_length), dofs, [(dofs.disp[att_nodes], atts[:, 1])])
 
     g, coef, stretched = None, 0.0, cable.length
     if tension_model == "uniform" and cable.EA is not None:
-        slope_nodes = _static_slopes(cable, atts, breaks, tension)
-        stretched = _stretched_length(breaks, slope_nodes)
-        g_full = _sag_vector(h, dofs.element_dofs, n_full, cable, atts, att_nodes, dofs, tension)
-        g = g_full[free]
+        stretched = _stretched_length(breaks, _static_slopes(cable, atts, tension))
+        g = _sag_vector(cable, atts, tension, h, dofs, att_nodes)
         coef = cable.EA / stretched
 
     return FEModel(
@@ -235,9 +210,9 @@ def fe_matrices(
         g=g,
         coef=coef,
         node_x=node_x,
-        disp_index=disp_index,
-        attachment_nodes=np.asarray(att_nodes, dtype=int),
-        upper_bandwidth=_upper_bandwidth(K),
+        disp_index=dofs.disp,
+        attachment_nodes=att_nodes,
+        upper_bandwidth=dofs.upper_bandwidth,
         stretched_length=stretched,
         tension=tension,
         tension_model=tension_model,
@@ -346,39 +321,46 @@ def fe_modes(
     return _to_hz(lam), model.node_x.copy(), model.nodal_displacements(vecs), vecs
 
 
-# ----------------------------------------------------------------- checks
+# ------------------------------------------------------------------ checks
 
 
 def _check_inputs(cable: Cable, tension: float, n_elements: int, tension_model: str, grading: float) -> float:
     if not isinstance(cable, Cable):
         raise ModelError("must be a Cable", field="cable")
-    if isinstance(tension, bool):
-        raise ModelError(f"must be a number, got {tension!r}", field="tension")
-    try:
-        tension = float(tension)
-    except (TypeError, ValueError):
-        raise ModelError(f"must be a number, got {tension!r}", field="tension") from None
-    if not math.isfinite(tension) or tension < 0:
-        raise ModelError(f"must be a finite number >= 0, got {tension!r}", field="tension")
+    tension = _number(tension, "tension")
+    if tension < 0:
+        raise ModelError(f"must be >= 0, got {tension!r}", field="tension")
     if tension == 0 and cable.EI == 0:
         raise ModelError("must be > 0 for a string (EI = 0)", field="tension")
     if tension_model not in TENSION_MODELS:
         raise ModelError(f"must be one of {TENSION_MODELS}, got {tension_model!r}", field="tension_model")
     if tension == 0 and tension_model == "uniform" and cable.EA is not None:
-        raise ModelError("must be > 0 for the sag term (use tension_model='none')", field="tension")
+        raise ModelError("must be > 0 for the sag term (or use tension_model='none')", field="tension")
     if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) or n_elements < 2:
         raise ModelError(f"must be an integer >= 2, got {n_elements!r}", field="n_elements")
-    if not (math.isfinite(grading) and grading >= 0):
-        raise ModelError(f"must be a finite number >= 0, got {grading!r}", field="grading")
+    if _number(grading, "grading") < 0:
+        raise ModelError(f"must be >= 0, got {grading!r}", field="grading")
     return tension
 
 
-def _merge_attachments(cable: Cable, attachments: Sequence[Attachment]) -> list[tuple[float, float, float]]:
-    """(position, mass, stiffness) sorted by position, equal positions summed."""
+def _number(value, name: str) -> float:
+    if isinstance(value, bool):
+        raise ModelError(f"must be a number, got {value!r}", field=name)
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"must be a number, got {value!r}", field=name) from None
+    if not math.isfinite(v):
+        raise ModelError(f"must be finite, got {value!r}", field=name)
+    return v
+
+
+def _merge_attachments(cable: Cable, attachments: Sequence[Attachment]) -> np.ndarray:
+    """Rows (position, mass, stiffness) in position order, equal positions summed."""
     merged: dict[float, list[float]] = {}
     for a in attachments:
         if not isinstance(a, Attachment):
-            raise ModelError("must hold Attachment objects", field="attachments")
+            raise ModelError(f"must hold Attachment objects, got {a!r}", field="attachments")
         if not 0 < a.position < cable.length:
             raise ModelError(
                 f"position {a.position} m is outside the span (0, {cable.length}) m",
@@ -387,65 +369,66 @@ def _merge_attachments(cable: Cable, attachments: Sequence[Attachment]) -> list[
         entry = merged.setdefault(a.position, [0.0, 0.0])
         entry[0] += a.mass
         entry[1] += a.stiffness
-    return [(x, ms[0], ms[1]) for x, ms in sorted(merged.items())]
+    rows = [(x, mass, spring) for x, (mass, spring) in sorted(merged.items())]
+    return np.array(rows, dtype=float).reshape(-1, 3)
 
 
-def _restrained_ends(cable: Cable) -> tuple[bool, bool]:
-    return (cable.boundary_a.rotational_stiffness > 0, cable.boundary_b.rotational_stiffness > 0)
+# -------------------------------------------------------------------- mesh
 
 
-# ------------------------------------------------------------------- mesh
+def _density(cable: Cable, tension: float, grading: float):
+    """Cumulative element density D(x) = ∫₀ˣ ρ, ρ = 1 + grading·e^{-d/δ}; None if uniform."""
+    restrained_a = cable.boundary_a.rotational_stiffness > 0
+    restrained_b = cable.boundary_b.rotational_stiffness > 0
+    if grading == 0 or cable.EI == 0 or tension == 0 or not (restrained_a or restrained_b):
+        return None
+    layer = math.sqrt(cable.EI / tension)
+    length = cable.length
 
-
-def _mesh(
-    breaks: np.ndarray, n_elements: int, grading: float, layer: float, restrained: tuple[bool, bool]
-) -> tuple[np.ndarray, list[int]]:
-    """Node positions and the node index of each interior break."""
-    length = breaks[-1]
-
-    def density_integral(x: np.ndarray) -> np.ndarray:
-        # ∫_0^x (1 + a e^{-s/δ} [A] + a e^{-(l-s)/δ} [B]) ds, closed form.
+    def cumulative(x: np.ndarray) -> np.ndarray:
         out = np.array(x, dtype=float)
-        if grading > 0:
-            if restrained[0]:
-                out += grading * layer * (1.0 - np.exp(-x / layer))
-            if restrained[1]:
-                out += grading * layer * (np.exp(-(length - x) / layer) - math.exp(-length / layer))
+        if restrained_a:
+            out += grading * layer * -np.expm1(-x / layer)
+        if restrained_b:
+            out += grading * layer * (np.exp(-(length - x) / layer) - math.exp(-length / layer))
         return out
 
-    weights = np.diff(density_integral(breaks))
+    return cumulative
+
+
+def _mesh(breaks: np.ndarray, n_elements: int, density) -> tuple[np.ndarray, np.ndarray]:
+    """Node positions, and the node index of each attachment (interior break)."""
+    weights = np.diff(breaks if density is None else density(breaks))
     counts = _allocate(weights, n_elements)
-    nodes = [np.array([0.0])]
-    att_nodes = []
+    pieces = [breaks[:1]]
     for j, n in enumerate(counts):
-        targets = np.linspace(density_integral(breaks[j]), density_integral(breaks[j + 1]), n + 1)
-        xs = _invert_monotone(density_integral, targets, breaks[j], breaks[j + 1])
-        xs[0], xs[-1] = breaks[j], breaks[j + 1]
-        nodes.append(xs[1:])
-        if j < len(counts) - 1:
-            att_nodes.append(int(sum(counts[: j + 1])))
-    return np.concatenate(nodes), att_nodes
+        lo, hi = breaks[j], breaks[j + 1]
+        if density is None:
+            xs = np.linspace(lo, hi, n + 1)
+        else:
+            xs = _invert_increasing(density, np.linspace(density(lo), density(hi), n + 1), lo, hi)
+            xs[0], xs[-1] = lo, hi
+        pieces.append(xs[1:])
+    return np.concatenate(pieces), np.cumsum(counts)[:-1]
 
 
 def _allocate(weights: np.ndarray, total: int) -> np.ndarray:
-    """Split ``total`` elements over segments in proportion to ``weights``, >= 2 each.
+    """Split ``total`` elements over segments in proportion to ``weights``, at least 2 each.
 
     Largest-remainder rounding of the proportional share.
     """
-    n_seg = len(weights)
-    total = max(total, 2 * n_seg)
+    total = max(total, 2 * len(weights))
     share = weights / weights.sum() * total
     counts = np.maximum(np.floor(share).astype(int), 2)
     while counts.sum() < total:
         counts[np.argmax(share - counts)] += 1
     while counts.sum() > total:
-        over = np.where(counts > 2, counts - share, -np.inf)
-        counts[np.argmax(over)] -= 1
+        counts[np.argmax(np.where(counts > 2, counts - share, -np.inf))] -= 1
     return counts
 
 
-def _invert_monotone(func, targets: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """Solve func(x) = targets for an increasing func on [lo, hi] by bisection."""
+def _invert_increasing(func, targets: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Solve func(x) = targets on [lo, hi] for an increasing func, by bisection."""
     a = np.full(targets.shape, lo)
     b = np.full(targets.shape, hi)
     for _ in range(60):
@@ -458,61 +441,82 @@ def _invert_monotone(func, targets: np.ndarray, lo: float, hi: float) -> np.ndar
 
 @dataclass(frozen=True)
 class _Dofs:
-    n_full: int
-    disp: np.ndarray  # dof of u at each node
-    rot_left: np.ndarray  # rotation dof seen by the element left of each node
-    rot_right: np.ndarray  # ... and by the element right of it
-    element_dofs: np.ndarray  # (n_elements, 4): u1, θ1, u2, θ2
+    """Free-dof numbering; -1 marks a fixed dof."""
+
+    n: int
+    disp: np.ndarray  # u at each node
+    element: np.ndarray  # (n_elements, 4): u1, θ1, u2, θ2 of each element
+    end_rot: tuple[int, int]  # rotation at A and at B
+    upper_bandwidth: int
 
 
-def _dof_map(n_nodes: int, att_nodes: Sequence[int], split: bool) -> _Dofs:
-    """Number the dofs node by node (u, θ, [θ+]) so that the matrices stay banded."""
-    split_nodes = set(att_nodes) if split else set()
-    disp = np.empty(n_nodes, dtype=int)
-    rot_left = np.empty(n_nodes, dtype=int)
-    rot_right = np.empty(n_nodes, dtype=int)
-    k = 0
-    for i in range(n_nodes):
-        disp[i] = k
-        rot_left[i] = rot_right[i] = k + 1
-        k += 2
-        if i in split_nodes:
-            rot_right[i] = k
-            k += 1
-    element_dofs = np.column_stack((disp[:-1], rot_right[:-1], disp[1:], rot_left[1:]))
-    return _Dofs(k, disp, rot_left, rot_right, element_dofs)
+def _number_dofs(cable: Cable, n_nodes: int, att_nodes: np.ndarray) -> _Dofs:
+    """Number the dofs node by node (u, θ, [θ⁺]), which keeps the matrices banded.
+
+    u is fixed at both ends; θ at a clamped end of a beam. For a string the
+    slope may jump at an attachment, so that node gets a second rotation θ⁺
+    for the element on its right.
+    """
+    beam = cable.EI > 0
+    split = np.zeros(n_nodes, dtype=bool)
+    if not beam:
+        split[att_nodes] = True
+    per_node = 2 + split
+    first = np.concatenate(([0], np.cumsum(per_node)[:-1]))
+    disp, rot_left = first, first + 1
+    rot_right = rot_left + split
+    fixed = [disp[0], disp[-1]]
+    if beam and cable.boundary_a.is_clamped:
+        fixed.append(rot_right[0])
+    if beam and cable.boundary_b.is_clamped:
+        fixed.append(rot_left[-1])
+    keep = np.ones(per_node.sum(), dtype=bool)
+    keep[fixed] = False
+    renumber = np.where(keep, np.cumsum(keep) - 1, -1)
+    element = renumber[np.column_stack((disp[:-1], rot_right[:-1], disp[1:], rot_left[1:]))]
+    valid = np.where(element >= 0, element, np.iinfo(int).max)
+    bandwidth = int(np.max(element.max(axis=1) - valid.min(axis=1)))
+    return _Dofs(
+        n=int(keep.sum()),
+        disp=renumber[disp],
+        element=element,
+        end_rot=(int(renumber[rot_right[0]]), int(renumber[rot_left[-1]])),
+        upper_bandwidth=bandwidth,
+    )
 
 
-# -------------------------------------------------------------- matrices
+# ---------------------------------------------------------------- matrices
 
 
 def _element_stiffness(h: np.ndarray, EI: float, tension: float) -> np.ndarray:
     """Bending EI∫N''N'' plus geometric H∫N'N' stiffness, shape (n, 4, 4)."""
-    scale = h[:, None, None] ** _H_SCALE_POW
     kb = (EI / h**3)[:, None, None] * _KB_HAT
     kg = (tension / (30.0 * h))[:, None, None] * _KG_HAT
-    return (kb + kg) * scale
+    return (kb + kg) * h[:, None, None] ** _H_SCALE_POW
 
 
 def _element_mass(h: np.ndarray, m: float) -> np.ndarray:
-    """Consistent mass m∫N N, shape (n, 4, 4)."""
+    """Consistent mass m∫N Nᵀ, shape (n, 4, 4)."""
     return (m * h / 420.0)[:, None, None] * _M_HAT * h[:, None, None] ** _H_SCALE_POW
 
 
 def _element_load(h: np.ndarray) -> np.ndarray:
-    """∫N dx of each element, shape (n, 4)."""
+    """∫N dx on each element, shape (n, 4)."""
     return np.column_stack((h / 2, h**2 / 12, h / 2, -(h**2) / 12))
 
 
-def _assemble(blocks: np.ndarray, element_dofs: np.ndarray, n: int) -> sp.csr_matrix:
-    rows = np.repeat(element_dofs, 4, axis=1).ravel()
-    cols = np.tile(element_dofs, (1, 4)).ravel()
-    return sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(n, n)).tocsr()
-
-
-def _upper_bandwidth(a: sp.spmatrix) -> int:
-    coo = a.tocoo()
-    return int(np.max(coo.col - coo.row, initial=0))
+def _assemble(blocks: np.ndarray, dofs: _Dofs, diagonal: list[tuple[np.ndarray, np.ndarray]]) -> sp.csr_matrix:
+    """Sum element blocks and diagonal (dof, value) terms; entries on fixed dofs dropped."""
+    rows = [np.repeat(dofs.element, 4, axis=1).ravel()]
+    cols = [np.tile(dofs.element, (1, 4)).ravel()]
+    vals = [blocks.ravel()]
+    for idx, values in diagonal:
+        rows.append(idx)
+        cols.append(idx)
+        vals.append(values)
+    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    keep = (rows >= 0) & (cols >= 0)
+    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(dofs.n, dofs.n))
 
 
 def _upper_banded(a: sp.spmatrix, u: int) -> np.ndarray:
@@ -523,50 +527,47 @@ def _upper_banded(a: sp.spmatrix, u: int) -> np.ndarray:
     return ab
 
 
-# ----------------------------------------------------- sag-extensibility
+# ------------------------------------------------------- sag-extensibility
 
 
-def _static_slopes(
-    cable: Cable, atts: Sequence[tuple[float, float, float]], breaks: np.ndarray, tension: float
-) -> np.ndarray:
-    """Slopes y' of the static profile at both ends of each segment, shape (n_seg, 2).
+def _static_slopes(cable: Cable, atts: np.ndarray, tension: float) -> np.ndarray:
+    """Slope y' of the static profile at both ends of each segment, shape (n_seg, 2).
 
     y'' = -w/H between attachments, H[y'] = -M_k g cos θ at x_k, y(0) = y(l) = 0.
     """
-    length = cable.length
-    w = cable.weight_per_length
-    loads = np.array([mass for _, mass, _ in atts]) * cable.gravity * math.cos(cable.inclination)
-    xs = breaks[1:-1]
-    slope0 = (w * length / 2 + np.sum(loads * (length - xs)) / length) / tension
-    start = slope0 - w * breaks[:-1] / tension - np.concatenate(([0.0], np.cumsum(loads))) / tension
+    length, w = cable.length, cable.weight_per_length
+    xs = atts[:, 0]
+    loads = atts[:, 1] * cable.gravity * math.cos(cable.inclination)
+    breaks = np.concatenate(([0.0], xs, [length]))
+    slope_a = (w * length / 2 + np.sum(loads * (length - xs)) / length) / tension
+    start = slope_a - (w * breaks[:-1] + np.concatenate(([0.0], np.cumsum(loads)))) / tension
     end = start - w * np.diff(breaks) / tension
     return np.column_stack((start, end))
 
 
 def _stretched_length(breaks: np.ndarray, slopes: np.ndarray) -> float:
-    """L_e = ∫(1 + y'²)^{3/2} dx, y' linear on each segment (16-point Gauss, exact to rounding)."""
-    half = np.diff(breaks)[:, None] / 2
-    s = slopes[:, :1] + (slopes[:, 1:] - slopes[:, :1]) * (_GAUSS_X[None, :] + 1) / 2
-    return float(np.sum(half * _GAUSS_W[None, :] * (1 + s**2) ** 1.5))
+    """L_e = ∫(1 + y'²)^{3/2} dx for y' linear on each segment.
+
+    16-point Gauss–Legendre per segment: the integrand is analytic with its
+    nearest singularity at y' = ±i, so this is exact to rounding for any
+    shallow profile.
+    """
+    s = slopes[:, :1] + (slopes[:, 1:] - slopes[:, :1]) * (_GAUSS_X + 1) / 2
+    return float(np.sum(np.diff(breaks)[:, None] / 2 * _GAUSS_W * (1 + s**2) ** 1.5))
 
 
 def _sag_vector(
-    h: np.ndarray,
-    element_dofs: np.ndarray,
-    n_full: int,
-    cable: Cable,
-    atts: Sequence[tuple[float, float, float]],
-    att_nodes: Sequence[int],
-    dofs: _Dofs,
-    tension: float,
+    cable: Cable, atts: np.ndarray, tension: float, h: np.ndarray, dofs: _Dofs, att_nodes: np.ndarray
 ) -> np.ndarray:
-    """g_i = ∫ y' N_i' dx = (w/H) ∫N_i dx + Σ_k (M_k g cos θ / H) N_i(x_k), on the full dofs."""
-    g = np.zeros(n_full)
-    np.add.at(g, element_dofs.ravel(), (cable.weight_per_length / tension * _element_load(h)).ravel())
-    weight = cable.gravity * math.cos(cable.inclination) / tension
-    for (_, mass, _), node in zip(atts, att_nodes):
-        g[dofs.disp[node]] += mass * weight
-    return g
+    """g_i = ∫ y' N_i' dx = (w/H) ∫N_i dx + Σ_k (M_k g cos θ / H) N_i(x_k) on the free dofs.
+
+    (Integration by parts; the end terms vanish because every shape
+    function of a free dof is zero at both ends.)
+    """
+    g = np.zeros(dofs.n + 1)  # slot -1 collects the fixed dofs' entries
+    np.add.at(g, dofs.element.ravel(), (cable.weight_per_length / tension * _element_load(h)).ravel())
+    g[dofs.disp[att_nodes]] += atts[:, 1] * cable.gravity * math.cos(cable.inclination) / tension
+    return g[:-1]
 
 
 # ---------------------------------------------------------------- solvers
@@ -590,50 +591,79 @@ def _solve_dense(model: FEModel, n_modes: int, vectors: bool) -> tuple[np.ndarra
 
 
 def _solve_sparse(model: FEModel, n_modes: int, vectors: bool) -> tuple[np.ndarray, np.ndarray | None]:
-    K, M, n = model.K, model.M, model.n_dof
+    n = model.n_dof
     g = model.g if model.g is not None else np.zeros(n)
     coef = model.coef
     sigma = _shift(model)
     # K - σM with σ < 0 is positive definite: banded Cholesky, factorised once.
-    chol = sla.cholesky_banded(_upper_banded(K - sigma * M, model.upper_bandwidth), lower=False)
-    z = sla.cho_solve_banded((chol, False), g)
+    # LAPACK pbtrf/pbtrs directly: cho_solve_banded's checks cost more than
+    # the solve itself at this size, and ARPACK calls it ~30 times.
+    pbtrf, pbtrs = sla.lapack.get_lapack_funcs(("pbtrf", "pbtrs"), (model.M.data,))
+    chol, info = pbtrf(_upper_banded(model.K - sigma * model.M, model.upper_bandwidth), lower=0)
+    if info != 0:
+        raise ComputationError(f"stiffness matrix is not positive definite (pbtrf info {info})")
+
+    def solve(v: np.ndarray) -> np.ndarray:
+        return pbtrs(chol, v, lower=0)[0]
+
+    z = solve(g)
     denom = 1.0 + coef * (g @ z)
 
     def op_inv(v: np.ndarray) -> np.ndarray:
-        y = sla.cho_solve_banded((chol, False), v, check_finite=False)
+        # Sherman–Morrison for (K - σM + coef g gᵀ)⁻¹ v.
+        y = solve(v)
         return y - z * (coef * (g @ y) / denom)
 
-    def stiffness(v: np.ndarray) -> np.ndarray:
-        return K @ v + g * (coef * (g @ v))
-
-    a_op = spla.LinearOperator((n, n), matvec=stiffness, dtype=float)
-    opinv = spla.LinearOperator((n, n), matvec=op_inv, dtype=float)
-    out = spla.eigsh(
-        a_op, k=n_modes, M=M, sigma=sigma, which="LM", OPinv=opinv, tol=0, return_eigenvectors=vectors
-    )
-    lam, vecs = (out if vectors else (out, None))
+    v0 = np.random.default_rng(_V0_SEED).standard_normal(n)
+    try:
+        out = spla.eigsh(
+            _Operator(n, lambda v: model.K @ v + g * (coef * (g @ v))),
+            k=n_modes,
+            M=_Operator(n, model.M.__matmul__),
+            sigma=sigma,
+            which="LM",
+            OPinv=_Operator(n, op_inv),
+            v0=v0,
+            tol=0,
+            return_eigenvectors=vectors,
+        )
+    except spla.ArpackNoConvergence as exc:
+        raise ComputationError(f"ARPACK did not converge: {exc}") from exc
+    lam, vecs = out if vectors else (out, None)
     order = np.argsort(lam)
     return lam[order], (vecs[:, order] if vectors else None)
 
 
-def _shift(model: FEModel) -> float:
-    """A small negative shift: 1e-6 of a pinned-beam estimate of the lowest ω².
+class _Operator(spla.LinearOperator):
+    """A square real LinearOperator calling ``func`` without per-call checks.
 
-    Negative so that K - σM stays positive definite; small so that it
-    barely slows ARPACK's convergence to the lowest modes.
+    ARPACK calls the mass and inverse operators ~100 times per solve; the
+    generic ``LinearOperator.matvec`` shape checks would then cost about
+    as much as the arithmetic.
     """
-    n_mass = model.M.diagonal()[model.disp_index[model.disp_index >= 0]].sum()
-    span = model.node_x[-1]
-    k = math.pi / span
-    # Stiffness per unit length ~ H k² + EI k⁴ is not stored; use K's own Rayleigh quotient
-    # on the sine shape, which is cheap and exact for the pinned string/beam.
-    shape = np.zeros(model.n_dof)
+
+    def __init__(self, n: int, func):
+        super().__init__(dtype=np.dtype(float), shape=(n, n))
+        self._func = func
+
+    def _matvec(self, x: np.ndarray) -> np.ndarray:
+        return self._func(np.ravel(x))
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        return self._func(x)
+
+
+def _shift(model: FEModel) -> float:
+    """Shift for shift-invert: -1e-6 times the Rayleigh quotient of a half sine.
+
+    Negative so that K - σM is positive definite even when K is nearly
+    singular (H → 0 with pinned ends); small so that it barely slows
+    ARPACK's convergence to the lowest modes.
+    """
     free = model.disp_index >= 0
-    shape[model.disp_index[free]] = np.sin(k * model.node_x[free])
-    num = shape @ (model.K @ shape)
-    den = shape @ (model.M @ shape)
-    estimate = num / den if den > 0 and num > 0 else 1.0 / max(n_mass, 1.0)
-    return -1e-6 * estimate
+    shape = np.zeros(model.n_dof)
+    shape[model.disp_index[free]] = np.sin(np.pi * model.node_x[free] / model.node_x[-1])
+    return -1e-6 * (shape @ (model.K @ shape)) / (shape @ (model.M @ shape))
 
 
 def _normalise(model: FEModel, vecs: np.ndarray) -> np.ndarray:
