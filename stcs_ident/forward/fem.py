@@ -76,6 +76,11 @@ class FEModel:
     disp_index : numpy.ndarray
         For each node, the index of its transverse displacement among the
         free dofs, or -1 where it is fixed (both ends).
+    rot_index : numpy.ndarray
+        Shape (n_nodes, 2): index of the rotation (slope) seen by the
+        element on the left and on the right of each node, -1 where fixed.
+        The two columns differ only at the attachments of a string, whose
+        slope may jump there.
     attachment_nodes : numpy.ndarray
         Node index of each attachment position (after merging attachments
         at the same position), in position order.
@@ -97,6 +102,7 @@ class FEModel:
     coef: float
     node_x: np.ndarray
     disp_index: np.ndarray
+    rot_index: np.ndarray
     attachment_nodes: np.ndarray
     upper_bandwidth: int
     stretched_length: float
@@ -192,7 +198,7 @@ def fe_matrices(
 
     k_diag = [(dofs.disp[att_nodes], atts[:, 2])]
     if cable.EI > 0:
-        for rot, boundary in ((dofs.end_rot[0], cable.boundary_a), (dofs.end_rot[1], cable.boundary_b)):
+        for rot, boundary in ((dofs.rot[0, 1], cable.boundary_a), (dofs.rot[-1, 0], cable.boundary_b)):
             if rot >= 0:
                 k_diag.append((np.array([rot]), np.array([boundary.rotational_stiffness])))
     K = _assemble(_element_stiffness(h, cable.EI, tension), dofs, k_diag)
@@ -211,6 +217,7 @@ def fe_matrices(
         coef=coef,
         node_x=node_x,
         disp_index=dofs.disp,
+        rot_index=dofs.rot,
         attachment_nodes=att_nodes,
         upper_bandwidth=dofs.upper_bandwidth,
         stretched_length=stretched,
@@ -445,8 +452,8 @@ class _Dofs:
 
     n: int
     disp: np.ndarray  # u at each node
+    rot: np.ndarray  # (n_nodes, 2): θ seen from the left and from the right
     element: np.ndarray  # (n_elements, 4): u1, θ1, u2, θ2 of each element
-    end_rot: tuple[int, int]  # rotation at A and at B
     upper_bandwidth: int
 
 
@@ -479,8 +486,8 @@ def _number_dofs(cable: Cable, n_nodes: int, att_nodes: np.ndarray) -> _Dofs:
     return _Dofs(
         n=int(keep.sum()),
         disp=renumber[disp],
+        rot=renumber[np.column_stack((rot_left, rot_right))],
         element=element,
-        end_rot=(int(renumber[rot_right[0]]), int(renumber[rot_left[-1]])),
         upper_bandwidth=bandwidth,
     )
 
