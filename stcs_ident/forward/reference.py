@@ -21,7 +21,6 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from .elements import wavenumbers
 
 
 def _modes(modes):
@@ -54,7 +53,10 @@ def beam_clamped_asymptotic(length, mass_per_length, tension, EI, modes):
 
 def _clamped_delta(omega, length, mass_per_length, tension, EI):
     """Δ(ω) / cosh(pL): same sign and roots as Δ, without overflow."""
-    p, q = wavenumbers(EI, tension, mass_per_length, omega)
+    a = tension / (2 * EI)
+    root = math.sqrt(a * a + mass_per_length * omega * omega / EI)
+    p = math.sqrt(a + root)
+    q = math.sqrt(mass_per_length * omega * omega / EI / (a + root))
     pL, qL = p * length, q * length
     sech = 2 * math.exp(-pL) / (1 + math.exp(-2 * pL))
     return 2 * p * q * (sech - math.cos(qL)) + (p * p - q * q) * math.tanh(pL) * math.sin(qL)
