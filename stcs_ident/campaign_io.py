@@ -36,7 +36,7 @@ _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
 _SETUP_KEYS = ("name", "attachment")
 _ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
-_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record")
+_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
 
@@ -211,6 +211,7 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
     frequencies = table.get("frequencies")
     modes = table.get("modes")
     record = table.get("record")
+    reference = _table(table.get("reference", {}), f"{where}.reference")
     return Test(
         name=name,
         setup=_string(_required(table, "setup", where), f"{where}.setup"),
@@ -218,6 +219,7 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
         frequencies=None if frequencies is None else _numbers(frequencies, f"{where}.frequencies"),
         modes=None if modes is None else _integers(modes, f"{where}.modes"),
         record=None if record is None else _string(record, f"{where}.record"),
+        reference=tuple((k, _numbers(v, f"{where}.reference.{k}")) for k, v in reference.items()),
     )
 
 
@@ -395,7 +397,17 @@ def _test_lines(test: Test) -> list[str]:
         lines.append(f"modes = [{', '.join(str(k) for k in test.modes)}]")
     if test.record is not None:
         lines.append(f"record = {_toml_string(test.record)}")
+    if test.reference:
+        lines.append("  [test.reference]")
+        for label, values in test.reference:
+            lines.append(f"  {_toml_key(label)} = [{', '.join(_toml_float(f) for f in values)}]")
     return lines
+
+
+def _toml_key(key: str) -> str:
+    """A bare TOML key when possible, else a quoted one."""
+    bare = key and all(c.isalnum() or c in "-_" for c in key) and key.isascii()
+    return key if bare else _toml_string(key)
 
 
 def _toml_boundary(a: Boundary, b: Boundary) -> str:

@@ -223,6 +223,10 @@ class Test:
         Mode numbers of ``frequencies`` (default 1..N).
     record : str or None
         Path of an acceleration record, relative to the campaign directory.
+    reference : tuple of (name, tuple of float)
+        Frequencies (Hz) computed by others for the same modes (a paper's
+        own model, say), shown beside ours; each list is ordered by
+        ``modes``.
     """
 
     __test__ = False  # not a pytest class
@@ -233,6 +237,7 @@ class Test:
     frequencies: tuple[float, ...] | None = None
     modes: tuple[int, ...] | None = None
     record: str | None = None
+    reference: tuple[tuple[str, tuple[float, ...]], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -258,6 +263,16 @@ class Test:
             object.__setattr__(self, "modes", modes)
         elif self.modes is not None:
             raise ModelError("given without frequencies", field=f"{where}.modes")
+        reference = tuple((str(k), tuple(v)) for k, v in self.reference)
+        for label, values in reference:
+            field_name = f"{where}.reference.{label}"
+            if self.modes is None:
+                raise ModelError("needs the test's frequencies and modes", field=field_name)
+            if len(values) != len(self.modes):
+                raise ModelError(f"has {len(values)} values but modes has {len(self.modes)}", field=field_name)
+            for f in values:
+                _positive(f, field_name)
+        object.__setattr__(self, "reference", tuple((k, tuple(float(f) for f in v)) for k, v in reference))
 
 
 @dataclass(frozen=True)

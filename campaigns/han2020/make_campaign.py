@@ -62,7 +62,9 @@ setup: the weights are "near midspan" in the paper (exact positions are only
   in its figures); here they are put at midspan, l/2 = {LENGTH / 2:g} m.
 test: tensions from data/tensions.csv (pressure-ring reading, which the paper
   says drifts after tensioning); measured frequencies, levels 4 and 5 only,
-  from data/measured.csv."""
+  from data/measured.csv; [test.reference] holds the paper's own computed
+  columns from data/paper_computed.csv (paper_taut_string, paper_beam_pinned,
+  paper_dsm and, for case 1, paper_corrected after its identification)."""
 
 
 def read_tensions(path: Path) -> dict[tuple[str, int], float]:
@@ -81,6 +83,16 @@ def read_measured(path: Path) -> dict[tuple[str, int], list[tuple[int, float]]]:
     return {key: sorted(rows) for key, rows in measured.items()}
 
 
+def read_computed(path: Path) -> dict[tuple[str, int], dict[str, dict[int, float]]]:
+    """The paper's computed frequencies: (case, level) -> method -> mode -> Hz."""
+    computed: dict = defaultdict(lambda: defaultdict(dict))
+    with open(path, newline="") as stream:
+        for row in csv.DictReader(stream):
+            key = (row["case"], int(row["level"]))
+            computed[key][row["method"]][int(row["mode"])] = float(row["frequency_Hz"])
+    return computed
+
+
 def make_setup(case: str) -> Setup:
     """The setup of one case: bare, or one weight W1 at midspan."""
     mass = WEIGHTS[case]
@@ -89,13 +101,20 @@ def make_setup(case: str) -> Setup:
     return Setup(case, (Attachment("W1", position=LENGTH / 2, mass=mass),))
 
 
-def make_test(case: str, level: int, tension: float, measured: list[tuple[int, float]] | None) -> Test:
-    """One test: a case at one tension level, with its measured frequencies if any."""
+def make_test(case: str, level: int, tension: float, measured: list[tuple[int, float]] | None,
+              computed: dict[str, dict[int, float]] | None = None) -> Test:
+    """One test: a case at one tension level, with its measured frequencies
+    if any and the paper's computed columns for the same modes as references."""
     name = f"{case}-L{level}"
     if not measured:
         return Test(name, case, tension)
     modes, frequencies = zip(*measured)
-    return Test(name, case, tension, frequencies=frequencies, modes=modes)
+    reference = tuple(
+        (f"paper_{method}" if not method.startswith("paper_") else method, tuple(by_mode[k] for k in modes))
+        for method, by_mode in (computed or {}).items()
+        if all(k in by_mode for k in modes)
+    )
+    return Test(name, case, tension, frequencies=frequencies, modes=modes, reference=reference)
 
 
 def build_campaign() -> Campaign:
@@ -108,10 +127,11 @@ def build_campaign() -> Campaign:
     )
     tensions = read_tensions(DATA / "tensions.csv")
     measured = read_measured(DATA / "measured.csv")
+    computed = read_computed(DATA / "paper_computed.csv")
     cases = list(dict.fromkeys(case for case, _ in tensions))
     setups = tuple(make_setup(case) for case in cases)
     tests = tuple(
-        make_test(case, level, t, measured.get((case, level))) for (case, level), t in tensions.items()
+        make_test(case, level, t, measured.get((case, level)), computed.get((case, level))) for (case, level), t in tensions.items()
     )
     description = "Full-scale PEJ15B-12 strand cable, bare and with a weight near midspan (Han et al. 2020)"
     return Campaign("han2020", cable, setups, tests, description)

@@ -249,8 +249,8 @@ def fe_eigen(
     omega2 : numpy.ndarray
         Eigenvalues ω² (rad²/s²), ascending, shape (n_modes,).
     vecs : numpy.ndarray or None
-        Shape (n_dof, n_modes), vᵀ M v = 1, sign chosen so that the
-        largest nodal displacement is positive.
+        Shape (n_dof, n_modes), vᵀ M v = 1, sign chosen so that the first
+        nodal displacement (from end A) above 1 % of the largest is positive.
     """
     if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
         raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
@@ -316,8 +316,8 @@ def fe_modes(
         Node positions from end A, m, shape (n_nodes,).
     displacement : numpy.ndarray
         Transverse displacement of each mode at the nodes, shape
-        (n_nodes, n_modes), zero at the ends, mass-normalised, largest
-        value positive.
+        (n_nodes, n_modes), zero at the ends, mass-normalised, positive
+        near end A (see :func:`fe_eigen`).
     vectors : numpy.ndarray
         The mass-normalised eigenvectors on the free dofs, shape
         (n_dof, n_modes) (displacements and rotations, see
@@ -674,11 +674,19 @@ def _shift(model: FEModel) -> float:
 
 
 def _normalise(model: FEModel, vecs: np.ndarray) -> np.ndarray:
+    """Scale to vᵀ M v = 1, and fix the sign: the first nodal displacement
+    (from end A) larger than 1 % of the largest one is positive.
+
+    A rule on the largest value would flip at random for symmetric shapes
+    (equal peaks of opposite sign); the first sizeable value is well clear
+    of rounding.
+    """
     norms = np.sqrt(np.einsum("ij,ij->j", vecs, model.M @ vecs))
     vecs = vecs / norms
     disp = model.nodal_displacements(vecs)
-    peak = disp[np.argmax(np.abs(disp), axis=0), np.arange(vecs.shape[1])]
-    return vecs * np.where(peak < 0, -1.0, 1.0)
+    sizeable = np.abs(disp) > 0.01 * np.abs(disp).max(axis=0)
+    first = disp[np.argmax(sizeable, axis=0), np.arange(vecs.shape[1])]
+    return vecs * np.where(first < 0, -1.0, 1.0)
 
 
 def _to_hz(omega2: np.ndarray) -> np.ndarray:
