@@ -81,6 +81,11 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
         raise CampaignError(err.message, field=err.field, file=str(file)) from err
 
 
+def campaign_file(path: str | os.PathLike) -> Path:
+    """The campaign's TOML file, given its directory or the file itself."""
+    return _campaign_file(Path(path))
+
+
 def _campaign_file(path: Path) -> Path:
     """The TOML file named by ``path`` (a campaign directory or the file)."""
     if path.is_dir():

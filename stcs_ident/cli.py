@@ -1,0 +1,78 @@
+"""Command line: ``stcs-ident forward CAMPAIGN ...``.
+
+Exit status 0 on success, 2 for bad input (one line on standard error
+naming the file, the field and what is wrong; nothing written), 1 for a
+computation that failed. ``--debug`` shows the traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import traceback
+
+from .errors import ComputationError, InputError
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="stcs-ident", description=__doc__.splitlines()[0])
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    sub = parser.add_subparsers(dest="command", required=True)
+    fwd = sub.add_parser("forward", help="nominal model against measured and published frequencies")
+    fwd.add_argument("campaign", help="campaign directory or its campaign.toml")
+    fwd.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+    fwd.add_argument("--modes", type=int, metavar="N", help="modes to compute (default: measured, at least 6)")
+    fwd.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform",
+                     help="additional tension from sag-extensibility (default uniform)")
+    fwd.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
+    fwd.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    return parser
+
+
+def _selected_tests(campaign, names, file):
+    known = [t.name for t in campaign.tests]
+    for name in names or []:
+        if name not in known:
+            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="test", file=file)
+    return names
+
+
+def _forward(args) -> int:
+    from .campaign_io import campaign_file, load_campaign
+    from .compare import compare_forward
+    from .report import forward_text, to_json, write_atomic
+
+    campaign = load_campaign(args.campaign)
+    file = str(campaign_file(args.campaign))
+    if args.modes is not None and args.modes < 1:
+        raise InputError(f"must be >= 1, got {args.modes}", field="--modes")
+    tests = _selected_tests(campaign, args.test, file)
+    result = compare_forward(campaign, tests, args.modes, args.tension_model)
+    text = forward_text(result)
+    if args.json:
+        write_atomic(args.json, to_json(result.summary()))
+    if args.json != "-":
+        sys.stdout.write(text)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return {"forward": _forward}[args.command](args)
+    except InputError as err:
+        if args.debug:
+            traceback.print_exc()
+        print(f"stcs-ident: {err}", file=sys.stderr)
+        return 2
+    except (ComputationError, FloatingPointError) as err:
+        if args.debug:
+            traceback.print_exc()
+        print(f"stcs-ident: computation failed: {err}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

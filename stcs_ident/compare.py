@@ -1,0 +1,244 @@
+"""The nominal model against measured and published frequencies (``forward``).
+
+For every test: the exact DSM frequencies, the taut-string and pinned-beam
+formulas, the measured frequencies and their errors in percent,
+(computed − measured) / measured × 100. For reference columns (frequencies
+computed by others, such as a paper's own model) the comparison says
+whether the nominal model reproduces them and, where it does not, which
+bending stiffness would.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import minimize_scalar
+
+from .forward import batch_frequencies
+from .forward import reference as closed_form
+from .model import Campaign, Test
+
+
+@dataclass(frozen=True)
+class TestComparison:
+    """One test's frequencies by every model, ordered by ``modes`` (Hz)."""
+
+    __test__ = False
+
+    name: str
+    setup: str
+    tension: float
+    modes: tuple[int, ...]
+    dsm: np.ndarray
+    taut_string: np.ndarray
+    beam_pinned: np.ndarray
+    measured: np.ndarray | None
+    reference: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def error(self, column: str) -> np.ndarray | None:
+        """(computed − measured) / measured × 100 for one model column."""
+        if self.measured is None:
+            return None
+        return (getattr(self, column) - self.measured) / self.measured * 100.0
+
+    def to_dataframe(self) -> pd.DataFrame:
+        data = {"mode": list(self.modes)}
+        if self.measured is not None:
+            data["measured"] = self.measured
+        for col in ("taut_string", "beam_pinned", "dsm"):
+            data[col] = getattr(self, col)
+            if self.measured is not None:
+                data[f"{col}_error_%"] = self.error(col)
+        for label, values in self.reference.items():
+            data[label] = values
+        return pd.DataFrame(data)
+
+
+@dataclass(frozen=True)
+class ReferenceCheck:
+    """Does the nominal model reproduce a reference column of some tests?
+
+    Attributes
+    ----------
+    label, setup : the reference column and the setup of its tests
+    tests : names of the tests compared
+    step : the column's printed resolution (Hz), the tolerance of "reproduces"
+    rms_nominal, max_nominal, worst_mode : difference with the nominal EI (Hz)
+    EI_nominal, EI_best : nominal EI and the EI that reproduces it best (N m²)
+    rms_best : rms difference with EI_best (Hz)
+    """
+
+    label: str
+    setup: str
+    tests: tuple[str, ...]
+    step: float
+    rms_nominal: float
+    max_nominal: float
+    worst_mode: int
+    EI_nominal: float
+    EI_best: float
+    rms_best: float
+
+    @property
+    def reproduced(self) -> bool:
+        return self.max_nominal <= self.step
+
+    def sentence(self) -> str:
+        tests = ", ".join(self.tests)
+        if self.reproduced:
+            return (f"The nominal model (EI = {self.EI_nominal / 1e3:.1f} kN m²) reproduces '{self.label}' of "
+                    f"{tests} within its printed resolution ({self.step:g} Hz): rms {self.rms_nominal:.3f} Hz.")
+        head = (f"The nominal EI = {self.EI_nominal / 1e3:.1f} kN m² does NOT reproduce '{self.label}' of {tests}: "
+                f"rms difference {self.rms_nominal:.3f} Hz, largest {self.max_nominal:.2f} Hz (mode "
+                f"{self.worst_mode}); ")
+        if self.rms_best <= self.step:
+            return head + f"EI = {self.EI_best / 1e3:.1f} kN m² reproduces it to rms {self.rms_best:.4f} Hz."
+        return head + (f"no single EI does (the best, {self.EI_best / 1e3:.1f} kN m², still leaves rms "
+                       f"{self.rms_best:.3f} Hz), so it differs from this model in more than EI.")
+
+
+@dataclass(frozen=True)
+class ForwardResult:
+    """Result of :func:`compare_forward`: one :class:`TestComparison` per test
+    and one :class:`ReferenceCheck` per (reference column, setup)."""
+
+    campaign: str
+    tension_model: str
+    tests: list[TestComparison]
+    reference_checks: list[ReferenceCheck]
+
+    def summary(self) -> dict:
+        """Plain data for JSON, per ``interface.md`` (plus ``reference`` keys)."""
+        def floats(a):
+            return None if a is None else [None if math.isnan(x) else float(x) for x in a]
+
+        return {
+            "campaign": self.campaign,
+            "tension_model": self.tension_model,
+            "tests": [
+                {"name": t.name, "setup": t.setup, "tension": t.tension, "modes": list(t.modes),
+                 "frequencies": {"dsm": floats(t.dsm), "taut_string": floats(t.taut_string),
+                                 "beam_pinned": floats(t.beam_pinned)},
+                 "measured": floats(t.measured),
+                 "errors": None if t.measured is None else
+                 {c: floats(t.error(c)) for c in ("dsm", "taut_string", "beam_pinned")},
+                 "reference": {k: floats(v) for k, v in t.reference.items()}}
+                for t in self.tests
+            ],
+            "reference_checks": [
+                {"label": c.label, "setup": c.setup, "tests": list(c.tests), "reproduced": c.reproduced,
+                 "rms_nominal_Hz": c.rms_nominal, "max_nominal_Hz": c.max_nominal, "EI_nominal": c.EI_nominal,
+                 "EI_best": c.EI_best, "rms_best_Hz": c.rms_best, "statement": c.sentence()}
+                for c in self.reference_checks
+            ],
+        }
+
+
+def _modes_of(test: Test, n_modes: int | None) -> tuple[int, ...]:
+    if test.modes is not None and n_modes is None:
+        return tuple(test.modes)
+    n = n_modes if n_modes is not None else 6
+    if test.modes is not None:
+        n = max(n, max(test.modes))
+    return tuple(range(1, n + 1))
+
+
+def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes: int | None = None,
+                    tension_model: str = "uniform") -> ForwardResult:
+    """Compute every model for the selected tests of a campaign.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    tests : list of test names, optional (default: all)
+    n_modes : int, optional
+        Modes to compute; default the measured modes, at least 1..6.
+    tension_model : {"uniform", "per-segment", "none"}
+    """
+    cable = campaign.cable
+    selected = campaign.tests if not tests else [campaign.test(n) for n in tests]
+    out = []
+    for test in selected:
+        atts = campaign.setup(test.setup).attachments
+        shown = _modes_of(test, n_modes)
+        if test.modes is not None:
+            shown = tuple(sorted(set(shown) | set(test.modes)))
+        n = max(max(shown), 6 if n_modes is None else n_modes)
+        dsm_all = batch_frequencies(cable, atts, test.tension, n, tension_model=tension_model)
+        idx = np.array(shown) - 1
+        by_mode = dict(zip(test.modes or (), test.frequencies or ()))
+        measured = None
+        if test.frequencies is not None:
+            measured = np.array([by_mode.get(k, np.nan) for k in shown])
+        reference = {}
+        for label, values in test.reference:
+            ref_by_mode = dict(zip(test.modes, values))
+            reference[label] = np.array([ref_by_mode.get(k, np.nan) for k in shown])
+        out.append(TestComparison(
+            name=test.name, setup=test.setup, tension=test.tension, modes=shown, dsm=dsm_all[idx],
+            taut_string=closed_form.taut_string(cable.length, cable.mass_per_length, test.tension, shown),
+            beam_pinned=closed_form.beam_pinned(cable.length, cable.mass_per_length, test.tension, cable.EI, shown),
+            measured=measured, reference=reference,
+        ))
+    checks = _reference_checks(campaign, [campaign.test(t.name) for t in out], tension_model)
+    return ForwardResult(campaign.name, tension_model, out, checks)
+
+
+def _printed_step(values) -> float:
+    """The resolution a column was printed with (0.01 for 7.16, 0.0001 for 1.3587)."""
+    decimals = 0
+    for v in values:
+        text = f"{v:.10f}".rstrip("0")
+        decimals = max(decimals, len(text.split(".")[1]) if "." in text else 0)
+    return 10.0 ** (-decimals)
+
+
+def _reference_checks(campaign: Campaign, tests: list[Test], tension_model: str) -> list[ReferenceCheck]:
+    """Group tests by (reference label, setup); compare and fit EI for each group.
+
+    Columns named like a closed form ("taut_string", "beam_pinned") are
+    compared with that formula; every other column with the DSM.
+    """
+    groups: dict[tuple[str, str], list[Test]] = {}
+    for t in tests:
+        for label, _ in t.reference:
+            groups.setdefault((label, t.setup), []).append(t)
+    cable = campaign.cable
+    checks = []
+    for (label, setup), members in groups.items():
+        atts = campaign.setup(setup).attachments
+        rows = []  # (tension, modes, values)
+        for t in members:
+            rows.append((t.tension, np.array(t.modes), np.array(dict(t.reference)[label])))
+        step = _printed_step(np.concatenate([r[2] for r in rows]))
+
+        def model(EI, rows=rows, atts=atts, label=label):
+            out = []
+            for H, modes, _ in rows:
+                if "taut_string" in label:
+                    out.append(closed_form.taut_string(cable.length, cable.mass_per_length, H, modes))
+                elif "beam_pinned" in label:
+                    out.append(closed_form.beam_pinned(cable.length, cable.mass_per_length, H, EI, modes))
+                else:
+                    f = batch_frequencies(cable, atts, H, int(modes.max()), EI=EI, tension_model=tension_model)
+                    out.append(f[modes - 1])
+            return np.concatenate(out)
+
+        target = np.concatenate([r[2] for r in rows])
+        modes_all = np.concatenate([r[1] for r in rows])
+        diff = model(cable.EI) - target
+        rms = float(np.sqrt(np.mean(diff**2)))
+        worst = int(np.argmax(np.abs(diff)))
+        if "taut_string" in label or cable.EI == 0:
+            EI_best, rms_best = cable.EI, rms
+        else:
+            res = minimize_scalar(lambda lg: float(np.mean((model(math.exp(lg)) - target) ** 2)),
+                                  bounds=(math.log(cable.EI) - 3, math.log(cable.EI) + 3), method="bounded",
+                                  options={"xatol": 1e-6})
+            EI_best, rms_best = math.exp(res.x), math.sqrt(res.fun)
+        checks.append(ReferenceCheck(label, setup, tuple(t.name for t in members), step, rms,
+                                     float(abs(diff[worst])), int(modes_all[worst]), cable.EI, EI_best, rms_best))
+    return checks
