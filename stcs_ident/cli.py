@@ -8,6 +8,7 @@ computation that failed. ``--debug`` shows the traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import traceback
 
@@ -37,20 +38,39 @@ def _selected_tests(campaign, names, file):
     return names
 
 
+def _check_output(path) -> None:
+    """Refuse an output file whose directory does not exist, before any work."""
+    if path in (None, "-"):
+        return
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise InputError(f"directory {parent} does not exist", field="--json", file=str(path))
+
+
+def _write(path, text) -> None:
+    from .report import write_atomic
+
+    try:
+        write_atomic(path, text)
+    except OSError as err:
+        raise InputError(f"cannot write: {err.strerror}", field="--json", file=str(path)) from err
+
+
 def _forward(args) -> int:
     from .campaign_io import campaign_file, load_campaign
     from .compare import compare_forward
-    from .report import forward_text, to_json, write_atomic
+    from .report import forward_text, to_json
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
     if args.modes is not None and args.modes < 1:
         raise InputError(f"must be >= 1, got {args.modes}", field="--modes")
     tests = _selected_tests(campaign, args.test, file)
+    _check_output(args.json)
     result = compare_forward(campaign, tests, args.modes, args.tension_model)
     text = forward_text(result)
     if args.json:
-        write_atomic(args.json, to_json(result.summary()))
+        _write(args.json, to_json(result.summary()))
     if args.json != "-":
         sys.stdout.write(text)
     return 0
