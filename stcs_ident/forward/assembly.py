@@ -15,6 +15,7 @@ of natural frequencies below ω, with det K(ω) for root refinement.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,8 +96,7 @@ class CableBatch:
             length, positions, weight / tension, self.kinks
         )
         self.stretched = stretched_lengths(self.seg_len, self.slope_start, self.slope_end)
-        self.v_dof, self.t_dof, self.h_dof, self.n_dof = topology.dof_map()
-        self._scatter = self._scatter_matrix()
+        self.v_dof, self.t_dof, self.h_dof, self.n_dof = _dof_map(topology)
         self._constant = self._constant_part()
         self._scale = self._dof_scales()
 
@@ -111,42 +111,11 @@ class CableBatch:
         return BeamSegment(L, self.EI[idx, None], self.H[idx, None], self.m[idx, None], omega[:, None])
 
     def element_dofs(self, j):
-        if self.topology.string:
-            return np.array([self.v_dof[j], self.v_dof[j + 1]])
-        return np.array([self.v_dof[j], self.t_dof[j], self.v_dof[j + 1], self.t_dof[j + 1]])
+        return _element_dofs(self.topology, j)
 
-    def _h_of(self, j):
-        return self.h_dof[0] if self.topology.tension_model == "uniform" else self.h_dof[j]
-
-    def _scatter_matrix(self):
-        """0/1 matrix S such that vec K = vec K_const + V S, where V holds, per
-        item, the frequency-dependent values in the order of :meth:`assemble`:
-        element matrices, ĥ couplings, ĥ diagonals, −M ω² of the attachments."""
-        topo, nd = self.topology, self.n_dof
-        ne = 2 if topo.string else 4
-        targets = []  # one list of (row, col) per column of V
-        for j in range(topo.n_segments):
-            dofs = self.element_dofs(j)
-            for r in range(ne):
-                for c in range(ne):
-                    ok = dofs[r] >= 0 and dofs[c] >= 0
-                    targets.append([(dofs[r], dofs[c])] if ok else [])
-        if topo.tension_model != "none":
-            for j in range(topo.n_segments):
-                h = self._h_of(j)
-                for r, d in enumerate(self.element_dofs(j)):
-                    targets.append([(d, h), (h, d)] if d >= 0 else [])
-            for j in range(topo.n_segments):
-                h = self._h_of(j)
-                targets.append([(h, h)])
-        for k in range(topo.n_attachments):
-            v = self.v_dof[k + 1]
-            targets.append([(v, v)])
-        S = np.zeros((len(targets), nd * nd))
-        for col, pairs in enumerate(targets):
-            for r, c in pairs:
-                S[col, r * nd + c] += 1.0
-        return S
+    @property
+    def _scatter(self):
+        return _scatter_matrix(self.topology)
 
     def _constant_part(self):
         """The ω-independent part of K per configuration: springs, end
@@ -224,6 +193,51 @@ class CableBatch:
         s = self._scale[idx]
         negative, det = negative_pivots(K * s[:, :, None] * s[:, None, :])
         return J0 + negative - self.topology.n_h, det, J0
+
+
+@functools.lru_cache(maxsize=64)
+def _dof_map(topology):
+    return topology.dof_map()
+
+
+@functools.lru_cache(maxsize=64)
+def _scatter_matrix(topo):
+    """0/1 matrix S such that vec K = vec K_const + V S, where V holds, per
+    item, the frequency-dependent values in the order of :meth:`assemble`:
+    element matrices, ĥ couplings, ĥ diagonals, −M ω² of the attachments."""
+    nd = _dof_map(topo)[3]
+    h_dof = _dof_map(topo)[2]
+    ne = 2 if topo.string else 4
+    targets = []  # one list of (row, col) per column of V
+    for j in range(topo.n_segments):
+        dofs = _element_dofs(topo, j)
+        for r in range(ne):
+            for c in range(ne):
+                ok = dofs[r] >= 0 and dofs[c] >= 0
+                targets.append([(dofs[r], dofs[c])] if ok else [])
+    if topo.tension_model != "none":
+        for j in range(topo.n_segments):
+            h = h_dof[0] if topo.tension_model == "uniform" else h_dof[j]
+            for r, d in enumerate(_element_dofs(topo, j)):
+                targets.append([(d, h), (h, d)] if d >= 0 else [])
+        for j in range(topo.n_segments):
+            h = h_dof[0] if topo.tension_model == "uniform" else h_dof[j]
+            targets.append([(h, h)])
+    for k in range(topo.n_attachments):
+        v = _dof_map(topo)[0][k + 1]
+        targets.append([(v, v)])
+    S = np.zeros((len(targets), nd * nd))
+    for col, pairs in enumerate(targets):
+        for r, c in pairs:
+            S[col, r * nd + c] += 1.0
+    return S
+
+
+def _element_dofs(topo, j):
+    v, t, _, _ = _dof_map(topo)
+    if topo.string:
+        return np.array([v[j], v[j + 1]])
+    return np.array([v[j], t[j], v[j + 1], t[j + 1]])
 
 
 #: Below this many matrices one batched LAPACK call is faster than

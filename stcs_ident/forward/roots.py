@@ -12,9 +12,19 @@ replaced by bisection.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from ..errors import ComputationError
+
+try:  # the optional compiled kernel (setup.py); same numerics, no per-call overhead
+    from . import _dsm_kernel
+except ImportError:  # pragma: no cover - depends on the install
+    _dsm_kernel = None
+
+#: Set STCS_IDENT_NUMPY=1 to force the numpy path (the tests compare both).
+FORCE_NUMPY = os.environ.get("STCS_IDENT_NUMPY", "") not in ("", "0")
 
 RTOL = 2e-13  # relative bracket width at convergence (target 1e-12)
 MAX_ITER = 200
@@ -88,6 +98,8 @@ def solve_modes(batch, config, mode):
     """
     config = np.asarray(config, dtype=np.int64)
     mode = np.asarray(mode, dtype=np.int64)
+    if use_kernel() and batch.n_dof <= 64:
+        return _solve_compiled(batch, config, mode)
     lo, hi, Jlo, Jhi, J0lo, J0hi, flo, fhi = _bracket(batch, config, mode)
     n = len(config)
     side = np.zeros(n, dtype=np.int8)  # +1: hi moved last, −1: lo moved last
@@ -137,3 +149,24 @@ def _ab_factor(f_new, f_old):
     with np.errstate(divide="ignore", invalid="ignore"):
         m = 1.0 - f_new / f_old
     return np.where(m > 0, m, 0.5)
+
+
+def use_kernel() -> bool:
+    """Whether the compiled kernel is available and not switched off."""
+    return _dsm_kernel is not None and not FORCE_NUMPY
+
+
+def _solve_compiled(batch, config, mode):
+    topo = batch.topology
+    model = {"none": 0, "uniform": 1, "per-segment": 2}[topo.tension_model]
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    raw, failed = _dsm_kernel.solve(
+        topo.n_attachments, batch.n_dof, topo.n_h, int(topo.string), model,
+        i64(batch.v_dof), i64(batch.t_dof), i64(batch.h_dof),
+        f64(batch.length), f64(batch.m), f64(batch.EI), f64(batch.H), f64(batch.w), f64(batch.seg_len),
+        f64(batch.masses), f64(batch._constant), f64(batch._scale), i64(config), i64(mode),
+    )
+    if failed:
+        raise ComputationError(f"{failed} natural frequencies did not converge")
+    return np.frombuffer(raw, dtype=np.float64).copy()

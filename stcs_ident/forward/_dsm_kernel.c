@@ -1,0 +1,293 @@
+/*
+ * Compiled kernel of the Wittrick–Williams root solver (optional).
+ *
+ * The same numerics as elements.py, assembly.py and roots.py, one item
+ * (configuration, mode) at a time: segment dynamic stiffness in the stable
+ * exponential form, assembly on (v, θ, ĥ), scaled elimination without row
+ * interchanges for the count J = J0 + s{K} − n_h and det K, bracketing by
+ * the count and Anderson–Björck false position inside a pole-free
+ * one-root bracket. It exists because numpy's per-call overhead dominates
+ * small problems (a single configuration, or the 3×3 systems of a sweep);
+ * the numpy path stays the reference and the tests compare the two.
+ *
+ * Arrays are C-contiguous float64 (int64 for indices), passed as buffers.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <string.h>
+#include <stdlib.h>
+
+#define RTOL 2e-13
+#define MAX_ITER 200
+#define MAX_DOF 64
+
+typedef struct {
+    int n_att, n_seg, n_dof, n_h, string, tension_model; /* 0 none, 1 uniform, 2 per-segment */
+    const long long *v_dof, *t_dof, *h_dof;
+    const double *length, *m, *EI, *H, *w, *seg_len, *masses, *kconst, *scale;
+} Problem;
+
+static double x_cos_minus_sin(double x) {
+    double x2 = x * x;
+    if (fabs(x) < 0.1)
+        return x * x2 * (-1.0 / 3 + x2 * (1.0 / 30 + x2 * (-1.0 / 840 + x2 / 45360)));
+    return x * cos(x) - sin(x);
+}
+
+static double x_minus_tanh(double x) {
+    double x2 = x * x;
+    if (fabs(x) < 0.1)
+        return x * x2 * (1.0 / 3 + x2 * (-2.0 / 15 + x2 * (17.0 / 315 - x2 * 62.0 / 2835)));
+    return x - tanh(x);
+}
+
+static double x_minus_tan(double x) {
+    double x2 = x * x;
+    if (fabs(x) < 0.1)
+        return -x * x2 * (1.0 / 3 + x2 * (2.0 / 15 + x2 * (17.0 / 315 + x2 * 62.0 / 2835)));
+    return x - tan(x);
+}
+
+static double sign_of(double x) { return (x > 0) - (x < 0); }
+
+/* Element matrix Ke (row-major ne×ne), translation force, residual R, J0. */
+static int beam_segment(double L, double EI, double H, double m, double omega,
+                        double Ke[16], double force[4], double *R) {
+    double half = 0.5 * L;
+    double a_ = H / (2.0 * EI), b_ = m * omega * omega / EI;
+    double root = sqrt(a_ * a_ + b_);
+    double p2 = a_ + root, q2 = b_ / p2;
+    double p = sqrt(p2), q = sqrt(q2);
+    double pl = p * half, ql = q * half;
+    double T = tanh(pl), s = sin(ql), c = cos(ql);
+    double ppqq = p2 + q2, pq = p * q;
+    double n_sym = q * s + p * T * c, n_anti = T * q * c - s * p;
+    double k1 = EI / n_sym, k2 = EI / n_anti;
+    double a = -k1 * pq * T * s * ppqq, b = k1 * pq * (p * s - q * T * c), d = k1 * c * ppqq;
+    double e = -k2 * pq * c * ppqq, f = k2 * pq * (p * T * c + q * s), h = -k2 * T * s * ppqq;
+    Ke[0] = Ke[10] = 0.5 * (a + e);
+    Ke[5] = Ke[15] = 0.5 * (d + h);
+    Ke[2] = Ke[8] = 0.5 * (a - e);
+    Ke[7] = Ke[13] = 0.5 * (h - d);
+    Ke[1] = Ke[4] = -0.5 * (b + f);
+    Ke[11] = Ke[14] = 0.5 * (b + f);
+    Ke[3] = Ke[12] = 0.5 * (b - f);
+    Ke[6] = Ke[9] = 0.5 * (f - b);
+    force[0] = a; force[1] = -b; force[2] = a; force[3] = b;
+    *R = 2.0 * EI * pq * (p2 * T * x_cos_minus_sin(ql) + q2 * s * x_minus_tanh(pl)) / n_sym;
+    /* clamped–clamped count J0 */
+    double pL = 2.0 * pl, qL = 2.0 * ql;
+    double ex = exp(-pL);
+    double tanh_pl = tanh(pL), sech_pl = ex * 2.0 / (1.0 + ex * ex);
+    double delta = 2 * p * q * (sech_pl - cos(qL)) + (p2 - q2) * tanh_pl * sin(qL);
+    double i = floor(qL / M_PI);
+    if (i < 1) return 0;
+    double parity = fmod(i, 2.0) == 0.0 ? 1.0 : -1.0;
+    return (int)(i - 1) + (sign_of(delta) == parity);
+}
+
+static int string_segment(double L, double H, double m, double omega,
+                          double Ke[4], double force[2], double *R) {
+    double half = 0.5 * L;
+    double q = omega * sqrt(m / H);
+    double ql2 = 2.0 * q * half;
+    double diag = H * q * cos(ql2) / sin(ql2), off = -H * q / sin(ql2);
+    Ke[0] = Ke[3] = diag;
+    Ke[1] = Ke[2] = off;
+    force[0] = force[1] = diag + off;
+    *R = 2.0 * H * q * x_minus_tan(q * half);
+    double n = ceil(ql2 / M_PI) - 1;
+    return n > 0 ? (int)n : 0;
+}
+
+/* Count J(ω) and det of the scaled K for configuration cfg. */
+static void evaluate(const Problem *P, long long cfg, double omega, int *J_out, int *J0_out, double *det_out) {
+    int nd = P->n_dof, ns = P->n_seg;
+    double K[MAX_DOF * MAX_DOF];
+    memcpy(K, P->kconst + cfg * nd * nd, sizeof(double) * nd * nd);
+    double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
+    double gamma = P->w[cfg] / (H * m * omega * omega);
+    int J0 = 0;
+    for (int j = 0; j < ns; j++) {
+        double Ke[16], force[4], R;
+        long long dofs[4];
+        int ne;
+        double L = P->seg_len[cfg * ns + j];
+        if (P->string) {
+            ne = 2;
+            J0 += string_segment(L, H, m, omega, Ke, force, &R);
+            dofs[0] = P->v_dof[j]; dofs[1] = P->v_dof[j + 1];
+        } else {
+            ne = 4;
+            J0 += beam_segment(L, EI, H, m, omega, Ke, force, &R);
+            dofs[0] = P->v_dof[j]; dofs[1] = P->t_dof[j];
+            dofs[2] = P->v_dof[j + 1]; dofs[3] = P->t_dof[j + 1];
+        }
+        for (int r = 0; r < ne; r++) {
+            if (dofs[r] < 0) continue;
+            for (int c = 0; c < ne; c++)
+                if (dofs[c] >= 0) K[dofs[r] * nd + dofs[c]] += Ke[r * ne + c];
+        }
+        if (P->tension_model != 0) {
+            long long hj = P->h_dof[P->tension_model == 1 ? 0 : j];
+            for (int r = 0; r < ne; r++) {
+                if (dofs[r] < 0) continue;
+                double v = -gamma * force[r];
+                K[dofs[r] * nd + hj] += v;
+                K[hj * nd + dofs[r]] += v;
+            }
+            K[hj * nd + hj] += gamma * gamma * R;
+        }
+    }
+    for (int k = 0; k < P->n_att; k++) {
+        long long v = P->v_dof[k + 1];
+        K[v * nd + v] -= P->masses[cfg * P->n_att + k] * omega * omega;
+    }
+    /* scaled elimination without row interchanges */
+    const double *s = P->scale + cfg * nd;
+    double big = 0.0;
+    for (int i = 0; i < nd; i++)
+        for (int j = 0; j < nd; j++) {
+            double v = K[i * nd + j] * s[i] * s[j];
+            K[i * nd + j] = v;
+            if (fabs(v) > big) big = v < 0 ? -v : v;
+        }
+    double floor_ = 1e-14 * big, det = 1.0;
+    int neg = 0;
+    for (int k = 0; k < nd; k++) {
+        double d = K[k * nd + k];
+        if (d == 0.0) d = floor_;
+        if (d < 0) neg++;
+        det *= d;
+        for (int i = k + 1; i < nd; i++) {
+            double l = K[i * nd + k] / d;
+            if (l == 0.0) continue;
+            for (int j = k + 1; j < nd; j++) K[i * nd + j] -= l * K[k * nd + j];
+        }
+    }
+    *J_out = J0 + neg - P->n_h;
+    *J0_out = J0;
+    *det_out = det;
+}
+
+static double estimate(const Problem *P, long long cfg, double x) {
+    double L = P->length[cfg], H = P->H[cfg], m = P->m[cfg], EI = P->EI[cfg];
+    double k = x * M_PI / L;
+    return k * sqrt(H / m) * sqrt(1.0 + k * k * EI / H);
+}
+
+typedef struct { double x, f; int J, J0, has_f; } Point;
+
+static int solve_one(const Problem *P, long long cfg, long long mode, double *result) {
+    Point lo = {0.0, NAN, 0, 0, 0}, hi, t;
+    hi.x = estimate(P, cfg, mode + 0.5);
+    evaluate(P, cfg, hi.x, &hi.J, &hi.J0, &hi.f); hi.has_f = 1;
+    int steps = 0;
+    while (hi.J < mode) {
+        lo = hi;
+        hi.x *= 2.0;
+        evaluate(P, cfg, hi.x, &hi.J, &hi.J0, &hi.f);
+        if (++steps > 60) return -1;
+    }
+    if (mode > 1) {
+        t.x = estimate(P, cfg, mode - 0.5);
+        if (t.x > lo.x && t.x < hi.x) {
+            evaluate(P, cfg, t.x, &t.J, &t.J0, &t.f); t.has_f = 1;
+            if (t.J < mode) lo = t; else hi = t;
+        }
+    }
+    int side = 0, stalled = 0;
+    double width_ref = hi.x - lo.x;
+    for (int it = 0; it < MAX_ITER; it++) {
+        double width = hi.x - lo.x;
+        if (width <= RTOL * hi.x) {
+            *result = 0.5 * (lo.x + hi.x);
+            return 0;
+        }
+        int smooth = (hi.J - lo.J == 1) && (hi.J0 == lo.J0) && lo.has_f && hi.has_f && isfinite(lo.f) && isfinite(hi.f);
+        double x = 0.5 * (lo.x + hi.x);
+        if (smooth && stalled < 4) {
+            double secant = hi.x - hi.f * width / (hi.f - lo.f);
+            if (secant >= lo.x && secant <= hi.x) {
+                double step = 0.25 * RTOL * hi.x;
+                if (secant < lo.x + step) secant = lo.x + step;
+                if (secant > hi.x - step) secant = hi.x - step;
+                x = secant;
+            }
+        }
+        t.x = x;
+        evaluate(P, cfg, x, &t.J, &t.J0, &t.f); t.has_f = 1;
+        if (t.f == 0.0) {
+            *result = x;
+            return 0;
+        }
+        if (t.J >= mode) {
+            if (side == 1) { double mm = 1.0 - t.f / hi.f; lo.f *= mm > 0 ? mm : 0.5; }
+            hi = t; side = 1;
+        } else {
+            if (side == -1) { double mm = 1.0 - t.f / lo.f; hi.f *= mm > 0 ? mm : 0.5; }
+            lo = t; side = -1;
+        }
+        double new_width = hi.x - lo.x;
+        if (new_width <= 0.5 * width_ref) { width_ref = new_width; stalled = 0; }
+        else stalled++;
+    }
+    return -2;
+}
+
+static int get_buffer(PyObject *obj, Py_buffer *view, const char *name) {
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0) {
+        PyErr_Format(PyExc_TypeError, "%s: a contiguous buffer is required", name);
+        return -1;
+    }
+    return 0;
+}
+
+/* solve(topology tuple, arrays..., config, mode, out) */
+static PyObject *py_solve(PyObject *self, PyObject *args) {
+    int n_att, n_dof, n_h, string, tension_model;
+    PyObject *objs[14];
+    if (!PyArg_ParseTuple(args, "iiiiiOOOOOOOOOOOOOO", &n_att, &n_dof, &n_h, &string, &tension_model,
+                          &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
+                          &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13]))
+        return NULL;
+    if (n_dof > MAX_DOF) {
+        PyErr_SetString(PyExc_ValueError, "too many degrees of freedom for the compiled kernel");
+        return NULL;
+    }
+    static const char *names[14] = {"v_dof", "t_dof", "h_dof", "length", "m", "EI", "H", "w", "seg_len",
+                                    "masses", "kconst", "scale", "config", "mode"};
+    Py_buffer views[15];
+    int got = 0;
+    PyObject *result = NULL;
+    for (; got < 14; got++)
+        if (get_buffer(objs[got], &views[got], names[got]) < 0) goto done;
+    Problem P = {n_att, n_att + 1, n_dof, n_h, string, tension_model,
+                 views[0].buf, views[1].buf, views[2].buf,
+                 views[3].buf, views[4].buf, views[5].buf, views[6].buf, views[7].buf, views[8].buf,
+                 views[9].buf, views[10].buf, views[11].buf};
+    const long long *config = views[12].buf, *mode = views[13].buf;
+    Py_ssize_t n_items = views[12].len / (Py_ssize_t)sizeof(long long);
+    PyObject *out = PyBytes_FromStringAndSize(NULL, n_items * (Py_ssize_t)sizeof(double));
+    if (!out) goto done;
+    double *omega = (double *)PyBytes_AS_STRING(out);
+    Py_ssize_t failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n_items; i++)
+        if (solve_one(&P, config[i], mode[i], &omega[i]) != 0) { omega[i] = NAN; failed++; }
+    Py_END_ALLOW_THREADS
+    result = Py_BuildValue("Nn", out, failed);
+done:
+    for (int i = 0; i < got; i++) PyBuffer_Release(&views[i]);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"solve", py_solve, METH_VARARGS, "Natural frequencies (rad/s) of (configuration, mode) items."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_dsm_kernel", NULL, -1, methods};
+
+PyMODINIT_FUNC PyInit__dsm_kernel(void) { return PyModule_Create(&module); }
