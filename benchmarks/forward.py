@@ -27,10 +27,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from stcs_ident.campaign_io import load_campaign  # noqa: E402
-from stcs_ident.forward import batch_frequencies, natural_frequencies  # noqa: E402
-from stcs_ident.forward.fem import fe_frequencies  # noqa: E402
-from stcs_ident.model import Attachment, Cable  # noqa: E402
+from stcs_ident.campaign_io import load_campaign
+from stcs_ident.forward import batch_frequencies, natural_frequencies
+from stcs_ident.forward.fem import fe_frequencies
+from stcs_ident.model import Attachment, Cable
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET_ACCURACY = 1e-6  # relative, on mode 10

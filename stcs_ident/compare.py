@@ -235,7 +235,7 @@ def _reference_checks(campaign: Campaign, tests: list[Test], tension_model: str)
         if "taut_string" in label or cable.EI == 0:
             EI_best, rms_best = cable.EI, rms
         else:
-            res = minimize_scalar(lambda lg: float(np.mean((model(math.exp(lg)) - target) ** 2)),
+            res = minimize_scalar(lambda lg, target=target: float(np.mean((model(math.exp(lg)) - target) ** 2)),
                                   bounds=(math.log(cable.EI) - 3, math.log(cable.EI) + 3), method="bounded",
                                   options={"xatol": 1e-6})
             EI_best, rms_best = math.exp(res.x), math.sqrt(res.fun)

@@ -37,7 +37,7 @@ class InputError(ValueError):
         head = ": ".join(parts)
         return f"{head}: {self.message}" if head else self.message
 
-    def with_file(self, file: str) -> "InputError":
+    def with_file(self, file: str) -> InputError:
         """Return the same error, attributed to ``file``."""
         return type(self)(self.message, field=self.field, file=file)
 

@@ -9,9 +9,10 @@ degrees; tables print kN).
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable
 
 from .errors import ModelError
 
@@ -65,11 +66,11 @@ class Boundary:
         object.__setattr__(self, "rotational_stiffness", k)
 
     @classmethod
-    def clamped(cls) -> "Boundary":
+    def clamped(cls) -> Boundary:
         return cls(math.inf)
 
     @classmethod
-    def pinned(cls) -> "Boundary":
+    def pinned(cls) -> Boundary:
         return cls(0.0)
 
     @property
@@ -190,7 +191,7 @@ class Setup:
             if names.count(n) > 1:
                 raise ModelError(f"duplicate attachment name {n!r}", field=f"setup[{self.name}].attachment[{n}].name")
         atts = tuple(sorted(atts, key=lambda a: a.position))
-        for a, b in zip(atts, atts[1:]):
+        for a, b in itertools.pairwise(atts):
             if a.position == b.position:
                 raise ModelError(
                     f"attachments {a.name!r} and {b.name!r} are at the same position {a.position} m",

@@ -2,8 +2,6 @@
 
 import math
 
-import numpy as np
-
 from stcs_ident.model import Attachment, Boundary, Cable
 
 

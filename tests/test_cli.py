@@ -102,3 +102,37 @@ def test_missing_campaign_exits_2(tmp_path, capsys):
 def test_unwritable_json_leaves_nothing(tmp_path, capsys):
     code, _, err = run(["forward", _write(tmp_path, GOOD), "--json", tmp_path / "no" / "dir" / "x.json"], capsys)
     assert code == 2 and "x.json" in err
+
+
+def _bad_cases():
+    from test_campaign_io import BAD
+
+    return BAD
+
+
+@pytest.mark.parametrize("name", list(_bad_cases()))
+def test_every_bad_campaign_exits_2_through_the_cli(tmp_path, capsys, name):
+    """Every bad input of the loader's tests, through the command line: exit 2,
+    one line naming the file and the field, nothing written."""
+    text, field = _bad_cases()[name]
+    directory = _write(tmp_path, text)
+    out_json = tmp_path / "out.json"
+    code, out, err = run(["forward", directory, "--json", out_json], capsys)
+    assert code == 2
+    assert err.count("\n") == 1 and str(directory / "campaign.toml") in err
+    assert f"'{field}'" in err
+    assert not out_json.exists() and out == ""
+
+
+@pytest.mark.parametrize("content", ["not TOML {{{ ]]]\n", b"\xff\xfe\x00\x81"])
+def test_unreadable_or_non_toml_exits_2(tmp_path, capsys, content):
+    file = tmp_path / "campaign.toml"
+    file.write_bytes(content if isinstance(content, bytes) else content.encode())
+    code, _, err = run(["forward", file], capsys)
+    assert code == 2 and err.count("\n") == 1 and str(file) in err
+
+
+def test_reference_column_of_wrong_length_exits_2(tmp_path, capsys):
+    text = GOOD + "  [test.reference]\n  paper = [2.4]\n"
+    code, _, err = run(["forward", _write(tmp_path, text)], capsys)
+    assert code == 2 and "test[T1].reference.paper" in err

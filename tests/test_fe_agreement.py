@@ -12,8 +12,8 @@ exact answer.
 
 import numpy as np
 import pytest
-
 from random_cables import random_configuration
+
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies, fe_modes
 from stcs_ident.forward.shapes import modal_masses, mode_shapes
@@ -63,7 +63,7 @@ def test_mode_shapes_are_mass_orthogonal_and_match_finite_elements():
         shapes = mode_shapes(cable, atts, H, 8)
         M = modal_masses(shapes, cable, atts)
         np.testing.assert_allclose(M, np.eye(8), atol=1e-8, rtol=0)
-        f_fe, x, disp, _ = fe_modes(cable, atts, H, 8, n_elements=400, grading=2.0)
+        _, x, disp, _ = fe_modes(cable, atts, H, 8, n_elements=400, grading=2.0)
         phi = shapes(x)
         for k in range(8):
             if k + 1 < 8 and abs(shapes.frequencies[k + 1] / shapes.frequencies[k] - 1) < 1e-4:

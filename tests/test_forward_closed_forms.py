@@ -121,7 +121,7 @@ def test_clamped_count_matches_brute_force(seed):
     H = 10 ** rng.uniform(1, 7)
     m = rng.uniform(0.5, 50)
     f20 = ref.beam_clamped(L, m, H, EI, [20])[0]
-    omega, brute, seg = _brute_force_clamped_count(L, EI, H, m, 2 * math.pi * f20 * 1.02)
+    _, brute, seg = _brute_force_clamped_count(L, EI, H, m, 2 * math.pi * f20 * 1.02)
     np.testing.assert_array_equal(seg.clamped_count(), brute)
     assert brute[-1] == 20
 
@@ -175,6 +175,7 @@ def test_compiled_kernel_matches_numpy_path(monkeypatch):
     import os
 
     from random_cables import random_configuration
+
     from stcs_ident.forward import roots
 
     if not roots.use_kernel():

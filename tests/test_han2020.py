@@ -113,7 +113,7 @@ def test_table12_with_uniform_additional_tension(campaign):
 
 
 def _batch_without_attachment_weights(cable, atts, H, model="uniform"):
-    one = lambda v: np.array([v], float)  # noqa: E731
+    one = lambda v: np.array([v], float)
     return CableBatch(
         Topology(3, True, True, False, model), length=one(cable.length), mass_per_length=one(cable.mass_per_length),
         EI=one(cable.EI), tension=one(H), EA=one(cable.EA), weight=one(cable.weight_per_length), gcos=one(0.0),

@@ -22,7 +22,6 @@ import numpy as np
 from scipy.optimize import brentq
 
 
-
 def _modes(modes):
     n = np.atleast_1d(np.asarray(modes))
     if n.ndim != 1 or np.any(n < 1) or np.any(n != np.round(n)):
@@ -86,7 +85,7 @@ def beam_clamped_no_tension(length, mass_per_length, EI, modes):
     out = []
     for k in n:
         # cos x − sech x = 0 has one root in ((k + ½)π − ½, (k + ½)π + ½)
-        g = lambda x: math.cos(x) - 2 * math.exp(-x) / (1 + math.exp(-2 * x))  # noqa: E731
+        g = lambda x: math.cos(x) - 2 * math.exp(-x) / (1 + math.exp(-2 * x))
         x = brentq(g, (k + 0.5) * math.pi - 0.5, (k + 0.5) * math.pi + 0.5, xtol=1e-300, rtol=1e-15)
         out.append((x / length) ** 2 * math.sqrt(EI / mass_per_length) / (2 * math.pi))
     return np.array(out)

@@ -159,8 +159,8 @@ def use_kernel() -> bool:
 def _solve_compiled(batch, config, mode):
     topo = batch.topology
     model = {"none": 0, "uniform": 1, "per-segment": 2}[topo.tension_model]
-    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)
     raw, failed = _dsm_kernel.solve(
         topo.n_attachments, batch.n_dof, topo.n_h, int(topo.string), model,
         i64(batch.v_dof), i64(batch.t_dof), i64(batch.h_dof),

@@ -11,8 +11,8 @@ boundary layers of width 1/p at the segment ends.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -67,7 +67,7 @@ class ModeShapes:
             a, b = self.nodes[j], self.nodes[j + 1]
             seg = self._segments[-1][j]  # highest mode: finest wavelength
             L = b - a
-            n_wave = int(math.ceil(2 * float(seg.q) * L / math.pi)) + 2
+            n_wave = math.ceil(2 * float(seg.q) * L / math.pi) + 2
             breaks = set(np.linspace(0.0, L, n_wave + 1).tolist())
             p = float(getattr(seg, "p", 0.0))
             if p * L > 4:
@@ -107,7 +107,7 @@ def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float,
                 "its shape is not defined by the nodal values"
             )
         z = s * vec[:, order[0]]
-        dof = lambda i: z[i] if i >= 0 else 0.0  # noqa: E731
+        dof = np.append(z, 0.0).__getitem__  # index −1 (a fixed dof) reads 0
         h = z[batch.h_dof] if topo.n_h else np.zeros(0)
         gamma = batch.w[0] / (batch.H[0] * batch.m[0] * omega[0] ** 2)
         per_seg = []
