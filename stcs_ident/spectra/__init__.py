@@ -1,0 +1,1 @@
+"""Spectra: acceleration records, a record simulator and modal frequency picking."""
