@@ -56,3 +56,11 @@ class ComputationError(RuntimeError):
 
 class StcsWarning(UserWarning):
     """Base class of the toolkit's warnings."""
+
+
+class RecordWarning(StcsWarning):
+    """Something in an acceleration record was handled (a channel dropped, say)."""
+
+
+class NumberingWarning(StcsWarning):
+    """A mode-number assignment is doubtful."""
