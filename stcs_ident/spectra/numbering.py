@@ -1,0 +1,218 @@
+"""Mode numbers for picked peaks, from the family structure of the cable.
+
+Nearest-prediction numbering fails as soon as the nominal model is a few
+per cent off or a mode is missing: the k-th peak is then taken for mode
+k ± 1. Here the whole family is matched instead. The exact model is
+evaluated on a grid of tension and bending-stiffness ratios (the batch
+solver makes this cheap), so every candidate family keeps the cable's own
+pattern (near-harmonic spacing, the bending stiffness's stretch, the
+shifts of symmetric modes by attachments and sag). For each family the
+peaks get the order-preserving assignment of least cost (dynamic
+programming; a peak may stay unassigned at a fixed cost, for spurious or
+out-of-plane peaks), with residuals scaled by the measurement uncertainty
+plus a model tolerance. The best family gives the numbers; a peak whose
+number differs in any family almost as good (within ``ambiguity`` in
+cost) is flagged doubtful — never silently guessed.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import InputError, NumberingWarning
+from ..forward import batch_frequencies
+from ..model import Attachment, Cable
+
+#: Cost of leaving a peak unassigned (in squared standardised residuals):
+#: a peak 4σ from every prediction is cheaper to call spurious.
+UNASSIGNED_COST = 16.0
+
+
+@dataclass(frozen=True)
+class Numbering:
+    """Mode numbers of a set of peaks.
+
+    Attributes
+    ----------
+    modes : ndarray of int (n_peaks,)
+        Mode number per peak, 0 where the peak is left unassigned.
+    doubtful : ndarray of bool (n_peaks,)
+        True where an almost equally good family numbers the peak otherwise.
+    tension_ratio, EI_ratio : float
+        The family that fits best (ratios to the nominal values).
+    predicted : ndarray (n_peaks,)
+        That family's frequency for each assigned peak (NaN if unassigned).
+    cost : float
+        Its cost; ``alternatives`` holds (cost, modes) of the runners-up.
+    """
+
+    modes: np.ndarray
+    doubtful: np.ndarray
+    tension_ratio: float
+    EI_ratio: float
+    predicted: np.ndarray
+    cost: float
+    alternatives: tuple
+
+
+def assign(frequencies, sigma, families):
+    """Order-preserving assignment of peaks to families (dynamic programming,
+    vectorised over the families).
+
+    Parameters
+    ----------
+    frequencies, sigma : arrays (n_peaks,), ascending frequencies
+    families : array (n_families, n_modes), ascending predicted frequencies
+
+    Returns
+    -------
+    modes : int array (n_families, n_peaks), 1-based, 0 = unassigned
+    cost : array (n_families,)
+    """
+    families = np.atleast_2d(families)
+    F, K = families.shape
+    n = len(frequencies)
+    resid = ((frequencies[None, :, None] - families[:, None, :]) / sigma[None, :, None]) ** 2  # (F, n, K)
+    # best[:, j, k]: least cost of the first j peaks using the first k modes
+    best = np.full((F, n + 1, K + 1), np.inf)
+    best[:, 0, :] = 0.0
+    choice = np.zeros((F, n + 1, K + 1), dtype=np.int8)  # 0 skip mode, 1 match, 2 peak unassigned
+    for j in range(1, n + 1):
+        best[:, j, 0] = best[:, j - 1, 0] + UNASSIGNED_COST
+        choice[:, j, 0] = 2
+        for k in range(1, K + 1):
+            options = np.stack([best[:, j, k - 1], best[:, j - 1, k - 1] + resid[:, j - 1, k - 1],
+                                best[:, j - 1, k] + UNASSIGNED_COST])
+            c = np.argmin(options, axis=0)
+            best[:, j, k] = np.take_along_axis(options, c[None], axis=0)[0]
+            choice[:, j, k] = c
+    modes = np.zeros((F, n), dtype=int)
+    for fam in range(F):
+        j, k = n, K
+        ch = choice[fam]
+        while j > 0:
+            c = ch[j, k]
+            if c == 0:
+                k -= 1
+            elif c == 1:
+                modes[fam, j - 1] = k
+                j -= 1
+                k -= 1
+            else:
+                j -= 1
+    return modes, best[:, n, K]
+
+
+def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], cable: Cable,
+                 attachments: Sequence[Attachment], tension: float, *, model_tolerance: float = 0.003,
+                 tension_range: tuple[float, float] = (0.6, 1.5), EI_range: tuple[float, float] = (0.2, 5.0),
+                 ambiguity: float = 6.0, tension_model: str = "uniform") -> Numbering:
+    """Number the peaks by matching the whole family of the cable model.
+
+    Parameters
+    ----------
+    frequencies, uncertainties : peak frequencies and 1σ uncertainties, Hz
+    cable, attachments, tension : the nominal model of the test
+    model_tolerance : relative misfit the model is allowed per mode after
+        tension and EI are fitted (attachments, sag, end conditions).
+    tension_range, EI_range : ratios to nominal searched (tension 0.6–1.5
+        covers frequencies 23 % below to 22 % above the nominal).
+    ambiguity : cost difference within which another family counts as
+        equally good (a χ² difference; 6 ≈ 2.4σ on one mode).
+    """
+    f = np.asarray(frequencies, float)
+    u = np.asarray(uncertainties, float)
+    if f.ndim != 1 or f.shape != u.shape:
+        raise InputError("frequencies and uncertainties must be 1-D of equal length", field="frequencies")
+    if f.size == 0:
+        return Numbering(np.zeros(0, int), np.zeros(0, bool), 1.0, 1.0, np.zeros(0), 0.0, ())
+    order = np.argsort(f)
+    f, u = f[order], u[order]
+    sigma = np.sqrt(u**2 + (model_tolerance * f) ** 2)
+    t_ratio = np.geomspace(*tension_range, 49)
+    ei_ratio = np.geomspace(*EI_range, 15) if cable.EI > 0 else np.array([1.0])
+    n_modes = _modes_needed(f, cable, attachments, tension, tension_range[0], tension_model)
+    fam = batch_frequencies(cable, attachments, tension * t_ratio[:, None], n_modes,
+                            EI=cable.EI * ei_ratio[None, :], tension_model=tension_model)
+    flat = fam.reshape(-1, n_modes)
+    all_modes, all_cost = assign(f, sigma, flat)
+    # candidate numberings from the best grid families, each refined by a
+    # continuous fit of (tension, EI) and re-assigned until stable
+    candidates = {}
+    for q in np.argsort(all_cost)[:40]:
+        key = tuple(all_modes[q])
+        if key not in candidates and len(candidates) < 8:
+            i, j = np.unravel_index(q, fam.shape[:2])
+            candidates[key] = (t_ratio[i], ei_ratio[j])
+    refined = {}
+    for key, (t0, r0) in candidates.items():
+        modes, cost, tr, er, family = _refine(f, sigma, np.array(key), t0, r0, cable, attachments, tension,
+                                              tension_model, n_modes)
+        if tuple(modes) not in refined or refined[tuple(modes)][0] > cost:
+            refined[tuple(modes)] = (cost, tr, er, family)
+    ranked = sorted(refined.items(), key=lambda kv: kv[1][0])
+    modes = np.array(ranked[0][0])
+    cost, tr, er, family = ranked[0][1]
+    doubtful = np.zeros(f.size, bool)
+    alternatives = []
+    for m, (c, *_rest) in ranked[1:]:
+        if c - cost <= ambiguity:
+            doubtful |= np.array(m) != modes
+            alternatives.append((c, np.array(m)))
+    predicted = np.where(modes > 0, family[np.maximum(modes, 1) - 1], np.nan)
+    inverse = np.argsort(order)
+    result = Numbering(modes[inverse], doubtful[inverse], float(tr), float(er),
+                       predicted[inverse], cost, tuple((c, m[inverse]) for c, m in alternatives))
+    if doubtful.any():
+        warnings.warn(
+            f"mode numbers of the peaks at {', '.join(f'{x:.3f}' for x in f[doubtful])} Hz are doubtful: "
+            "another family of modes fits almost as well", NumberingWarning, stacklevel=2)
+    return result
+
+
+def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model, n_modes):
+    """Fit (tension, EI) ratios to the assigned peaks, re-assign, repeat."""
+    fit_ei = cable.EI > 0
+    x = np.log([t0, r0] if fit_ei else [t0])
+    family = None
+    for _ in range(3):
+        assigned = modes > 0
+        if assigned.sum() >= (2 if fit_ei else 1):
+            idx = modes[assigned] - 1
+
+            def residual(x, idx=idx, assigned=assigned):
+                fam = _family(x, cable, attachments, tension, tension_model, n_modes)
+                return (f[assigned] - fam[idx]) / sigma[assigned]
+
+            x = least_squares(residual, x, method="lm", x_scale=0.1).x
+        family = _family(x, cable, attachments, tension, tension_model, n_modes)
+        new_modes, cost = assign(f, sigma, family[None, :])
+        if np.array_equal(new_modes[0], modes):
+            break
+        modes = new_modes[0]
+    _, cost = assign(f, sigma, family[None, :])
+    ratios = np.exp(x)
+    return modes, float(cost[0]), float(ratios[0]), float(ratios[1]) if fit_ei else 1.0, family
+
+
+def _family(x, cable, attachments, tension, tension_model, n_modes):
+    t = math.exp(x[0])
+    EI = cable.EI * math.exp(x[1]) if len(x) > 1 else cable.EI
+    return batch_frequencies(cable, attachments, tension * t, n_modes, EI=EI, tension_model=tension_model)
+
+
+def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
+    """Enough modes that the softest family in the search reaches past the highest peak."""
+    n = 8
+    while True:
+        soft = batch_frequencies(cable, attachments, tension * lowest_ratio, n, EI=cable.EI * 0.2,
+                                 tension_model=tension_model)
+        if soft[-1] > 1.2 * f.max() or n > 400:
+            return n
+        n = int(n * 1.6)

@@ -1,0 +1,57 @@
+"""Mode numbering from the family structure (spectra/numbering.py)."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from stcs_ident.errors import NumberingWarning
+from stcs_ident.forward import natural_frequencies
+from stcs_ident.model import Attachment, Cable
+from stcs_ident.spectra.numbering import assign, number_modes
+
+STAY = Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9, inclination=np.radians(30))
+STAY_ATTS = [Attachment("damper", 3.0, 50.0, 5.0e4)]
+HANGER = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5)
+HANGER_ATTS = [Attachment("clamp", 2.7, 15.0)]
+
+
+def test_assign_is_order_preserving_and_skips_spurious_peaks():
+    family = np.array([[1.0, 2.0, 3.0, 4.0, 5.0]])
+    peaks = np.array([1.001, 2.5, 3.0, 4.999])  # 2.5 fits nothing
+    modes, cost = assign(peaks, np.full(4, 0.01), family)
+    np.testing.assert_array_equal(modes[0], [1, 0, 3, 5])
+
+
+@pytest.mark.parametrize("cable,atts,tension", [(STAY, STAY_ATTS, 4.0e6), (HANGER, HANGER_ATTS, 4.0e5)])
+@pytest.mark.parametrize("tension_error", [0.75, 1.0, 1.32])  # frequencies ~13 % low to ~15 % high
+@pytest.mark.parametrize("missing", [(), (0,), (1, 2), (0, 4, 6)])
+def test_numbers_survive_a_wrong_nominal_and_missing_modes(cable, atts, tension, tension_error, missing):
+    """The truth has the tension off by the given factor and EI 30 % off;
+    some modes are missing; measured to 1e-4 relative."""
+    true = natural_frequencies(Cable(cable.length, cable.mass_per_length, cable.EI * 1.3, cable.EA,
+                                     cable.inclination), atts, tension * tension_error, 10)
+    keep = np.array([k for k in range(10) if k not in missing])
+    rng = np.random.default_rng(len(missing))
+    f = true[keep] * (1 + 1e-4 * rng.standard_normal(keep.size))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NumberingWarning)
+        result = number_modes(f, 1e-4 * f, cable, atts, tension)
+    np.testing.assert_array_equal(result.modes, keep + 1)
+    assert not result.doubtful.any()
+
+
+def test_spurious_peak_is_left_unassigned():
+    true = natural_frequencies(HANGER, HANGER_ATTS, 4.0e5, 6)
+    f = np.sort(np.append(true, 0.5 * (true[2] + true[3])))
+    result = number_modes(f, 1e-4 * f, HANGER, HANGER_ATTS, 4.0e5)
+    assert list(result.modes) == [1, 2, 3, 0, 4, 5, 6]
+
+
+def test_ambiguous_numbering_is_flagged_not_guessed():
+    """Only high modes, imprecise, and a nominal 30 % off: several numberings
+    fit, so every peak is flagged and a warning says so."""
+    true = natural_frequencies(STAY, STAY_ATTS, 4.0e6, 16)[10:14]
+    with pytest.warns(NumberingWarning, match="doubtful"):
+        result = number_modes(true, 5e-3 * true, STAY, STAY_ATTS, 4.0e6 * 1.3)
+    assert result.doubtful.all()
