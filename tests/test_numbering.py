@@ -19,7 +19,7 @@ HANGER_ATTS = [Attachment("clamp", 2.7, 15.0)]
 def test_assign_is_order_preserving_and_skips_spurious_peaks():
     family = np.array([[1.0, 2.0, 3.0, 4.0, 5.0]])
     peaks = np.array([1.001, 2.5, 3.0, 4.999])  # 2.5 fits nothing
-    modes, cost = assign(peaks, np.full(4, 0.01), family)
+    modes, _cost = assign(peaks, np.full(4, 0.01), family)
     np.testing.assert_array_equal(modes[0], [1, 0, 3, 5])
 
 
