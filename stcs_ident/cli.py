@@ -27,6 +27,12 @@ def _parser() -> argparse.ArgumentParser:
                      help="additional tension from sag-extensibility (default uniform)")
     fwd.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     fwd.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    spe = sub.add_parser("spectra", help="numbered modal frequencies picked from the acceleration records")
+    spe.add_argument("campaign", help="campaign directory or its campaign.toml")
+    spe.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+    spe.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
+    spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
+    spe.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     return parser
 
 
@@ -56,6 +62,45 @@ def _write(path, text) -> None:
         raise InputError(f"cannot write: {err.strerror}", field="--json", file=str(path)) from err
 
 
+def _progress(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _picked(campaign, tests, file):
+    """Spectra of the selected tests that have records (for forward and spectra)."""
+    if not any(t.record is not None for t in campaign.tests if not tests or t.name in tests):
+        return []
+    from .spectra.pipeline import analyse_campaign
+
+    return analyse_campaign(campaign, tests, progress=_progress)
+
+
+def _spectra(args) -> int:
+    from .campaign_io import campaign_file, load_campaign
+    from .report import spectra_text, to_json
+
+    campaign = load_campaign(args.campaign)
+    file = str(campaign_file(args.campaign))
+    tests = _selected_tests(campaign, args.test, file)
+    _check_output(args.json)
+    if args.plot is not None and os.path.exists(args.plot) and not os.path.isdir(args.plot):
+        raise InputError("exists and is not a directory", field="--plot", file=args.plot)
+    results = _picked(campaign, tests, file)
+    skipped = [t.name for t in campaign.tests if t.record is None and (not tests or t.name in tests)]
+    if args.json:
+        _write(args.json, to_json({"campaign": campaign.name, "tests": [r.summary() for r in results],
+                                   "skipped": skipped}))
+    if args.plot is not None:
+        from .plots import plot_test_spectra, save_figure
+
+        os.makedirs(args.plot, exist_ok=True)
+        for r in results:
+            save_figure(plot_test_spectra(r)["figure"], os.path.join(args.plot, f"{r.name}.png"))
+    if args.json != "-":
+        sys.stdout.write(spectra_text(campaign.name, results, skipped))
+    return 0
+
+
 def _forward(args) -> int:
     from .campaign_io import campaign_file, load_campaign
     from .compare import compare_forward
@@ -67,7 +112,8 @@ def _forward(args) -> int:
         raise InputError(f"must be >= 1, got {args.modes}", field="--modes")
     tests = _selected_tests(campaign, args.test, file)
     _check_output(args.json)
-    result = compare_forward(campaign, tests, args.modes, args.tension_model)
+    picked = {r.name: (r.modes, r.frequencies) for r in _picked(campaign, tests, file)}
+    result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked)
     text = forward_text(result)
     if args.json:
         _write(args.json, to_json(result.summary()))
@@ -81,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     try:
-        return {"forward": _forward}[args.command](args)
+        return {"forward": _forward, "spectra": _spectra}[args.command](args)
     except InputError as err:
         if args.debug:
             traceback.print_exc()

@@ -11,7 +11,7 @@ bending stiffness would.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -147,7 +147,7 @@ def _modes_of(test: Test, n_modes: int | None) -> tuple[int, ...]:
 
 
 def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes: int | None = None,
-                    tension_model: str = "uniform") -> ForwardResult:
+                    tension_model: str = "uniform", picked: dict | None = None) -> ForwardResult:
     """Compute every model for the selected tests of a campaign.
 
     Parameters
@@ -157,11 +157,23 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
     n_modes : int, optional
         Modes to compute; default the measured modes, at least 1..6.
     tension_model : {"uniform", "per-segment", "none"}
+    picked : dict, optional
+        {test name: (modes, frequencies)} picked from records; they replace
+        the table as ``measured`` (the table is then shown as a reference
+        column, ``table``).
     """
+    picked = picked or {}
     cable = campaign.cable
     selected = campaign.tests if not tests else [campaign.test(n) for n in tests]
     out = []
     for test in selected:
+        table = None
+        if test.name in picked:
+            modes, freqs = picked[test.name]
+            if test.frequencies is not None:
+                table = dict(zip(test.modes, test.frequencies))
+            test = replace(test, frequencies=tuple(float(f) for f in freqs) or None,
+                           modes=tuple(int(k) for k in modes) or None, reference=())
         atts = campaign.setup(test.setup).attachments
         shown = _modes_of(test, n_modes)
         if test.modes is not None:
@@ -177,13 +189,16 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
         for label, values in test.reference:
             ref_by_mode = dict(zip(test.modes, values))
             reference[label] = np.array([ref_by_mode.get(k, np.nan) for k in shown])
+        if table is not None:
+            reference["table"] = np.array([table.get(k, np.nan) for k in shown])
         out.append(TestComparison(
             name=test.name, setup=test.setup, tension=test.tension, modes=shown, dsm=dsm_all[idx],
             taut_string=closed_form.taut_string(cable.length, cable.mass_per_length, test.tension, shown),
             beam_pinned=closed_form.beam_pinned(cable.length, cable.mass_per_length, test.tension, cable.EI, shown),
             measured=measured, reference=reference,
         ))
-    checks = _reference_checks(campaign, [campaign.test(t.name) for t in out], tension_model)
+    checks = _reference_checks(campaign, [campaign.test(t.name) for t in out if t.name not in picked],
+                               tension_model)
     return ForwardResult(campaign.name, tension_model, out, checks)
 
 

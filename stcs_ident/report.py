@@ -84,3 +84,26 @@ def _json_default(value):
     if hasattr(value, "tolist"):
         return value.tolist()
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def spectra_text(campaign: str, results, skipped) -> str:
+    """The ``spectra`` tables: per test, mode, frequency, uncertainty, channels."""
+    lines = [f"Campaign {campaign}: modal frequencies picked from the records", ""]
+    for r in results:
+        lines.append(f"Test {r.name} ({r.peaks.kind} record {os.path.basename(r.record)})")
+        for name, reason in r.dropped:
+            lines.append(f"  channel {name} dropped: {reason}")
+        lines.append(f"{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9}  channels")
+        for k, f, u, z, ch, doubt in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels, r.doubtful):
+            flag = "?" if doubt else " "
+            zeta = "-" if np.isnan(z) else f"{100 * z:.2f}"
+            lines.append(f"{k:>3}{flag} {f:11.4f} {u:11.5f} {zeta:>9}  {' '.join(ch)}")
+        if any(r.doubtful):
+            lines.append("  ? = doubtful mode number: another family of modes fits almost as well")
+        for f, u in r.unassigned:
+            lines.append(f"  unassigned peak at {f:.4f} ± {u:.5f} Hz")
+        lines.append("")
+    if skipped:
+        lines.append(f"Tests without a record (nothing to pick): {', '.join(skipped)}")
+        lines.append("")
+    return "\n".join(lines)

@@ -1,0 +1,71 @@
+"""Figures (headless, Agg). Each function builds on a matplotlib Figure or a
+given Axes, never on pyplot's global state, and returns what it drew so
+that tests can inspect it. matplotlib is imported only here."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+def _figure(**kwargs):
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
+
+
+def plot_test_spectra(spectra, fig=None) -> dict:
+    """Combined and per-channel spectra of one test, picked peaks labelled by mode.
+
+    Parameters
+    ----------
+    spectra : stcs_ident.spectra.pipeline.TestSpectra
+    fig : matplotlib.figure.Figure, optional
+
+    Returns
+    -------
+    dict with the figure, both axes, the spectrum lines and the peak labels
+    (``labels``: list of matplotlib Text, one per picked peak).
+    """
+    fig = fig or _figure(figsize=(10, 6.5), layout="constrained")
+    ax_c, ax_ch = fig.subplots(2, 1, sharex=True)
+    result = spectra.peaks
+    f = result.frequency_axis
+    combined = ax_c.semilogy(f, result.combined_spectrum, color="k", lw=0.8, label="combined")[0]
+    channel_lines = []
+    names = [n for n in result.channel_names] if hasattr(result, "channel_names") else None
+    for i in range(result.channel_spectra.shape[1]):
+        label = names[i] if names else f"channel {i + 1}"
+        channel_lines.append(ax_ch.semilogy(f, result.channel_spectra[:, i], lw=0.7, label=label)[0])
+    labels = []
+    top = np.interp(spectra.frequencies, f, result.combined_spectrum) if len(f) else []
+    for k, fk, yk, doubt in zip(spectra.modes, spectra.frequencies, top, spectra.doubtful):
+        ax_c.axvline(fk, color="tab:red", lw=0.5, alpha=0.5)
+        text = f"{k}?" if doubt else f"{k}"
+        labels.append(ax_c.annotate(text, (fk, yk), xytext=(0, 6), textcoords="offset points", ha="center",
+                                    fontsize=8, color="tab:red" if not doubt else "tab:orange"))
+    for fu, _ in spectra.unassigned:
+        ax_c.axvline(fu, color="0.6", lw=0.5, ls=":")
+    ax_c.set_ylabel("combined spectrum")
+    ax_c.set_title(f"{spectra.name}: {len(spectra.modes)} modes picked ({result.kind}); "
+                   "red = mode number, orange ? = doubtful, dotted = unassigned", fontsize=9)
+    ax_ch.set_ylabel("channel PSD (m/s²)²/Hz")
+    ax_ch.set_xlabel("frequency (Hz)")
+    ax_ch.legend(fontsize=7, ncols=4, loc="upper right")
+    return {"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels}
+
+
+def save_figure(fig, path) -> None:
+    """Save a PNG whole or not at all (temporary file, then rename)."""
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=target.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=110, format="png")
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

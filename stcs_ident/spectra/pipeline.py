@@ -1,0 +1,124 @@
+"""From a test's acceleration record to numbered modal frequencies.
+
+read the record → check it against the cable (positions, duration) → pick
+peaks across channels (:mod:`.peaks`) → number them by the family of the
+nominal model (:mod:`.numbering`). One :class:`TestSpectra` per test.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..forward import natural_frequencies
+from ..model import Campaign, Test
+from .io import check_duration, check_positions, read_record
+from .numbering import Numbering, number_modes
+from .peaks import PeakResult, find_peaks
+
+#: Modes searched by default: enough for identification, few enough that a
+#: long stay cable's hundreds of modes below Nyquist are not all numbered.
+DEFAULT_MAX_MODES = 30
+
+
+@dataclass(frozen=True)
+class TestSpectra:
+    """Numbered modal frequencies picked from one test's record.
+
+    Attributes
+    ----------
+    name, record : test name and record path
+    modes, frequencies, uncertainty : assigned peaks, ordered by mode (Hz)
+    damping : damping ratios (NaN where not estimated)
+    channels : per mode, the channels in which the peak was seen
+    doubtful : per mode, True where the mode number is doubtful
+    unassigned : (frequency, uncertainty) of peaks left without a number
+    dropped : (channel, reason) removed when the record was read
+    peaks, numbering : the full intermediate results (for plots)
+    """
+
+    __test__ = False
+
+    name: str
+    record: str
+    modes: tuple[int, ...]
+    frequencies: np.ndarray
+    uncertainty: np.ndarray
+    damping: np.ndarray
+    channels: tuple[tuple[str, ...], ...]
+    doubtful: tuple[bool, ...]
+    unassigned: tuple[tuple[float, float], ...]
+    dropped: tuple[tuple[str, str], ...]
+    peaks: PeakResult
+    numbering: Numbering
+
+    def to_dataframe(self) -> pd.DataFrame:
+        return pd.DataFrame({
+            "mode": self.modes, "frequency_Hz": self.frequencies, "uncertainty_Hz": self.uncertainty,
+            "damping": self.damping, "doubtful": self.doubtful,
+            "channels": [" ".join(c) for c in self.channels],
+        })
+
+    def summary(self) -> dict:
+        return {
+            "name": self.name, "record": self.record, "kind": self.peaks.kind, "modes": list(self.modes),
+            "frequencies": [float(x) for x in self.frequencies],
+            "uncertainty": [float(x) for x in self.uncertainty],
+            "damping": [None if math.isnan(x) else float(x) for x in self.damping],
+            "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
+            "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
+            "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
+        }
+
+
+def record_path(campaign: Campaign, test: Test) -> str:
+    """The record's path, relative paths taken from the campaign directory."""
+    if os.path.isabs(test.record) or campaign.directory is None:
+        return test.record
+    return os.path.join(campaign.directory, test.record)
+
+
+def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
+                 tension_model: str = "uniform") -> TestSpectra:
+    """Pick and number the modal frequencies of one test's record."""
+    path = record_path(campaign, test)
+    record = read_record(path)
+    cable = campaign.cable
+    atts = campaign.setup(test.setup).attachments
+    check_positions(record, cable.length, file=path)
+    nominal = natural_frequencies(cable, atts, test.tension, max_modes, tension_model=tension_model)
+    check_duration(record, nominal[0] / 1.5, file=path)  # a few periods of mode 1, with margin for a 15 % error
+    f_max = min(0.45 * record.sampling_rate, 1.3 * nominal[-1])
+    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max)
+    freqs = np.array([p.frequency for p in result.peaks])
+    unc = np.array([p.uncertainty for p in result.peaks])
+    numbering = number_modes(freqs, unc, cable, atts, test.tension, tension_model=tension_model)
+    order = [i for i in np.argsort(numbering.modes) if numbering.modes[i] > 0]
+    peaks = result.peaks
+    return TestSpectra(
+        name=test.name, record=path,
+        modes=tuple(int(numbering.modes[i]) for i in order),
+        frequencies=freqs[order], uncertainty=unc[order],
+        damping=np.array([np.nan if peaks[i].damping is None else peaks[i].damping for i in order]),
+        channels=tuple(tuple(peaks[i].channels) for i in order),
+        doubtful=tuple(bool(numbering.doubtful[i]) for i in order),
+        unassigned=tuple((float(freqs[i]), float(unc[i])) for i in range(len(peaks)) if numbering.modes[i] == 0),
+        dropped=tuple(record.dropped), peaks=result, numbering=numbering,
+    )
+
+
+def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, progress=None,
+                     tension_model: str = "uniform") -> list[TestSpectra]:
+    """:func:`analyse_test` for every selected test that has a record."""
+    selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
+    with_record = [t for t in selected if t.record is not None]
+    out = []
+    for k, test in enumerate(with_record, 1):
+        if progress is not None:
+            progress(f"spectra: test {test.name} ({k} of {len(with_record)})")
+        out.append(analyse_test(campaign, test, tension_model=tension_model))
+    return out
