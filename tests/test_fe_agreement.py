@@ -17,6 +17,7 @@ from random_cables import random_configuration
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies, fe_modes
 from stcs_ident.forward.shapes import modal_masses, mode_shapes
+from stcs_ident.model import Attachment, Cable
 
 N_CONFIGS = 200
 N_MODES = 12
@@ -72,3 +73,23 @@ def test_mode_shapes_are_mass_orthogonal_and_match_finite_elements():
                 continue
             mac = (phi[:, k] @ disp[:, k]) ** 2 / ((phi[:, k] @ phi[:, k]) * (disp[:, k] @ disp[:, k]))
             assert mac > 0.9999
+
+
+@pytest.mark.parametrize("EI,atts", [(1e4, []), (0.0, [Attachment("M", 10.0, 5.0)]),
+                                      (0.0, [Attachment(f"M{i}", 5.0 * i, 8.0) for i in (1, 2, 3)])])
+def test_mode_shapes_when_every_node_is_at_rest(EI, atts):
+    """A bare clamped cable has no nodal unknowns; a string with a mass at
+    midspan (or equal spacing) has modes whose nodes are all at rest. The
+    shapes are still found, mass-orthogonal, and equal to sin(kπx/l) for
+    the taut-string modes that the masses do not see."""
+    cable = Cable(length=20.0, mass_per_length=10.0, EI=EI)
+    shapes = mode_shapes(cable, atts, 1e5, 6)
+    np.testing.assert_allclose(modal_masses(shapes, cable, atts), np.eye(6), atol=1e-8, rtol=0)
+    if EI == 0:
+        x = np.linspace(0, 20, 41)
+        k = 2 if len(atts) == 1 else 4  # a mode with nodes at every attachment
+        f_k = k / 40 * np.sqrt(1e5 / 10)
+        i = int(np.argmin(np.abs(shapes.frequencies - f_k)))
+        phi = shapes(x)[:, i]
+        exact = np.sin(k * np.pi * x / 20) * np.sqrt(2 / (10 * 20))
+        assert np.allclose(phi, exact, atol=1e-9) or np.allclose(phi, -exact, atol=1e-9)

@@ -84,7 +84,40 @@ class ModeShapes:
 
 def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
                 tension_model: str = "uniform") -> ModeShapes:
-    """Natural frequencies and mass-normalised mode shapes of one configuration."""
+    """Natural frequencies and mass-normalised mode shapes of one configuration.
+
+    A mode whose nodes are all at rest (a bare clamped cable without
+    sag-extensibility has no nodal unknowns at all; a string with a mass at
+    midspan has its antisymmetric modes so) is invisible to the nodal
+    values. Such a configuration is solved again with a null attachment
+    (no mass, no spring: it changes no frequency or shape) at an irrational
+    fraction of the span, where no such node falls.
+    """
+    try:
+        return _mode_shapes(cable, attachments, tension, n_modes, tension_model)
+    except _NodesAtRest:
+        node = _null_node(cable.length, attachments)
+        shapes = _mode_shapes(cable, (*attachments, node), tension, n_modes, tension_model)
+        return shapes
+
+
+class _NodesAtRest(ComputationError):
+    pass
+
+
+def _null_node(length: float, attachments: Sequence[Attachment]) -> Attachment:
+    """A null attachment at an irrational fraction of the span, the candidate
+    farthest from the existing attachments."""
+    candidates = length * np.array([0.381966011250105, 0.618033988749895, 0.292893218813452,
+                                    0.707106781186548, 0.414213562373095, 0.585786437626905])
+    taken = np.array([a.position for a in attachments])
+    if taken.size:
+        gaps = np.min(np.abs(candidates[:, None] - taken[None, :]), axis=1)
+        return Attachment("(null node)", float(candidates[np.argmax(gaps)]))
+    return Attachment("(null node)", float(candidates[0]))
+
+
+def _mode_shapes(cable, attachments, tension, n_modes, tension_model) -> ModeShapes:
     atts = sorted(attachments, key=lambda a: a.position)
     freqs = natural_frequencies(cable, atts, tension, n_modes, tension_model=tension_model)
     _, [(batch, _)] = build_batch(cable, atts, float(tension), tension_model=tension_model)
@@ -97,12 +130,14 @@ def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float,
         seg = batch.segments(idx, omega)
         K, _ = batch.assemble(idx, omega, segments=seg)
         s = batch._scale[0]
+        if batch.n_dof == 0:
+            raise _NodesAtRest("no nodal unknowns")
         lam, vec = np.linalg.eigh(K[0] * s[:, None] * s[None, :])
         order = np.argsort(np.abs(lam))
-        if len(lam) > 1 and abs(lam[order[0]]) > 1e-6 * abs(lam[order[1]]):
+        if len(lam) == 1 or abs(lam[order[0]]) > 1e-6 * abs(lam[order[1]]):
             # K(ω_k) is regular: the mode lives inside segments whose clamped
             # frequency equals ω_k (nodes at rest), beyond nodal values
-            raise ComputationError(
+            raise _NodesAtRest(
                 f"mode at {f:.6g} Hz coincides with a clamped-segment frequency; "
                 "its shape is not defined by the nodal values"
             )

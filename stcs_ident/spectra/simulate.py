@@ -1,0 +1,297 @@
+"""Acceleration records from the forward model, by modal superposition.
+
+The modes are the exact dynamic-stiffness model's natural frequencies and
+mass-normalised shapes (:func:`~stcs_ident.forward.shapes.mode_shapes`).
+Each modal coordinate obeys q̈ + 2ζω q̇ + ω² q = φᵀF(t) and a sensor at x
+reads Σ_k φ_k(x) q̈_k(t). Nothing is time-stepped approximately:
+
+- an impulse J at x₀ and t₀ starts each mode with q̇_k = φ_k(x₀) J, and its
+  damped-sinusoid response is evaluated in closed form at the samples;
+- ambient pressure is held constant over each sampling interval
+  (zero-order hold, white up to the Nyquist frequency), and each mode is
+  advanced by its exact state-transition matrix. The record starts from a
+  state drawn from the stationary distribution, so it has no start-up
+  transient (the kernels are in :mod:`~stcs_ident.spectra.modal_response`).
+
+All modes below 0.45 × the sampling rate are kept (or a given number), so
+a record has the realistic content of a band-limited sensor. Hidden
+effects (:class:`~stcs_ident.spectra.effects.Effects`) act on the true
+model only. :func:`~stcs_ident.spectra.simulate_campaign.simulate_campaign`
+writes a whole campaign directory from them, for tests and benchmarks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..forward.dsm import count_below
+from ..forward.shapes import ModeShapes, mode_shapes
+from ..model import Attachment, Cable
+from .effects import Effects, true_model
+from .modal_response import matrix_sqrt, modal_force_covariance, superpose
+from .record import Record
+
+__all__ = [
+    "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "Effects", "Impulse", "modal_basis", "modal_damping",
+    "simulate_record", "true_model",
+]
+
+#: Modes are kept up to this fraction of the sampling rate (just below Nyquist).
+NYQUIST_FRACTION = 0.45
+#: Uncorrelated pressure: ``rms_pressure`` is the rms of its mean over this length (m).
+UNCORRELATED_LENGTH = 1.0
+
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """A hand or hammer blow: an impulse at one point of the cable.
+
+    Parameters
+    ----------
+    time : float
+        s from the start of the record (may be negative: a blow before it).
+    position : float
+        m from end A.
+    magnitude : float
+        N s, positive in the direction of sag.
+    """
+
+    time: float
+    position: float
+    magnitude: float
+
+    def __post_init__(self):
+        for name in ("time", "position", "magnitude"):
+            object.__setattr__(self, name, _finite(getattr(self, name), f"impulse.{name}"))
+
+
+@dataclass(frozen=True)
+class Ambient:
+    """Random pressure along the cable: Gaussian, white in time up to Nyquist.
+
+    Parameters
+    ----------
+    rms_pressure : float
+        N/m. With a correlation length, the pointwise rms; without one, the
+        rms of the pressure averaged over each metre of cable
+        (:data:`UNCORRELATED_LENGTH`), since a spatially white pressure has
+        no pointwise value.
+    correlation_length : float or None
+        m; spatial correlation exp(−|x − x'| / L). None: uncorrelated along
+        the cable, which loads every mode alike (∝ ∫φ_k²); a long L loads
+        mainly the symmetric modes (∝ (∫φ_k)²).
+    """
+
+    rms_pressure: float
+    correlation_length: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "rms_pressure", _finite(self.rms_pressure, "ambient.rms_pressure", positive=True))
+        if self.correlation_length is not None:
+            L = _finite(self.correlation_length, "ambient.correlation_length", positive=True)
+            object.__setattr__(self, "correlation_length", L)
+
+
+def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: float, positions: Sequence[float], *,
+                    duration: float, sampling_rate: float, damping: float | Sequence[float] = 0.005,
+                    impulses: Sequence[Impulse] = (), ambient: Ambient | None = None, snr_db: float | None = None,
+                    effects: Effects | None = None, n_modes: int | None = None,
+                    seed: int | np.random.SeedSequence | None = 0, channel_names: Sequence[str] | None = None,
+                    progress: Progress | None = None) -> Record:
+    """Simulate a multi-channel acceleration record of one configuration.
+
+    Parameters
+    ----------
+    cable, attachments, tension :
+        The nominal configuration (tension in N); ``effects`` turn it into
+        the true one that vibrates.
+    positions : sequence of float
+        Sensor positions, m from end A, strictly inside the true span.
+    duration : float
+        s; the record has ``round(duration * sampling_rate)`` samples.
+    sampling_rate : float
+        Hz.
+    damping : float or sequence of float
+        Modal damping ratio(s), 0 < ζ < 1: one for all modes, or one per
+        mode from mode 1 (at least as many as modes simulated; extra
+        entries are ignored).
+    impulses : sequence of Impulse
+        Blows, evaluated exactly.
+    ambient : Ambient or None
+        Distributed random pressure. At least one excitation is needed.
+    snr_db : float or None
+        Sensor noise: white Gaussian, per channel with rms = the channel's
+        signal rms × 10^(−snr_db/20). None: noise-free.
+    effects : Effects or None
+        Hidden differences of the true model from the nominal one.
+    n_modes : int or None
+        Number of modes; default all below 0.45 × sampling rate. Every
+        mode must lie below the Nyquist frequency.
+    seed : int, SeedSequence or None
+        For ``np.random.default_rng``; the same seed gives the same record,
+        and the same signal with or without noise (noise is drawn last).
+    channel_names : sequence of str or None
+        Default ``"A1"``, ``"A2"``, ...
+    progress : callable(done, total), optional
+        Called after each block of samples.
+
+    Returns
+    -------
+    Record
+        Acceleration in m/s² at the sensors.
+
+    Raises
+    ------
+    ModelError
+        For an invalid option; the field names it.
+    """
+    fs, n_samples = _check_timing(duration, sampling_rate)
+    impulses = _check_impulses(impulses)
+    if snr_db is not None:
+        snr_db = _finite(snr_db, "snr_db")
+    if not impulses and ambient is None:
+        raise ModelError("no excitation: give impulses and/or ambient", field="excitation")
+    if ambient is not None and not isinstance(ambient, Ambient):
+        raise ModelError(f"must be an Ambient or None, got {type(ambient).__name__}", field="ambient")
+    cable, atts, tension = true_model(cable, attachments, tension, effects)
+    x = _check_positions(positions, cable.length, "positions")
+    for imp in impulses:
+        _check_positions([imp.position], cable.length, "impulse.position")
+    names = _channel_names(channel_names, len(x))
+    shapes = modal_basis(cable, atts, tension, fs, n_modes)
+    zeta = modal_damping(damping, len(shapes.frequencies))
+    rng = np.random.default_rng(seed)
+    force_sqrt = None
+    if ambient is not None:
+        cov = modal_force_covariance(shapes, ambient.rms_pressure, ambient.correlation_length, length=cable.length,
+                                     wave_speed=math.sqrt(tension / cable.mass_per_length),
+                                     uncorrelated_length=UNCORRELATED_LENGTH)
+        force_sqrt = matrix_sqrt(cov)
+    kicks = [(imp.time, shapes([imp.position])[0] * imp.magnitude) for imp in impulses]
+    clean = superpose(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng, progress)
+    return Record(_with_noise(clean, snr_db, rng), fs, names, x)
+
+
+def modal_basis(cable: Cable, attachments: Sequence[Attachment], tension: float, sampling_rate: float,
+                n_modes: int | None = None) -> ModeShapes:
+    """The modes a record at ``sampling_rate`` contains.
+
+    Parameters
+    ----------
+    cable, attachments, tension :
+        The configuration that vibrates (the true one).
+    sampling_rate : float
+        Hz.
+    n_modes : int or None
+        Default: all modes below ``NYQUIST_FRACTION × sampling_rate``.
+        Given, every one of them must lie below the Nyquist frequency.
+
+    Returns
+    -------
+    ModeShapes
+        Frequencies (Hz) and mass-normalised shapes.
+
+    Notes
+    -----
+    A massless, springless node is added at an irrational fraction of the
+    span, away from the attachments: the shapes come from the nodal values
+    of the dynamic stiffness, and without it a bare clamped cable has no
+    nodal unknowns, and a mode with a node at every attachment has none
+    that move. It changes no frequency or shape.
+    """
+    fs = float(sampling_rate)
+    if n_modes is None:
+        n = count_below(cable, attachments, tension, NYQUIST_FRACTION * fs)
+        if n == 0:
+            raise ModelError(f"no mode below {NYQUIST_FRACTION} x sampling rate ({fs:g} Hz): raise it",
+                             field="sampling_rate")
+    else:
+        if isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer) or n_modes < 1:
+            raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
+        n = int(n_modes)
+    shapes = mode_shapes(cable, attachments, tension, n)
+    if shapes.frequencies[-1] >= fs / 2:
+        raise ModelError(f"mode {n} at {shapes.frequencies[-1]:.4g} Hz is at or above the Nyquist frequency "
+                         f"({fs / 2:g} Hz) and would alias", field="n_modes")
+    return shapes
+
+
+def modal_damping(damping: float | Sequence[float], n_modes: int) -> np.ndarray:
+    """Damping ratios of the first ``n_modes`` modes, checked: 0 < ζ < 1."""
+    try:
+        values = np.atleast_1d(np.asarray(damping, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"must be a number or a sequence of numbers, got {damping!r}", field="damping") from None
+    if values.ndim != 1:
+        raise ModelError("must be a number or a sequence of numbers", field="damping")
+    if values.size == 1 and np.ndim(damping) == 0:
+        values = np.full(n_modes, values[0])
+    if values.size < n_modes:
+        raise ModelError(f"gives {values.size} ratios for {n_modes} modes", field="damping")
+    values = values[:n_modes]
+    if not np.all(np.isfinite(values) & (values > 0) & (values < 1)):
+        raise ModelError("ratios must satisfy 0 < damping < 1", field="damping")
+    return values
+
+
+def _with_noise(clean: np.ndarray, snr_db: float | None, rng: np.random.Generator) -> np.ndarray:
+    if snr_db is None:
+        return clean
+    noise_rms = np.sqrt(np.mean(clean**2, axis=0)) * 10 ** (-snr_db / 20)
+    return clean + rng.standard_normal(clean.shape) * noise_rms
+
+
+def _finite(value, name: str, *, positive: bool = False) -> float:
+    """``value`` as a float, refusing non-numbers, NaN and infinities (and <= 0 if ``positive``)."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ModelError(f"must be a number, got {value!r}", field=name)
+    v = float(value)
+    if not math.isfinite(v) or (positive and v <= 0):
+        raise ModelError(f"must be a finite number{' > 0' if positive else ''}, got {value!r}", field=name)
+    return v
+
+
+def _check_timing(duration, sampling_rate) -> tuple[float, int]:
+    duration = _finite(duration, "duration", positive=True)
+    fs = _finite(sampling_rate, "sampling_rate", positive=True)
+    n = round(duration * fs)
+    if n < 2:
+        raise ModelError(f"gives {n} samples at {fs:g} Hz: at least 2 needed", field="duration")
+    return fs, n
+
+
+def _check_impulses(impulses) -> tuple[Impulse, ...]:
+    out = tuple(impulses)
+    for imp in out:
+        if not isinstance(imp, Impulse):
+            raise ModelError(f"must hold Impulse objects, got {type(imp).__name__}", field="impulses")
+    return out
+
+
+def _check_positions(positions, length: float, name: str) -> np.ndarray:
+    try:
+        x = np.atleast_1d(np.asarray(positions, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"must be numbers (m), got {positions!r}", field=name) from None
+    if x.ndim != 1 or x.size == 0:
+        raise ModelError("must be a non-empty sequence of positions (m)", field=name)
+    bad = ~(np.isfinite(x) & (x > 0) & (x < length))
+    if bad.any():
+        raise ModelError(f"{x[bad][0]!r} m is outside the (true) span (0, {length:g}) m", field=name)
+    return x
+
+
+def _channel_names(names, n: int) -> tuple[str, ...]:
+    if names is None:
+        return tuple(f"A{i + 1}" for i in range(n))
+    names = tuple(str(s) for s in names)
+    if len(names) != n:
+        raise ModelError(f"gives {len(names)} names for {n} positions", field="channel_names")
+    return names

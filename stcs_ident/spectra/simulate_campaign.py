@@ -1,0 +1,231 @@
+"""A whole simulated campaign directory, for tests and benchmarks.
+
+:func:`simulate_campaign` turns a nominal campaign into a campaign
+directory whose records come from a true model that may differ from it
+(:class:`~stcs_ident.spectra.effects.Effects`), and writes the truth
+beside it in ``truth.json`` for scoring identification and diagnosis.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import shutil
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..campaign_io import CAMPAIGN_FILE, campaign_to_toml
+from ..errors import ModelError
+from ..forward.dsm import natural_frequencies
+from ..model import Cable, Campaign, Test
+from .effects import Effects, true_model
+from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record
+
+__all__ = ["TRUTH_FILE", "simulate_campaign"]
+
+#: The file, beside ``campaign.toml``, that holds the true model.
+TRUTH_FILE = "truth.json"
+
+def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positions: Sequence[float],
+                      duration: float, sampling_rate: float, tests: Sequence[str] | None = None,
+                      damping: float | Sequence[float] = 0.005, impulses: Sequence[Impulse] = (),
+                      ambient: Ambient | None = None, snr_db: float | None = None,
+                      effects: Effects | Mapping[str, Effects] | None = None, n_modes: int | None = None,
+                      seed: int = 0, channel_names: Sequence[str] | None = None, overwrite: bool = False,
+                      progress: Progress | None = None) -> Path:
+    """Write a campaign directory whose records come from a (hidden) true model.
+
+    ``out_dir`` gets ``records/<test>.h5`` for each selected test,
+    ``campaign.toml`` describing the **nominal** campaign only (its cable,
+    setups and the selected tests, each with ``record`` and without
+    ``frequencies``), and ``truth.json`` with the true parameters and
+    natural frequencies per test (not referenced by the campaign). The
+    directory appears whole or not at all: it is built beside ``out_dir``
+    under a temporary name, then renamed.
+
+    Parameters
+    ----------
+    campaign : Campaign
+        The nominal campaign.
+    out_dir : path-like
+        Must not exist, or be empty, unless ``overwrite``.
+    positions, duration, sampling_rate, damping, impulses, ambient, snr_db, n_modes, channel_names :
+        As for :func:`simulate_record`, the same for every test.
+    tests : sequence of str, optional
+        Test names; default all.
+    effects : Effects or mapping of test name to Effects, optional
+        Hidden effects, for all tests or per test (tests not in the
+        mapping get none).
+    seed : int
+        Each test gets its own stream, spawned from ``SeedSequence(seed)``.
+    overwrite : bool
+        Replace an existing non-empty ``out_dir`` (as a whole).
+    progress : callable(done, total), optional
+        Called after each test with the number of tests done.
+
+    Returns
+    -------
+    Path
+        ``out_dir``.
+
+    Raises
+    ------
+    FileExistsError
+        If ``out_dir`` is a non-empty directory (or a file) and not ``overwrite``.
+    ModelError
+        For an invalid option or an unknown test name.
+    """
+    out = Path(out_dir)
+    _check_target(out, overwrite)
+    selected = _select_tests(campaign, tests)
+    per_test = _effects_per_test(effects, selected)
+    stems = _record_stems([t.name for t in selected])
+    streams = np.random.SeedSequence(seed).spawn(len(selected))
+    options = {"duration": duration, "sampling_rate": sampling_rate, "damping": damping,
+               "impulses": tuple(impulses), "ambient": ambient, "snr_db": snr_db, "n_modes": n_modes,
+               "channel_names": channel_names}
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    try:
+        os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; give the mode a plain mkdir would
+        (tmp / "records").mkdir()
+        nominal_tests, truth_tests = [], []
+        for i, (test, stem) in enumerate(zip(selected, stems)):
+            rel = f"records/{stem}.h5"
+            truth_tests.append(_simulate_test(campaign, test, tmp / rel, positions, per_test[test.name],
+                                              streams[i], options))
+            truth_tests[-1]["record"] = rel
+            nominal_tests.append(replace(test, frequencies=None, modes=None, reference=(), record=rel))
+            if progress is not None:
+                progress(i + 1, len(selected))
+        nominal = replace(campaign, tests=tuple(nominal_tests), directory=None)
+        header = f"Simulated by stcs_ident.spectra.simulate_campaign; the true model is in {TRUTH_FILE}."
+        (tmp / CAMPAIGN_FILE).write_text(campaign_to_toml(nominal, header=header), encoding="utf-8")
+        truth = {"campaign": campaign.name, "options": _options_json(positions, seed, options), "tests": truth_tests}
+        (tmp / TRUTH_FILE).write_text(json.dumps(truth, indent=2) + "\n", encoding="utf-8")
+        _install(tmp, out, overwrite)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
+
+
+def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effects: Effects | None,
+                   stream: np.random.SeedSequence, options: dict) -> dict:
+    from .io import write_record  # lazily: h5py only when files are written
+
+    attachments = campaign.setup(test.setup).attachments
+    record = simulate_record(campaign.cable, attachments, test.tension, positions, effects=effects, seed=stream,
+                             **options)
+    write_record(record, path)
+    cable, atts, tension = true_model(campaign.cable, attachments, test.tension, effects)
+    shapes = modal_basis(cable, atts, tension, options["sampling_rate"], options["n_modes"])
+    n = len(shapes.frequencies)
+    return {
+        "name": test.name, "setup": test.setup, "stated_tension": test.tension, "tension": tension,
+        "effects": effects.to_dict() if effects else {}, "effect_names": effects.names if effects else [],
+        "cable": _cable_json(cable),
+        "attachments": [{"name": a.name, "position": a.position, "mass": a.mass, "stiffness": a.stiffness}
+                        for a in atts],
+        "modes": list(range(1, n + 1)),
+        "frequencies": [float(f) for f in shapes.frequencies],
+        "nominal_frequencies": [float(f) for f in natural_frequencies(campaign.cable, attachments, test.tension, n)],
+        "damping": [float(z) for z in modal_damping(options["damping"], n)],
+    }
+
+
+def _cable_json(cable: Cable) -> dict:
+    def end(b):
+        return b.kind if b.kind != "spring" else b.rotational_stiffness
+
+    return {"length": cable.length, "mass_per_length": cable.mass_per_length, "EI": cable.EI, "EA": cable.EA,
+            "inclination_deg": math.degrees(cable.inclination), "gravity": cable.gravity,
+            "boundary": [end(cable.boundary_a), end(cable.boundary_b)]}
+
+
+def _options_json(positions, seed: int, options: dict) -> dict:
+    ambient = options["ambient"]
+    return {
+        "positions": [float(x) for x in np.atleast_1d(positions)], "seed": seed,
+        "duration": float(options["duration"]), "sampling_rate": float(options["sampling_rate"]),
+        "impulses": [{"time": i.time, "position": i.position, "magnitude": i.magnitude} for i in options["impulses"]],
+        "ambient": None if ambient is None else {"rms_pressure": ambient.rms_pressure,
+                                                 "correlation_length": ambient.correlation_length},
+        "snr_db": None if options["snr_db"] is None else float(options["snr_db"]), "n_modes": None if options["n_modes"] is None else int(options["n_modes"]),
+    }
+
+
+def _select_tests(campaign: Campaign, names: Sequence[str] | None) -> list[Test]:
+    if names is None:
+        names = [t.name for t in campaign.tests]
+    elif isinstance(names, str):
+        names = [names]
+    known = {t.name for t in campaign.tests}
+    for name in names:
+        if name not in known:
+            raise ModelError(f"names no test of the campaign (known: {sorted(known)})", field=f"tests[{name}]")
+    if not names:
+        raise ModelError("no test to simulate", field="tests")
+    return [campaign.test(name) for name in dict.fromkeys(names)]
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _effects_per_test(effects, tests: list[Test]) -> dict[str, Effects | None]:
+    if effects is None or isinstance(effects, Effects):
+        return {t.name: effects for t in tests}
+    if not isinstance(effects, Mapping):
+        raise ModelError("must be an Effects, a mapping of test name to Effects, or None", field="effects")
+    unknown = set(effects) - {t.name for t in tests}
+    if unknown:
+        raise ModelError(f"names tests not simulated: {sorted(unknown)}", field="effects")
+    return {t.name: effects.get(t.name) for t in tests}
+
+
+def _record_stems(names: list[str]) -> list[str]:
+    """File names for test names: unsafe characters become '_'; collisions get a suffix."""
+    stems, seen = [], set()
+    for name in names:
+        stem = re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".") or "test"
+        base, k = stem, 2
+        while stem.lower() in seen:
+            stem, k = f"{base}-{k}", k + 1
+        seen.add(stem.lower())
+        stems.append(stem)
+    return stems
+
+
+def _check_target(out: Path, overwrite: bool) -> None:
+    if out.exists() and not out.is_dir():
+        raise FileExistsError(f"{out}: exists and is not a directory")
+    if out.is_dir() and any(out.iterdir()) and not overwrite:
+        raise FileExistsError(f"{out}: directory exists and is not empty (pass overwrite=True to replace it)")
+
+
+def _install(tmp: Path, out: Path, overwrite: bool) -> None:
+    """Rename the finished ``tmp`` to ``out``; an old ``out`` is replaced only once the new one is complete."""
+    _check_target(out, overwrite)
+    if out.is_dir() and not any(out.iterdir()):
+        out.rmdir()
+    if not out.exists():
+        os.replace(tmp, out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+    os.replace(out, old / "previous")
+    try:
+        os.replace(tmp, out)
+    except BaseException:
+        os.replace(old / "previous", out)
+        raise
+    finally:
+        shutil.rmtree(old, ignore_errors=True)
