@@ -33,7 +33,92 @@ def _parser() -> argparse.ArgumentParser:
     spe.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
     spe.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    _simulate_parser(sub)
     return parser
+
+
+def _simulate_parser(sub) -> None:
+    sim = sub.add_parser("simulate", help="simulated records of a campaign's tests, with optional hidden effects",
+                         description="Writes OUT/campaign.toml (the nominal cable only), OUT/records/<test>.h5 "
+                                     "and OUT/truth.json (the true model and frequencies).")
+    sim.add_argument("campaign", help="campaign directory or its campaign.toml")
+    sim.add_argument("--out", required=True, metavar="DIR", help="output directory (new or empty)")
+    sim.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+    sim.add_argument("--sensors", default="0.23,0.5,0.71", metavar="X,...",
+                     help="sensor positions as fractions of the length (default 0.23,0.5,0.71)")
+    sim.add_argument("--duration", type=float, default=60.0, metavar="S", help="record length, s (default 60)")
+    sim.add_argument("--sampling-rate", type=float, default=200.0, metavar="HZ", help="default 200 Hz")
+    sim.add_argument("--damping", type=float, default=0.005, metavar="ZETA", help="modal damping ratio (0.005)")
+    sim.add_argument("--impulses", type=int, default=1, metavar="N",
+                     help="hand-excitation events, N s apart from t = 1 s (default 1; 0 for none)")
+    sim.add_argument("--ambient", type=float, default=None, metavar="PA",
+                     help="ambient random pressure, RMS N/m per metre (default off)")
+    sim.add_argument("--snr", type=float, default=30.0, metavar="DB", help="sensor noise, dB (default 30)")
+    sim.add_argument("--seed", type=int, default=0)
+    sim.add_argument("--overwrite", action="store_true", help="replace a non-empty output directory")
+    eff = sim.add_argument_group("hidden effects (in the records, not in the written campaign)")
+    eff.add_argument("--tension-ratio", type=float, metavar="R")
+    eff.add_argument("--EI-ratio", type=float, metavar="R")
+    eff.add_argument("--length-ratio", type=float, metavar="R")
+    eff.add_argument("--end-stiffness", metavar="KA,KB", help="rotational end stiffness, N m/rad ('inf' clamped)")
+    eff.add_argument("--extra-mass", metavar="KG@X", help="an unmodelled point mass at X m")
+    eff.add_argument("--extra-spring", metavar="K@X", help="an unmodelled transverse spring (N/m) at X m")
+    eff.add_argument("--move", action="append", metavar="NAME@X", help="an attachment truly at X m (repeatable)")
+    sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+
+
+def _pair(text, option, sep):
+    try:
+        a, b = text.split(sep)
+        return a, float(b)
+    except ValueError:
+        raise InputError(f"expected VALUE{sep}VALUE, got {text!r}", field=option) from None
+
+
+def _simulate(args) -> int:
+    from .campaign_io import load_campaign
+    from .spectra.effects import Effects
+    from .spectra.simulate import Ambient, Impulse
+    from .spectra.simulate_campaign import simulate_campaign
+
+    campaign = load_campaign(args.campaign)
+    try:
+        fractions = [float(x) for x in args.sensors.split(",")]
+    except ValueError:
+        raise InputError(f"expected fractions like 0.2,0.5, got {args.sensors!r}", field="--sensors") from None
+    if not all(0 < x < 1 for x in fractions):
+        raise InputError("fractions of the length must lie in (0, 1)", field="--sensors")
+    length = campaign.cable.length
+    effects = {}
+    for name in ("tension_ratio", "EI_ratio", "length_ratio"):
+        if getattr(args, name) is not None:
+            effects[name] = getattr(args, name)
+    if args.end_stiffness:
+        effects["end_stiffness"] = tuple(float(v) for v in args.end_stiffness.split(","))
+    if args.extra_mass:
+        kg, x = _pair(args.extra_mass, "--extra-mass", "@")
+        effects["extra_mass"] = (float(kg), x)
+    if args.extra_spring:
+        k, x = _pair(args.extra_spring, "--extra-spring", "@")
+        effects["extra_spring"] = (float(k), x)
+    if args.move:
+        effects["attachment_positions"] = dict(_pair(m, "--move", "@") for m in args.move)
+    impulses = [Impulse(1.0 + i * max(args.duration / max(args.impulses, 1), 1.0), 0.17 * length, 50.0)
+                for i in range(args.impulses)]
+    ambient = Ambient(args.ambient) if args.ambient else None
+    if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
+        raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
+    try:
+        effect = Effects(**effects) if effects else None
+    except (TypeError, ValueError) as err:
+        raise InputError(str(err), field="effects") from None
+    out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions], duration=args.duration,
+                            sampling_rate=args.sampling_rate, tests=args.test, damping=args.damping,
+                            impulses=impulses, ambient=ambient, snr_db=args.snr, effects=effect, seed=args.seed,
+                            overwrite=args.overwrite,
+                            progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
+    print(f"wrote {out}")
+    return 0
 
 
 def _selected_tests(campaign, names, file):
@@ -127,7 +212,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     try:
-        return {"forward": _forward, "spectra": _spectra}[args.command](args)
+        return {"forward": _forward, "spectra": _spectra, "simulate": _simulate}[args.command](args)
     except InputError as err:
         if args.debug:
             traceback.print_exc()
