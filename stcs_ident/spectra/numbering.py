@@ -153,7 +153,7 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
     refined = {}
     for key, (t0, r0) in candidates.items():
         modes, cost, tr, er, family = _refine(f, sigma, np.array(key), t0, r0, cable, attachments, tension,
-                                              tension_model, n_modes)
+                                              tension_model, n_modes, tension_range, EI_range)
         if tuple(modes) not in refined or refined[tuple(modes)][0] > cost:
             refined[tuple(modes)] = (cost, tr, er, family)
     ranked = sorted(refined.items(), key=lambda kv: kv[1][0])
@@ -176,10 +176,13 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
     return result
 
 
-def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model, n_modes):
-    """Fit (tension, EI) ratios to the assigned peaks, re-assign, repeat."""
+def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model, n_modes, tension_range, EI_range):
+    """Fit (tension, EI) ratios to the assigned peaks (within the searched
+    ranges), re-assign, repeat."""
     fit_ei = cable.EI > 0
     x = np.log([t0, r0] if fit_ei else [t0])
+    lower = np.log([tension_range[0], EI_range[0]][: x.size])
+    upper = np.log([tension_range[1], EI_range[1]][: x.size])
     family = None
     for _ in range(3):
         assigned = modes > 0
@@ -190,7 +193,7 @@ def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model,
                 fam = _family(x, cable, attachments, tension, tension_model, n_modes)
                 return (f[assigned] - fam[idx]) / sigma[assigned]
 
-            x = least_squares(residual, x, method="lm", x_scale=0.1).x
+            x = least_squares(residual, np.clip(x, lower, upper), bounds=(lower, upper), x_scale=0.1).x
         family = _family(x, cable, attachments, tension, tension_model, n_modes)
         new_modes, cost = assign(f, sigma, family[None, :])
         if np.array_equal(new_modes[0], modes):

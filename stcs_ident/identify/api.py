@@ -1,0 +1,86 @@
+"""One entry point for both methods: :func:`identify`."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+
+from ..errors import InputError
+from ..model import Campaign
+from .parameters import parse_parameters
+from .problem import Problem, gather_measurements
+from .result import IdentificationResult
+
+METHODS = ("lsq", "contour")
+
+
+def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str | Iterable[str] = "tension,EI", *,
+             method: str = "lsq", picked: Mapping[str, object] | None = None,
+             bounds: Mapping[str, tuple[float, float]] | None = None, tension_model: str = "uniform",
+             scale_rule: str = "auto", **options) -> IdentificationResult:
+    """Correct uncertain model parameters from measured natural frequencies.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    tests : list of str, optional
+        Tests fitted together (default: every test with measured
+        frequencies or a record; the others are skipped and listed in
+        ``result.skipped``). A tension is one parameter per test; EI,
+        length, end stiffness and the attachments of a setup are shared.
+    params : str or iterable of str
+        Free parameters, e.g. ``"tension,EI"``, ``"position[W1]"``,
+        ``"tension,EI,position"`` (see
+        :func:`~stcs_ident.identify.parameters.parse_parameters`).
+    method : {"lsq", "contour"}
+        Weighted least squares (any number of parameters), or the source
+        paper's contour intersection (exactly two parameters).
+    picked : mapping, optional
+        {test: spectra or :class:`~stcs_ident.identify.problem.Measurement`}
+        replacing a test's table (its uncertainties become the weights).
+    bounds : mapping, optional
+        {parameter: (lower, upper)} in variable units.
+    tension_model : {"uniform", "per-segment", "none"}
+    scale_rule : {"auto", "birge", "never"}
+        When to scale the covariance by the reduced χ².
+    **options :
+        Passed to :func:`~stcs_ident.identify.lsq.fit_lsq` (``starts``,
+        ``n_starts``, ``max_nfev``, ``seed``) or
+        :func:`~stcs_ident.identify.contour.fit_contour` (``grid``,
+        ``ranges``).
+
+    Returns
+    -------
+    IdentificationResult
+
+    Raises
+    ------
+    InputError
+        Naming the field: ``method``, ``test``,
+        ``test[<name>].frequencies`` (a selected test with neither
+        frequencies nor a record), ``params`` (unknown name, fewer measured
+        frequencies than free parameters), ``bounds.<parameter>``.
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        When parameters are not identifiable from the data.
+    """
+    if method not in METHODS:
+        raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
+    measurements, skipped = gather_measurements(campaign, tests, picked)
+    parameters = parse_parameters(campaign, [m.test for m in measurements], params, bounds)
+    problem = Problem(campaign, measurements, parameters, tension_model)
+    if method == "lsq":
+        from .lsq import fit_lsq
+
+        result = fit_lsq(problem, scale_rule=scale_rule, **options)
+    else:
+        from .contour import fit_contour
+
+        result = fit_contour(problem, scale_rule=scale_rule, **options)
+    if skipped:
+        from dataclasses import replace
+
+        note = f"skipped (nothing to identify from): {', '.join(f'{n} ({r})' for n, r in skipped)}"
+        result = replace(result, skipped=tuple(skipped), notes=result.notes + (note,))
+    return result

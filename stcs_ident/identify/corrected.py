@@ -1,0 +1,40 @@
+"""The campaign with identified values in place of the nominal ones.
+
+Used to chain identifications the way the source paper does (tension and EI
+from the bare cable first, then the attachment positions of the loaded
+cable with those values), and by the diagnosis step to start from a
+corrected model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..model import Boundary, Campaign
+from .result import IdentificationResult
+
+
+def corrected_campaign(campaign: Campaign, result: IdentificationResult) -> Campaign:
+    """``campaign`` with every identified parameter set to its estimate.
+
+    Tensions replace the tests' measured tensions; EI, length and mass per
+    length the cable's; positions, masses and springs the attachments' of
+    their setup; an end fixity the boundary's rotational stiffness.
+    """
+    cable = campaign.cable
+    tests = {t.name: t for t in campaign.tests}
+    setups = {s.name: list(s.attachments) for s in campaign.setups}
+    for p, value in zip(result.parameters, result.values):
+        value = float(value)
+        if p.kind == "tension":
+            tests[p.member] = replace(tests[p.member], tension=value)
+        elif p.kind in ("EI", "length", "mass_per_length"):
+            cable = replace(cable, **{p.kind: value})
+        elif p.kind == "end_stiffness":
+            ends = {"A": ("boundary_a",), "B": ("boundary_b",), "AB": ("boundary_a", "boundary_b")}[p.member]
+            cable = replace(cable, **{end: Boundary(value) for end in ends})
+        else:
+            atts = setups[p.setup]
+            atts[p.index] = replace(atts[p.index], **{p.kind: value})
+    new_setups = tuple(replace(s, attachments=tuple(setups[s.name])) for s in campaign.setups)
+    return replace(campaign, cable=cable, setups=new_setups, tests=tuple(tests[t.name] for t in campaign.tests))

@@ -1,0 +1,236 @@
+"""Weighted least squares of any set of parameters over several tests at once.
+
+Minimises Σ ((f_model − f_measured)/σ)² over the free variables within
+their bounds (SciPy's trust-region reflective method, Jacobian by central
+differences in one batch call of the forward solver per test). Attachment
+positions make the problem multimodal (a mass and its mirror image give the
+same frequencies on a symmetric cable; two equal masses can trade places),
+so with position parameters the fit starts from the best points of a scan
+over the span as well as from the nominal values, and reports the other
+minima that fit as well. The covariance comes from the Jacobian at the
+estimate (:mod:`.uncertainty`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .problem import Problem
+from .result import IdentificationResult, TestFit
+from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability
+
+#: Candidate positions of the multi-start scan, as fractions of the length.
+SCAN_FRACTIONS = np.linspace(0.025, 0.975, 20)
+#: Two minima closer than this (in variable units) are one.
+SAME_POINT = 1e-5
+#: χ² difference (relative) below which two minima explain the data equally well.
+SAME_CHI2 = 1e-6
+
+_TOLERANCES = {"xtol": 1e-14, "ftol": 1e-14, "gtol": 1e-14}
+
+
+def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str = "auto",
+            max_nfev: int = 200, seed: int = 0) -> IdentificationResult:
+    """Least-squares estimate of the problem's parameters with their covariance.
+
+    Parameters
+    ----------
+    problem : Problem
+    starts : array of shape (k, p), optional
+        Starting points (variable units); default the nominal values, plus
+        the ``n_starts`` best points of a scan over the span when there are
+        position parameters.
+    n_starts : int
+        Extra starts from the scan (position parameters only).
+    scale_rule : {"auto", "birge", "never"}
+        When to scale the covariance by the reduced χ²
+        (:func:`~stcs_ident.identify.uncertainty.covariance_scale`).
+    max_nfev : int
+        Function evaluations per local fit.
+    seed : int
+        Seed of the scan's random candidates (three or more positions).
+
+    Returns
+    -------
+    IdentificationResult
+        ``method="lsq"``; ``uncertainty`` is one standard deviation.
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        Naming the parameters the data cannot determine.
+    """
+    starts = _starts(problem, n_starts, seed) if starts is None else np.atleast_2d(np.asarray(starts, float))
+    starts = np.clip(starts, problem.lower, problem.upper)
+    solutions = [_local_fit(problem, x0, max_nfev) for x0 in starts]
+    best = min(solutions, key=lambda s: s[1])[0]
+    solutions += [_local_fit(problem, m, max_nfev) for m in mirror_images(problem, best)]
+    x, chi2, alternatives, notes = _choose(problem, solutions)
+    return finish(problem, x, chi2, "lsq", scale_rule=scale_rule, alternatives=alternatives, notes=notes)
+
+
+def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_rule: str = "auto",
+           alternatives=(), notes=(), uncertainty=None, sweep=None, scale=None) -> IdentificationResult:
+    """Covariance, identifiability and the before/after fits at the estimate ``x``.
+
+    ``uncertainty`` replaces the standard deviations and ``scale`` the
+    covariance scale (the contour method passes its region's extent and the
+    scale it used); the covariance is still computed.
+    """
+    n, p = problem.n_data, len(problem.parameters)
+    dof = n - p
+    notes = list(notes)
+    if scale is None:
+        scale, scale_note = covariance_scale(chi2, dof, scale_rule)
+        if scale_note:
+            notes.insert(0, scale_note)
+    J = problem.jacobian(x)
+    cov, corr = covariance(J, scale)
+    sigma = np.sqrt(np.diag(cov))
+    span = problem.upper - problem.lower
+    at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
+                if min(v - lo, hi - v) <= 1e-9 * w]
+    if at_bound:
+        notes.append(f"at a bound (the standard deviation there is only indicative): {', '.join(at_bound)}")
+    notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper),
+                                  stacklevel=4)
+    before = problem.predict(problem.start)
+    after = problem.predict(x)
+    tests, k = [], 0
+    for m in problem.measurements:
+        sl = slice(k, k + m.modes.size)
+        k += m.modes.size
+        reference = {label: np.array([dict(zip(m.test.modes or (), values)).get(int(k), np.nan) for k in m.modes])
+                     for label, values in m.test.reference}
+        tests.append(TestFit(m.name, m.test.setup, tuple(int(v) for v in m.modes), m.frequencies, m.uncertainty,
+                             m.source, before[sl], after[sl], reference))
+    return IdentificationResult(
+        method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
+        uncertainty=sigma if uncertainty is None else np.asarray(uncertainty, float),
+        covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
+        covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
+    )
+
+
+def _local_fit(problem: Problem, x0: np.ndarray, max_nfev: int) -> tuple[np.ndarray, float]:
+    """One bounded trust-region fit from ``x0``: (x, χ²)."""
+    def residuals(x):
+        r = problem.residuals(x)
+        return np.where(np.isfinite(r), r, 1e8)
+
+    def jacobian(x):
+        J = problem.jacobian(x)
+        return np.where(np.isfinite(J), J, 0.0)
+
+    # Start strictly inside the bounds (the reflective method needs an interior point).
+    eps = 1e-10 * (problem.upper - problem.lower)
+    x0 = np.clip(x0, problem.lower + eps, problem.upper - eps)
+    res = least_squares(residuals, x0, jac=jacobian, bounds=(problem.lower, problem.upper), method="trf",
+                        x_scale="jac", max_nfev=max_nfev, **_TOLERANCES)
+    return res.x, float(2 * res.cost)
+
+
+def _starts(problem: Problem, n_starts: int, seed: int) -> np.ndarray:
+    """The nominal point, plus the best distinct points of a scan over the span for positions."""
+    start = problem.start
+    pos = [j for j, q in enumerate(problem.parameters) if q.kind == "position"]
+    if not pos or n_starts <= 0:
+        return start[None, :]
+    length = problem.campaign.cable.length
+    nominal = np.array([problem.parameters[j].nominal for j in pos])
+    if len(pos) <= 2:
+        grids = np.meshgrid(*([SCAN_FRACTIONS] * len(pos)), indexing="ij")
+        fractions = np.stack([g.ravel() for g in grids], axis=1)
+    else:
+        fractions = np.random.default_rng(seed).uniform(SCAN_FRACTIONS[0], SCAN_FRACTIONS[-1], (400, len(pos)))
+    candidates = np.repeat(start[None, :], len(fractions), axis=0)
+    candidates[:, pos] = fractions * length / nominal
+    candidates = np.clip(candidates, problem.lower, problem.upper)
+    chi2 = problem.chi2(candidates)
+    chosen = [start]
+    spacing = 1.5 * (SCAN_FRACTIONS[1] - SCAN_FRACTIONS[0]) * length
+    for i in np.argsort(chi2):
+        if not np.isfinite(chi2[i]) or len(chosen) > n_starts:
+            break
+        here = candidates[i, pos] * nominal
+        if all(np.linalg.norm(here - c[pos] * nominal) > spacing for c in chosen):
+            chosen.append(candidates[i])
+    return np.array(chosen)
+
+
+def mirror_images(problem: Problem, x: np.ndarray) -> list[np.ndarray]:
+    """Every combination of mirroring the free positions x → l − x of one or more setups.
+
+    On a symmetric cable they give the same frequencies; the fit is rerun
+    from each, so on an unsymmetric one they are just more starts.
+    """
+    groups: dict[str, list[int]] = {}
+    for j, q in enumerate(problem.parameters):
+        if q.kind == "position":
+            groups.setdefault(q.setup, []).append(j)
+    if not groups:
+        return []
+    length = problem.campaign.cable.length
+    out = []
+    for mask in itertools.product((False, True), repeat=len(groups)):
+        if not any(mask):
+            continue
+        m = np.array(x, float)
+        for flip, cols in zip(mask, groups.values()):
+            if flip:
+                for j in cols:
+                    q = problem.parameters[j]
+                    m[j] = (length - x[j] * q.nominal) / q.nominal
+        m = np.clip(m, problem.lower, problem.upper)
+        if not any(np.allclose(m, y, rtol=SAME_POINT, atol=0) for y in [x, *out]):
+            out.append(m)
+    return out
+
+
+def nearest_nominal(problem: Problem, candidates: list[np.ndarray]) -> list[np.ndarray]:
+    """Candidates ordered by distance from the nominal values (relative to the bounds); ties (a
+    mirror image of a midspan nominal) go to the smaller positions, that is to end A's half."""
+    width = problem.upper - problem.lower
+    pos = [j for j, q in enumerate(problem.parameters) if q.kind == "position"]
+
+    def key(x):
+        d = float(np.linalg.norm((x - problem.start) / width))
+        return (round(d, 6), tuple(round(float(x[j] * problem.parameters[j].nominal), 6) for j in pos))
+
+    return sorted(candidates, key=key)
+
+
+def _choose(problem: Problem, solutions: list[tuple[np.ndarray, float]]):
+    """Best minimum; among minima that fit equally well, the one nearest the nominal values.
+
+    Returns (x, χ², alternatives, notes).
+    """
+    distinct: list[tuple[np.ndarray, float]] = []
+    for x, c in sorted(solutions, key=lambda s: s[1]):
+        if not math.isfinite(c):
+            continue
+        if all(np.max(np.abs(x - y) / np.maximum(1.0, np.abs(y))) > SAME_POINT for y, _ in distinct):
+            distinct.append((x, c))
+    best_chi2 = distinct[0][1]
+    tol = SAME_CHI2 * max(best_chi2, 1.0)
+    equal = {id(x): (x, c) for x, c in distinct if c - best_chi2 <= tol}
+    order = nearest_nominal(problem, [x for x, _ in equal.values()])
+    x, chi2 = equal[id(order[0])]
+    alternatives = order[1:]
+    notes = []
+    names = problem.names
+    if alternatives:
+        shown = "; ".join(", ".join(f"{n} = {v:.6g}" for n, v in zip(names, a)) for a in alternatives)
+        notes.append(f"{len(alternatives)} other estimate(s) explain the data equally well (the one nearest the "
+                     f"nominal values is reported): {shown}")
+    # "almost as well": within one unit of χ² (scaled like the covariance when the misfit is large)
+    unit = max(1.0, best_chi2 / max(problem.n_data - len(names), 1))
+    close = [(y, c) for y, c in distinct if tol < c - best_chi2 < unit]
+    for y, c in close:
+        shown = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, y))
+        notes.append(f"another minimum fits almost as well (chi2 {c:.4g} against {best_chi2:.4g}): {shown}")
+    return x, chi2, alternatives, notes

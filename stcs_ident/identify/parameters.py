@@ -1,0 +1,389 @@
+"""Uncertain model parameters: what can be corrected, and how it enters the model.
+
+One :class:`Parameter` is one free number of an identification. It knows
+its kind (tension, EI, attachment position, ...), what it belongs to (a test
+for a tension, an attachment for a position, an end for a rotational
+stiffness), its nominal value, the dimensionless *variable* the optimiser
+and the contour grids work in, and how a value of that variable becomes an
+override of :func:`stcs_ident.forward.batch_frequencies`.
+
+The variable is the ratio to the nominal value (H̃/H, ẼI/EI, l̃_k/l_k), as
+in the source paper, except
+
+- an attachment mass or spring whose nominal value is zero: the variable is
+  then the value itself in kg or N/m;
+- an end's rotational stiffness k: the variable is the *fixity*
+  φ = k / (k + √(EI·H)), 0 for a pinned end and 1 for a clamped one. √(EI·H)
+  is the stiffness at which the end's boundary layer (length √(EI/H)) is
+  half restrained, so φ spreads the range that matters over [0, 1].
+
+:func:`parse_parameters` turns names such as ``"tension,EI"``,
+``"position[W1]"`` or ``"end_stiffness[A]"`` into parameters for the
+selected tests; the diagnosis step reuses it with the effect vocabulary of
+``interface.md`` (``bending_stiffness``, ``attachment_position``, ...).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import Campaign, Test
+
+#: Kinds of parameter, what they belong to and the override they change.
+KINDS = {
+    "tension": ("test", "tension"),
+    "EI": (None, "EI"),
+    "length": (None, "length"),
+    "mass_per_length": (None, "mass_per_length"),
+    "position": ("attachment", "positions"),
+    "mass": ("attachment", "masses"),
+    "stiffness": ("attachment", "stiffnesses"),
+    "end_stiffness": ("end", None),
+}
+
+#: Other names accepted for a kind (the effect vocabulary of ``interface.md``).
+ALIASES = {
+    "bending_stiffness": "EI",
+    "ei": "EI",
+    "attachment_position": "position",
+    "attachment_mass": "mass",
+    "attachment_stiffness": "stiffness",
+    "end_restraint": "end_stiffness",
+    "rotational_stiffness": "end_stiffness",
+}
+
+#: Default bounds of the variable (ratio unless stated in the module docstring).
+DEFAULT_BOUNDS = {
+    "tension": (0.5, 2.0),
+    "EI": (0.01, 100.0),
+    "length": (0.8, 1.2),
+    "mass_per_length": (0.5, 2.0),
+    "mass": (0.0, 10.0),
+    "stiffness": (0.0, 100.0),
+    "end_stiffness": (0.0, 1.0),
+}
+
+#: Positions stay this fraction of the length away from the anchorages.
+_POSITION_MARGIN = 1e-3
+
+_NAME = re.compile(r"^\s*([A-Za-z_]+?)(?:_ratio)?\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One free parameter of an identification.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    member : str or None
+        The test (tension), the attachment (``"W1"``, or ``"case2:W1"`` when
+        two setups of the selected tests have an attachment of that name),
+        the end (``"A"``, ``"B"`` or ``"AB"`` for both ends as one
+        parameter), or None for a cable property.
+    nominal : float
+        Nominal value in SI units (N, N m², m, kg, N/m, N m/rad).
+    scale : float
+        SI value of one unit of the variable: value = variable × scale.
+        Unused for ``end_stiffness``, whose variable is the fixity.
+    lower, upper : float
+        Bounds of the variable.
+    setup : str or None
+        The setup of an attachment parameter.
+    index : int or None
+        Place of the attachment in its setup (ascending position).
+    reference_stiffness : float
+        √(EI·H) (N m/rad) of the fixity of an ``end_stiffness`` parameter.
+    """
+
+    kind: str
+    member: str | None
+    nominal: float
+    scale: float
+    lower: float
+    upper: float
+    setup: str | None = None
+    index: int | None = None
+    reference_stiffness: float = 1.0
+
+    @property
+    def name(self) -> str:
+        """Display name: ``EI_ratio``, ``tension_ratio[case1-L4]``, ``end_fixity[A]``."""
+        return self.key if self.member is None else f"{self.key}[{self.member}]"
+
+    @property
+    def key(self) -> str:
+        """JSON key of the variable (``tension_ratio``, ``mass`` for a zero-nominal mass, ...)."""
+        if self.kind == "end_stiffness":
+            return "end_fixity"
+        return f"{self.kind}_ratio" if self.is_ratio else self.kind
+
+    @property
+    def is_ratio(self) -> bool:
+        """True when the variable is the ratio to the nominal value."""
+        return self.kind != "end_stiffness" and self.scale == self.nominal
+
+    @property
+    def start(self) -> float:
+        """The variable at the nominal value."""
+        if self.kind == "end_stiffness":
+            return fixity(self.nominal, self.reference_stiffness)
+        return self.nominal / self.scale
+
+    def to_value(self, variable):
+        """SI value(s) of the variable (array-friendly)."""
+        if self.kind == "end_stiffness":
+            return stiffness_of_fixity(variable, self.reference_stiffness)
+        return np.asarray(variable, float) * self.scale
+
+    def value_uncertainty(self, variable: float, sigma: float) -> float:
+        """Standard deviation in SI units, to first order (inf where the map is singular)."""
+        if self.kind != "end_stiffness":
+            return abs(sigma * self.scale)
+        if variable >= 1.0:
+            return math.inf
+        return abs(sigma) * self.reference_stiffness / (1.0 - variable) ** 2
+
+    def applies_to(self, test: Test) -> bool:
+        """Whether the parameter changes the model of ``test``."""
+        if self.kind == "tension":
+            return self.member == test.name
+        if KINDS[self.kind][0] == "attachment":
+            return self.setup == test.setup
+        return True
+
+
+def fixity(stiffness, reference: float):
+    """φ = k / (k + k_ref): 0 pinned, 1 clamped (k = inf)."""
+    k = np.asarray(stiffness, float)
+    with np.errstate(invalid="ignore"):
+        phi = np.where(np.isinf(k), 1.0, k / (k + reference))
+    return float(phi) if phi.ndim == 0 else phi
+
+
+def stiffness_of_fixity(phi, reference: float):
+    """k = k_ref φ / (1 − φ): the inverse of :func:`fixity` (inf at φ = 1)."""
+    phi = np.asarray(phi, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.where(phi >= 1.0, np.inf, reference * phi / (1.0 - phi))
+    return float(k) if k.ndim == 0 else k
+
+
+def _known_names() -> str:
+    return ", ".join([*KINDS, *ALIASES])
+
+
+def _split(spec: str | Iterable[str]) -> list[str]:
+    """``"tension,EI"`` or ``["tension", "EI"]`` → names; commas inside [] kept."""
+    items = [spec] if isinstance(spec, str) else list(spec)
+    out = []
+    for item in items:
+        if not isinstance(item, str):
+            raise InputError(f"parameter names must be strings, got {item!r}", field="params")
+        out += [part for part in re.split(r",(?![^\[]*\])", item) if part.strip()]
+    if not out:
+        raise InputError("no parameter named", field="params")
+    return out
+
+
+def parse_name(name: str) -> tuple[str, str | None]:
+    """``"position[W1]"`` → ``("position", "W1")``; aliases resolved, unknown names refused."""
+    match = _NAME.match(name)
+    kind = None
+    if match:
+        word = match.group(1)
+        kind = word if word in KINDS else ALIASES.get(word, ALIASES.get(word.lower()))
+        if kind is None and word.lower() in {k.lower() for k in KINDS}:
+            kind = next(k for k in KINDS if k.lower() == word.lower())
+    if kind is None:
+        raise InputError(f"unknown parameter {name.strip()!r}; known: {_known_names()}", field="params")
+    return kind, (match.group(2) or None)
+
+
+def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iterable[str] = "tension,EI",
+                     bounds: Mapping[str, tuple[float, float]] | None = None) -> tuple[Parameter, ...]:
+    """Free parameters named by ``spec`` for the selected ``tests``.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    tests : sequence of Test
+        The tests fitted together; a tension is one parameter per test,
+        everything else is shared (an attachment by all tests of its setup).
+    spec : str or iterable of str
+        Comma-separated names: ``tension``, ``EI``, ``length``,
+        ``mass_per_length``, ``position``, ``mass``, ``stiffness``,
+        ``end_stiffness`` (one fixity for both ends; ``end_stiffness[A]``,
+        ``end_stiffness[B]`` for one end each), or an alias from the effect
+        vocabulary (``bending_stiffness``, ``attachment_position``,
+        ``attachment_mass``, ``end_restraint``). A member in brackets
+        restricts a per-test or per-attachment kind: ``tension[case1-L4]``,
+        ``position[W1]``, ``position[case2:W1]``. A ``_ratio`` suffix is
+        accepted (``EI_ratio``).
+    bounds : mapping, optional
+        ``{name: (lower, upper)}`` in variable units (ratios; kg or N/m for a
+        zero-nominal mass or spring; fixity in [0, 1]), keyed by a kind
+        (``"EI"``, ``"position"``) or a display name
+        (``"position_ratio[W1]"``, ``"position[W1]"``).
+
+    Returns
+    -------
+    tuple of Parameter
+
+    Raises
+    ------
+    InputError
+        ``field="params"`` for an unknown name, a member that does not exist
+        or a parameter named twice; ``field="bounds.<name>"`` for bounds that
+        are not increasing or exclude the nominal value.
+    """
+    cable = campaign.cable
+    tension_scale = float(np.mean([t.tension for t in tests])) if tests else 1.0
+    k_ref = math.sqrt(max(cable.EI, 1e-12) * tension_scale)
+    params: list[Parameter] = []
+    for name in _split(spec):
+        kind, member = parse_name(name)
+        params += _expand(campaign, tests, kind, member, name.strip(), k_ref)
+    names = [p.name for p in params]
+    for n in names:
+        if names.count(n) > 1:
+            raise InputError(f"parameter {n} is named twice", field="params")
+    ends = {p.member for p in params if p.kind == "end_stiffness"}
+    if "AB" in ends and len(ends) > 1:
+        raise InputError("end_stiffness for both ends and for one end at once", field="params")
+    return tuple(_with_bounds(p, bounds or {}, cable.length) for p in params)
+
+
+def _expand(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
+            k_ref: float) -> list[Parameter]:
+    cable = campaign.cable
+    lo, hi = DEFAULT_BOUNDS.get(kind, (0.0, 1.0))
+    if kind == "tension":
+        chosen = [t for t in tests if member is None or t.name == member]
+        if not chosen:
+            known = ", ".join(t.name for t in tests)
+            raise InputError(f"{name}: no selected test named {member!r} (selected: {known})", field="params")
+        return [Parameter("tension", t.name, t.tension, t.tension, lo, hi) for t in chosen]
+    if kind in ("EI", "length", "mass_per_length"):
+        if member is not None:
+            raise InputError(f"{name}: {kind} is a cable property and takes no [member]", field="params")
+        nominal = float(getattr(cable, kind))
+        if nominal <= 0:
+            raise InputError(f"{name}: the nominal {kind} is 0, so it has no ratio", field="params")
+        return [Parameter(kind, None, nominal, nominal, lo, hi)]
+    if kind == "end_stiffness":
+        ends = {"A": cable.boundary_a, "B": cable.boundary_b}
+        if member is None:
+            if cable.boundary_a != cable.boundary_b:
+                return [Parameter(kind, e, b.rotational_stiffness, 1.0, lo, hi, reference_stiffness=k_ref)
+                        for e, b in ends.items()]
+            return [Parameter(kind, "AB", cable.boundary_a.rotational_stiffness, 1.0, lo, hi,
+                              reference_stiffness=k_ref)]
+        end = member.upper()
+        if end not in ends:
+            raise InputError(f"{name}: the end must be A or B, got {member!r}", field="params")
+        return [Parameter(kind, end, ends[end].rotational_stiffness, 1.0, lo, hi, reference_stiffness=k_ref)]
+    return _attachment_parameters(campaign, tests, kind, member, name, (lo, hi))
+
+
+def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
+                           default: tuple[float, float]) -> list[Parameter]:
+    setups = list(dict.fromkeys(t.setup for t in tests))
+    found = [(s, i, a) for s in setups for i, a in enumerate(campaign.setup(s).attachments)]
+    if not found:
+        raise InputError(f"{name}: the setups of the selected tests have no attachment", field="params")
+    counts: dict[str, int] = {}
+    for _, _, a in found:
+        counts[a.name] = counts.get(a.name, 0) + 1
+    chosen = []
+    for s, i, a in found:
+        label = a.name if counts[a.name] == 1 else f"{s}:{a.name}"
+        if member is None or member in (a.name, f"{s}:{a.name}"):
+            chosen.append((s, i, a, label))
+    if not chosen:
+        known = ", ".join(dict.fromkeys(a.name for _, _, a in found))
+        raise InputError(f"{name}: no attachment {member!r} in the selected tests' setups (known: {known})",
+                         field="params")
+    out = []
+    cable = campaign.cable
+    for s, i, a, label in chosen:
+        nominal = {"position": a.position, "mass": a.mass, "stiffness": a.stiffness}[kind]
+        if kind == "position":
+            lo, hi = _POSITION_MARGIN * cable.length / nominal, (1 - _POSITION_MARGIN) * cable.length / nominal
+            out.append(Parameter(kind, label, nominal, nominal, lo, hi, setup=s, index=i))
+            continue
+        if nominal > 0:
+            out.append(Parameter(kind, label, nominal, nominal, *default, setup=s, index=i))
+            continue
+        # Zero nominal: the variable is the value itself, bounded by the cable's own scale.
+        if kind == "mass":
+            upper = cable.mass_per_length * cable.length
+        else:
+            upper = 100.0 * _mean_tension(campaign) / cable.length
+        out.append(Parameter(kind, label, 0.0, 1.0, 0.0, upper, setup=s, index=i))
+    return out
+
+
+def _mean_tension(campaign: Campaign) -> float:
+    return float(np.mean([t.tension for t in campaign.tests])) if campaign.tests else 1.0
+
+
+def _with_bounds(p: Parameter, bounds: Mapping[str, tuple[float, float]], length: float) -> Parameter:
+    """Apply a user bound (by display name first, then by kind) and check it."""
+    candidates = [p.name, f"{p.kind}[{p.member}]" if p.member else p.kind, p.key, p.kind]
+    given = next((bounds[c] for c in candidates if c in bounds), None)
+    lo, hi = (p.lower, p.upper) if given is None else given
+    field = f"bounds.{p.name}"
+    try:
+        lo, hi = float(lo), float(hi)
+    except (TypeError, ValueError):
+        raise InputError(f"must be two numbers (lower, upper), got {given!r}", field=field) from None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
+        raise InputError(f"must satisfy lower < upper (finite), got [{lo:g}, {hi:g}]", field=field)
+    if not lo <= p.start <= hi:
+        raise InputError(f"bounds [{lo:g}, {hi:g}] exclude the nominal value {p.start:g}", field=field)
+    if p.kind == "position":
+        lo = max(lo, _POSITION_MARGIN * length / p.nominal)
+        hi = min(hi, (1 - _POSITION_MARGIN) * length / p.nominal)
+    elif p.kind in ("EI", "tension", "length", "mass_per_length"):
+        if lo <= 0:
+            raise InputError(f"the lower bound must be > 0, got {lo:g}", field=field)
+    elif lo < 0:
+        raise InputError(f"the lower bound must be >= 0, got {lo:g}", field=field)
+    if p.kind == "end_stiffness" and hi > 1:
+        raise InputError(f"the fixity lies in [0, 1], got upper bound {hi:g}", field=field)
+    return Parameter(p.kind, p.member, p.nominal, p.scale, lo, hi, p.setup, p.index, p.reference_stiffness)
+
+
+def overrides_for(test: Test, parameters: Sequence[Parameter], X: np.ndarray, n_attachments: int,
+                  nominal_attachments: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Overrides of ``batch_frequencies`` for ``test`` at the variable rows ``X`` (k, p).
+
+    Only what a parameter of this test touches is overridden; ``tension`` is
+    always returned (shape (k,)).
+    """
+    k = X.shape[0]
+    out: dict[str, np.ndarray] = {"tension": np.full(k, test.tension)}
+    for j, p in enumerate(parameters):
+        if not p.applies_to(test):
+            continue
+        column = X[:, j]
+        slot = KINDS[p.kind][1]
+        if p.kind == "end_stiffness":
+            value = p.to_value(column)
+            for end in ("end_a", "end_b") if p.member == "AB" else ("end_a" if p.member == "A" else "end_b",):
+                out[end] = np.broadcast_to(value, (k,)).astype(float)
+        elif KINDS[p.kind][0] == "attachment":
+            if slot not in out:
+                out[slot] = np.tile(nominal_attachments[slot], (k, 1))
+            out[slot][:, p.index] = p.to_value(column)
+        else:
+            out[slot] = p.to_value(column) * np.ones(k)
+    return out

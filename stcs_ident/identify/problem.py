@@ -1,0 +1,278 @@
+"""The identification problem: measured frequencies, their uncertainties and the model.
+
+:class:`Measurement` holds one test's measured modes with a standard
+uncertainty per mode: from the spectra of a record, given by the caller,
+or, for a table of frequencies, the rounding of the table (a value printed
+to 0.01 Hz is uniform within ±0.005 Hz: standard uncertainty 0.01/√12 Hz).
+
+:class:`Problem` ties measurements and free parameters to the forward
+solver. :meth:`Problem.predict` evaluates the model at many parameter
+vectors in one vectorised call per test: the residuals, the Jacobian, the
+multi-start scan and the contour grids all go through it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, ModelError
+from ..forward import batch_frequencies
+from ..model import Campaign, Test
+from .parameters import KINDS, Parameter, overrides_for
+
+#: Relative step of the numerical Jacobian (the solver is accurate to 1e-12).
+JACOBIAN_STEP = 1e-6
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """Measured natural frequencies of one test.
+
+    Attributes
+    ----------
+    test : Test
+    modes : ndarray of int
+    frequencies : ndarray
+        Hz, ordered by ``modes``.
+    uncertainty : ndarray
+        Standard uncertainty of each frequency, Hz (> 0).
+    source : str
+        Where the uncertainty comes from: ``"spectra"``, ``"table rounding
+        (0.01 Hz / sqrt 12)"`` or ``"given"``.
+    """
+
+    test: Test
+    modes: np.ndarray
+    frequencies: np.ndarray
+    uncertainty: np.ndarray
+    source: str
+
+    def __post_init__(self):
+        where = f"test[{self.test.name}]"
+        modes = np.asarray(self.modes, int)
+        freqs = np.asarray(self.frequencies, float)
+        unc = np.broadcast_to(np.asarray(self.uncertainty, float), freqs.shape).copy()
+        if modes.ndim != 1 or modes.shape != freqs.shape or modes.size == 0:
+            raise InputError("modes and frequencies must be non-empty lists of one length", field=f"{where}.modes")
+        if np.any(modes < 1) or len(set(modes.tolist())) != modes.size:
+            raise InputError("mode numbers must be distinct integers >= 1", field=f"{where}.modes")
+        if not np.all(np.isfinite(freqs) & (freqs > 0)):
+            raise InputError("must be finite and > 0", field=f"{where}.frequencies")
+        if not np.all(np.isfinite(unc) & (unc > 0)):
+            raise InputError("frequency uncertainties must be finite and > 0", field=f"{where}.uncertainty")
+        order = np.argsort(modes)
+        object.__setattr__(self, "modes", modes[order])
+        object.__setattr__(self, "frequencies", freqs[order])
+        object.__setattr__(self, "uncertainty", unc[order])
+
+    @property
+    def name(self) -> str:
+        return self.test.name
+
+
+def printed_step(values: Sequence[float]) -> float:
+    """Resolution a list of numbers was printed with: 0.01 for (7.24, 44.4)."""
+    decimals = 0
+    for v in values:
+        text = repr(float(v))
+        if "e" in text or "E" in text:
+            mantissa, exponent = text.lower().split("e")
+            digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
+            decimals = max(decimals, digits - int(exponent))
+        elif "." in text:
+            decimals = max(decimals, len(text.split(".")[1].rstrip("0")))
+    return 10.0 ** (-decimals)
+
+
+def table_measurement(test: Test) -> Measurement:
+    """A test's tabulated frequencies, with the rounding of the table as uncertainty."""
+    step = printed_step(test.frequencies)
+    return Measurement(test, np.array(test.modes), np.array(test.frequencies), step / math.sqrt(12),
+                       f"table rounding ({step:g} Hz / sqrt 12)")
+
+
+def as_measurement(test: Test, picked) -> Measurement:
+    """A :class:`Measurement` from picked spectra (anything with ``modes``,
+    ``frequencies`` and ``uncertainty``, as :class:`~stcs_ident.spectra.pipeline.TestSpectra`)."""
+    if isinstance(picked, Measurement):
+        return picked
+    modes = getattr(picked, "modes", None)
+    freqs = getattr(picked, "frequencies", None)
+    unc = getattr(picked, "uncertainty", None)
+    if modes is None or freqs is None or unc is None:
+        raise InputError("picked frequencies need modes, frequencies and uncertainty", field=f"test[{test.name}]")
+    if len(modes) == 0:
+        raise InputError("no mode was picked from the record", field=f"test[{test.name}].record")
+    return Measurement(test, np.array(modes), np.array(freqs), np.array(unc), "spectra")
+
+
+def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
+                        picked: Mapping[str, object] | None = None) -> tuple[list[Measurement], list[tuple[str, str]]]:
+    """The measurements of the selected tests, and the tests skipped with why.
+
+    A test is measured by ``picked[name]`` when given (spectra or a
+    :class:`Measurement`), else by its table of frequencies, else by the
+    spectra of its record (computed here). A test with none of these is
+    skipped when all tests are used, and is an error when it was selected
+    by name.
+
+    Raises
+    ------
+    InputError
+        For a test name that does not exist, a selected test without
+        frequencies or record, or when no test is left.
+    """
+    picked = dict(picked or {})
+    known = [t.name for t in campaign.tests]
+    for name in list(tests or []) + list(picked):
+        if name not in known:
+            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="test")
+    selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
+    out, skipped = [], []
+    for test in selected:
+        if test.name in picked:
+            out.append(as_measurement(test, picked[test.name]))
+        elif test.frequencies is not None:
+            out.append(table_measurement(test))
+        elif test.record is not None:
+            from ..spectra.pipeline import analyse_test  # lazily: reads the record
+
+            out.append(as_measurement(test, analyse_test(campaign, test)))
+        elif tests:
+            raise InputError("has neither measured frequencies nor a record: nothing to identify from",
+                             field=f"test[{test.name}].frequencies")
+        else:
+            skipped.append((test.name, "no measured frequencies and no record"))
+    if not out:
+        raise InputError("no selected test has measured frequencies or a record", field="test")
+    return out, skipped
+
+
+class Problem:
+    """Measurements, free parameters and the forward model, evaluated in batches.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    measurements : list of Measurement
+    parameters : sequence of Parameter
+    tension_model : {"uniform", "per-segment", "none"}
+
+    Raises
+    ------
+    InputError
+        ``field="params"`` when there are fewer measured frequencies than
+        free parameters, or a parameter touches none of the tests.
+    """
+
+    def __init__(self, campaign: Campaign, measurements: Sequence[Measurement], parameters: Sequence[Parameter],
+                 tension_model: str = "uniform"):
+        self.campaign = campaign
+        self.measurements = list(measurements)
+        self.parameters = tuple(parameters)
+        self.tension_model = tension_model
+        n, p = self.n_data, len(self.parameters)
+        if p == 0:
+            raise InputError("no free parameter", field="params")
+        if n < p:
+            names = ", ".join(q.name for q in self.parameters)
+            raise InputError(f"{p} free parameters ({names}) but only {n} measured frequencies", field="params")
+        for q in self.parameters:
+            if not any(q.applies_to(m.test) for m in self.measurements):
+                raise InputError(f"{q.name} belongs to none of the selected tests", field="params")
+        self._atts = {m.name: campaign.setup(m.test.setup).attachments for m in self.measurements}
+        self._nominal_atts = {
+            name: {KINDS[k][1]: np.array([getattr(a, k) for a in atts], float)
+                   for k in ("position", "mass", "stiffness")}
+            for name, atts in self._atts.items()
+        }
+        self.measured = np.concatenate([m.frequencies for m in self.measurements])
+        self.sigma = np.concatenate([m.uncertainty for m in self.measurements])
+        self.lower = np.array([q.lower for q in self.parameters])
+        self.upper = np.array([q.upper for q in self.parameters])
+        self.start = np.array([q.start for q in self.parameters])
+
+    @property
+    def n_data(self) -> int:
+        return int(sum(m.modes.size for m in self.measurements))
+
+    @property
+    def names(self) -> list[str]:
+        return [q.name for q in self.parameters]
+
+    def predict(self, X) -> np.ndarray:
+        """Model frequencies of every measured mode at the variable rows ``X``.
+
+        Parameters
+        ----------
+        X : array of shape (k, p) or (p,)
+
+        Returns
+        -------
+        ndarray of shape (k, n_data) (or (n_data,)), Hz, tests in order and
+        modes as measured; NaN for a row the model cannot take (two
+        attachments at one place, an attachment outside the span).
+        """
+        X = np.asarray(X, float)
+        single = X.ndim == 1
+        X = np.atleast_2d(X)
+        out = []
+        cable = self.campaign.cable
+        for m in self.measurements:
+            ov = overrides_for(m.test, self.parameters, X, len(self._atts[m.name]), self._nominal_atts[m.name])
+            ok = _valid_rows(ov, cable.length, self._nominal_atts[m.name]["positions"])
+            f = np.full((X.shape[0], m.modes.size), np.nan)
+            if ok.any():
+                sub = {k: v[ok] for k, v in ov.items()}
+                tension = sub.pop("tension")
+                try:
+                    F = batch_frequencies(cable, self._atts[m.name], tension, int(m.modes.max()),
+                                          tension_model=self.tension_model, **sub)
+                except ModelError as err:
+                    raise InputError(f"the model refused a parameter value: {err.message}",
+                                     field=err.field) from err
+                f[ok] = F[:, m.modes - 1]
+            out.append(f)
+        F = np.concatenate(out, axis=1)
+        return F[0] if single else F
+
+    def residuals(self, x) -> np.ndarray:
+        """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""
+        return (self.predict(x) - self.measured) / self.sigma
+
+    def jacobian(self, x) -> np.ndarray:
+        """d residuals / d variables by central differences (one-sided at a bound), one batch."""
+        x = np.asarray(x, float)
+        p = x.size
+        h = JACOBIAN_STEP * np.maximum(np.abs(x), 1.0)
+        if any(q.kind == "end_stiffness" for q in self.parameters):
+            h = np.where([q.kind == "end_stiffness" for q in self.parameters], JACOBIAN_STEP, h)
+        up = np.minimum(x + h, self.upper)
+        down = np.maximum(x - h, self.lower)
+        rows = np.repeat(x[None, :], 2 * p, axis=0)
+        rows[np.arange(p), np.arange(p)] = up
+        rows[p + np.arange(p), np.arange(p)] = down
+        F = self.predict(rows)
+        J = (F[:p] - F[p:]) / (up - down)[:, None]
+        return J.T / self.sigma[:, None]
+
+    def chi2(self, X) -> np.ndarray:
+        """χ² at the rows of ``X`` (inf where the model is undefined)."""
+        r = (self.predict(np.atleast_2d(X)) - self.measured) / self.sigma
+        c = np.sum(r**2, axis=1)
+        return np.where(np.isfinite(c), c, np.inf)
+
+
+def _valid_rows(ov: dict[str, np.ndarray], length: float, nominal_positions: np.ndarray) -> np.ndarray:
+    """Rows whose attachments lie strictly inside the span, at distinct places."""
+    k = ov["tension"].shape[0]
+    pos = ov.get("positions", np.broadcast_to(nominal_positions, (k, nominal_positions.size)))
+    span = ov.get("length", np.full(k, length))
+    ok = np.all((pos > 0) & (pos < span[:, None]), axis=1)
+    if pos.shape[1] > 1:
+        ok &= np.all(np.diff(np.sort(pos, axis=1), axis=1) > 0, axis=1)
+    return ok

@@ -1,0 +1,258 @@
+"""Result objects of the identification step.
+
+:class:`IdentificationResult` is what :func:`~stcs_ident.identify.identify`
+returns for either method: the estimates in the dimensionless variables of
+the parameters (ratios to nominal, mostly) and in SI units, their
+uncertainties, and per test the measured frequencies before and after the
+correction (:class:`TestFit`). ``.summary()`` is the ``identify`` JSON of
+``interface.md`` plus optional keys; ``.to_dataframe()`` is the paper's
+Table 9/10 form.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .parameters import Parameter
+
+
+@dataclass(frozen=True)
+class TestFit:
+    """One test's measured frequencies against the model before and after correction.
+
+    Attributes
+    ----------
+    name, setup : str
+    modes : tuple of int
+    measured, uncertainty : ndarray
+        Hz; the standard uncertainty used as weight.
+    source : str
+        Where ``uncertainty`` comes from.
+    before, after : ndarray
+        Model frequencies (Hz) with the nominal and with the identified
+        parameters.
+    reference : dict of str to ndarray
+        Frequencies computed by others for the same modes (the test's
+        ``reference`` columns, e.g. the paper's own corrected values), NaN
+        where missing.
+    """
+
+    __test__ = False
+
+    name: str
+    setup: str
+    modes: tuple[int, ...]
+    measured: np.ndarray
+    uncertainty: np.ndarray
+    source: str
+    before: np.ndarray
+    after: np.ndarray
+    reference: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def reference_error(self, label: str) -> np.ndarray:
+        """(reference − measured) / measured × 100 for one reference column."""
+        return (self.reference[label] - self.measured) / self.measured * 100.0
+
+    @property
+    def before_error(self) -> np.ndarray:
+        """(before − measured) / measured × 100."""
+        return (self.before - self.measured) / self.measured * 100.0
+
+    @property
+    def after_error(self) -> np.ndarray:
+        """(after − measured) / measured × 100."""
+        return (self.after - self.measured) / self.measured * 100.0
+
+    @property
+    def rms_before(self) -> float:
+        """Root mean square of ``before_error``, %."""
+        return float(np.sqrt(np.mean(self.before_error**2)))
+
+    @property
+    def rms_after(self) -> float:
+        """Root mean square of ``after_error``, %."""
+        return float(np.sqrt(np.mean(self.after_error**2)))
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """Identified parameters with uncertainties, and the fit to every test.
+
+    Attributes
+    ----------
+    method : {"lsq", "contour"}
+    parameters : tuple of Parameter
+    estimate : ndarray
+        The identified variables (ratio to nominal for most kinds; see
+        :mod:`stcs_ident.identify.parameters`).
+    uncertainty : ndarray
+        lsq: one standard deviation from the covariance. contour: half the
+        extent of the intersection region along each axis.
+    covariance, correlation : ndarray or None
+        Of the variables (lsq only).
+    tests : tuple of TestFit
+    chi2 : float
+        Σ ((f_model − f_measured)/σ)² at the estimate.
+    dof : int
+        Measured frequencies minus free parameters.
+    covariance_scale : float
+        Factor applied to the covariance: the reduced χ² when the misfit is
+        larger than the stated uncertainties explain, else 1.
+    notes : tuple of str
+        Plain-language remarks (scaling, parameters at a bound, ambiguity,
+        not identifiable, ...).
+    skipped : tuple of (test, reason)
+    alternatives : tuple of ndarray
+        Other estimates that explain the data equally well (mirror images,
+        interchangeable attachments).
+    sweep : ContourSweep or None
+        The contour method's grids, surfaces and region (for figures).
+    """
+
+    method: str
+    parameters: tuple[Parameter, ...]
+    estimate: np.ndarray
+    uncertainty: np.ndarray
+    covariance: np.ndarray | None
+    correlation: np.ndarray | None
+    tests: tuple[TestFit, ...]
+    chi2: float
+    dof: int
+    covariance_scale: float = 1.0
+    notes: tuple[str, ...] = ()
+    skipped: tuple[tuple[str, str], ...] = ()
+    alternatives: tuple[np.ndarray, ...] = ()
+    sweep: object | None = field(default=None, repr=False)
+
+    @property
+    def names(self) -> list[str]:
+        return [p.name for p in self.parameters]
+
+    @property
+    def reduced_chi2(self) -> float:
+        """χ² / dof (NaN when dof is 0)."""
+        return self.chi2 / self.dof if self.dof > 0 else math.nan
+
+    @property
+    def values(self) -> np.ndarray:
+        """The estimates in SI units."""
+        return np.array([float(p.to_value(x)) for p, x in zip(self.parameters, self.estimate)])
+
+    @property
+    def value_uncertainty(self) -> np.ndarray:
+        """The uncertainties in SI units (first order)."""
+        return np.array([p.value_uncertainty(float(x), float(s))
+                         for p, x, s in zip(self.parameters, self.estimate, self.uncertainty)])
+
+    def get(self, name: str) -> tuple[float, float]:
+        """(estimate, uncertainty) of the parameter with this display name."""
+        i = self.names.index(name)
+        return float(self.estimate[i]), float(self.uncertainty[i])
+
+    def test(self, name: str) -> TestFit:
+        return next(t for t in self.tests if t.name == name)
+
+    @property
+    def rms_before(self) -> float:
+        """rms error (%) over every measured frequency, nominal model."""
+        return float(np.sqrt(np.mean(np.concatenate([t.before_error for t in self.tests]) ** 2)))
+
+    @property
+    def rms_after(self) -> float:
+        """rms error (%) over every measured frequency, corrected model."""
+        return float(np.sqrt(np.mean(np.concatenate([t.after_error for t in self.tests]) ** 2)))
+
+    def summary(self) -> dict:
+        """Plain data for JSON: the ``identify`` object of ``interface.md``, with extra keys.
+
+        Extra keys: ``values`` and ``value_uncertainty`` (SI units),
+        ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
+        ``reduced_chi2``, ``covariance_scale``, ``rms_error_before``,
+        ``rms_error_after`` (%), ``notes``, ``skipped``, ``alternatives``,
+        and per test ``uncertainty``, ``uncertainty_source`` and ``reference``
+        (frequencies computed by others, e.g. the paper's corrected values).
+        """
+        out = {
+            "method": self.method,
+            "parameters": _nest(self.parameters, self.estimate, by="key"),
+            "uncertainty": _nest(self.parameters, self.uncertainty, by="key"),
+            "uncertainty_kind": "one standard deviation" if self.method == "lsq"
+            else "half extent of the contours' intersection region",
+            "values": _nest(self.parameters, self.values, by="kind"),
+            "value_uncertainty": _nest(self.parameters, self.value_uncertainty, by="kind"),
+            "tests": [
+                {"name": t.name, "setup": t.setup, "modes": list(t.modes), "measured": _floats(t.measured),
+                 "before": _floats(t.before), "after": _floats(t.after),
+                 "before_error": _floats(t.before_error), "after_error": _floats(t.after_error),
+                 "uncertainty": _floats(t.uncertainty), "uncertainty_source": t.source,
+                 "reference": {k: _floats(v) for k, v in t.reference.items()}}
+                for t in self.tests
+            ],
+            "correlation": None if self.correlation is None else
+            {"parameters": self.names, "matrix": [_floats(row) for row in self.correlation]},
+            "chi2": _float(self.chi2),
+            "dof": self.dof,
+            "reduced_chi2": _float(self.reduced_chi2),
+            "covariance_scale": _float(self.covariance_scale),
+            "rms_error_before": _float(self.rms_before),
+            "rms_error_after": _float(self.rms_after),
+            "notes": list(self.notes),
+            "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
+            "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
+        }
+        return out
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Before/after table in the paper's Table 9/10 form (one row per test and mode)."""
+        from .tables import before_after_table
+
+        return before_after_table(self)
+
+    def to_csv(self, path) -> None:
+        """Write :meth:`to_dataframe` as CSV."""
+        from .tables import write_csv
+
+        write_csv(self, path)
+
+    def parameters_dataframe(self) -> pd.DataFrame:
+        """One row per parameter: nominal, estimate and uncertainty, as variable and in SI units."""
+        from .tables import parameters_table
+
+        return parameters_table(self)
+
+    def to_markdown(self) -> str:
+        """Parameters and before/after tables as Markdown."""
+        from .tables import result_markdown
+
+        return result_markdown(self)
+
+    def text(self) -> str:
+        """Parameters and before/after tables as plain text (the CLI's standard output)."""
+        from .tables import result_text
+
+        return result_text(self)
+
+
+def _float(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _floats(a) -> list:
+    return [_float(x) for x in np.asarray(a, float)]
+
+
+def _nest(parameters, values, by: str) -> dict:
+    """{key: value} for cable properties, {key: {member: value}} for per-member ones."""
+    out: dict = {}
+    for p, v in zip(parameters, values):
+        key = p.key if by == "key" else p.kind
+        if p.member is None:
+            out[key] = _float(v)
+        else:
+            out.setdefault(key, {})[p.member] = _float(v)
+    return out

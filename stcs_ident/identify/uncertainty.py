@@ -1,0 +1,137 @@
+"""Covariance from the Jacobian, its scaling, and the identifiability check.
+
+With weighted residuals r = (f_model − f_measured)/σ and their Jacobian J
+at the estimate, the covariance of the estimate is (JᵀJ)⁻¹ when the σ are
+right. Real data rarely fit a few-parameter model to within the stated σ
+(a table's rounding, say): then the covariance is multiplied by the reduced
+χ² (Birge ratio squared), which takes the scatter of the residuals as the
+measure of the frequencies' real uncertainty. By default this is done only
+when the misfit is significant (χ² above its 95 % quantile for the degrees
+of freedom): when the stated σ are right, an unconditional
+``max(1, χ²/dof)`` would widen the intervals in about half the data sets and
+make the 1σ intervals cover the truth ~72 % of the time instead of 68 %.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+from scipy import stats
+
+from ..errors import StcsWarning
+
+#: |correlation| above which two parameters are reported as not separately identifiable.
+CORRELATION_LIMIT = 0.995
+#: Condition number of the column-normalised Jacobian above which the fit is ill-conditioned.
+CONDITION_LIMIT = 1e3
+#: A column this small relative to the largest has no effect on the data.
+NO_EFFECT = 1e-9
+
+SCALE_RULES = ("auto", "birge", "never")
+
+
+class IdentifiabilityWarning(StcsWarning):
+    """Some parameters are not identifiable from the data; ``.parameters`` names them."""
+
+    def __init__(self, message: str, parameters: Sequence[str] = ()):
+        super().__init__(message)
+        self.parameters = tuple(parameters)
+
+
+def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, str | None]:
+    """Factor for the covariance and a note saying why it is applied.
+
+    Parameters
+    ----------
+    chi2 : float
+    dof : int
+    rule : {"auto", "birge", "never"}
+        ``auto``: scale by χ²/dof when χ² exceeds its 95 % quantile;
+        ``birge``: whenever χ²/dof > 1; ``never``.
+    """
+    if rule not in SCALE_RULES:
+        raise ValueError(f"scale rule must be one of {SCALE_RULES}, got {rule!r}")
+    if dof <= 0:
+        return 1.0, "no degrees of freedom left: the uncertainties rest on the stated frequency uncertainties alone"
+    reduced = chi2 / dof
+    significant = chi2 > stats.chi2.ppf(0.95, dof)
+    if rule == "never" or reduced <= 1 or (rule == "auto" and not significant):
+        return 1.0, None
+    return reduced, (f"the misfit is {np.sqrt(reduced):.3g} times the stated frequency uncertainties "
+                     f"(reduced chi2 {reduced:.3g}, {dof} degrees of freedom): the covariance is scaled by "
+                     "the reduced chi2")
+
+
+def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance (JᵀJ)⁻¹ × scale and the correlation matrix (pseudo-inverse: a
+    direction the data do not see gets infinite variance)."""
+    norms = np.linalg.norm(J, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    Jn = J / safe
+    _U, s, Vt = np.linalg.svd(Jn, full_matrices=False)
+    small = s <= NO_EFFECT * max(s.max(initial=0.0), 1e-300)
+    inv = np.where(small, 0.0, 1.0 / np.where(small, 1.0, s) ** 2)
+    cov_n = (Vt.T * inv) @ Vt
+    cov = cov_n / np.outer(safe, safe) * scale
+    blind = (norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)) | (np.abs(Vt[small]) > 0.1).any(axis=0)
+    for i in np.flatnonzero(blind):
+        cov[i, :] = np.nan
+        cov[:, i] = np.nan
+        cov[i, i] = np.inf
+    d = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(d, d)
+    np.fill_diagonal(corr, 1.0)
+    return cov, corr
+
+
+def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma: np.ndarray,
+                    lower: np.ndarray, upper: np.ndarray) -> list[tuple[str, tuple[str, ...]]]:
+    """Problems that make parameters not identifiable: (sentence, names) pairs.
+
+    - a parameter that does not change any measured frequency;
+    - two parameters correlated beyond :data:`CORRELATION_LIMIT`;
+    - an ill-conditioned Jacobian (condition number of its column-normalised
+      form above :data:`CONDITION_LIMIT`): the parameters of the weakest
+      direction are named;
+    - a standard deviation wider than half the bounds: the data do not
+      locate the parameter within them.
+    """
+    names = list(names)
+    problems = []
+    norms = np.linalg.norm(J, axis=0)
+    dead = norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)
+    for i in np.flatnonzero(dead):
+        problems.append((f"{names[i]} does not change any measured frequency", (names[i],)))
+    live = np.flatnonzero(~dead)
+    for a, i in enumerate(live):
+        for j in live[a + 1:]:
+            if abs(corr[i, j]) > CORRELATION_LIMIT:
+                problems.append(((f"{names[i]} and {names[j]} are correlated at {corr[i, j]:+.4f}: the data "
+                                 "determine only a combination of them"), (names[i], names[j])))
+    if live.size > 1:
+        Jn = J[:, live] / norms[live]
+        _, s, Vt = np.linalg.svd(Jn, full_matrices=False)
+        cond = s[0] / s[-1] if s[-1] > 0 else np.inf
+        if cond > CONDITION_LIMIT:
+            weak = tuple(names[live[k]] for k in np.flatnonzero(np.abs(Vt[-1]) > 0.25))
+            problems.append(((f"the Jacobian is ill-conditioned (condition number {cond:.3g}); weakest direction: "
+                             f"{', '.join(weak)}"), weak))
+    for i in live:
+        if np.isfinite(sigma[i]) and sigma[i] > 0.5 * (upper[i] - lower[i]):
+            problems.append(((f"{names[i]} is not located within its bounds [{lower[i]:g}, {upper[i]:g}] "
+                             f"(standard deviation {sigma[i]:.3g})"), (names[i],)))
+    return problems
+
+
+def warn_identifiability(problems: list[tuple[str, tuple[str, ...]]], stacklevel: int = 3) -> list[str]:
+    """Issue one :class:`IdentifiabilityWarning` naming every affected parameter; return the notes."""
+    if not problems:
+        return []
+    affected = tuple(dict.fromkeys(n for _, names in problems for n in names))
+    notes = [f"not identifiable from the data: {sentence}" for sentence, _ in problems]
+    message = f"parameters not identifiable from the data: {', '.join(affected)} ({'; '.join(s for s, _ in problems)})"
+    warnings.warn(IdentifiabilityWarning(message, affected), stacklevel=stacklevel)
+    return notes
