@@ -34,6 +34,17 @@ def _parser() -> argparse.ArgumentParser:
     spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
     spe.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     _simulate_parser(sub)
+    idf = sub.add_parser("identify", help="correct tension, EI, attachment positions... from measured frequencies")
+    idf.add_argument("campaign", help="campaign directory or its campaign.toml")
+    idf.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+    idf.add_argument("--params", default="tension,EI",
+                     help="free parameters, e.g. tension,EI or position[W1] (default tension,EI)")
+    idf.add_argument("--method", choices=("lsq", "contour"), default="lsq",
+                     help="weighted least squares (default) or the source paper's contour intersection")
+    idf.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")
+    idf.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
+    idf.add_argument("--plot", metavar="DIR", help="write the figures into DIR")
+    idf.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     return parser
 
 
@@ -186,6 +197,40 @@ def _spectra(args) -> int:
     return 0
 
 
+def _identify(args) -> int:
+    import warnings
+
+    from .campaign_io import campaign_file, load_campaign
+    from .identify import identify
+    from .report import to_json
+
+    campaign = load_campaign(args.campaign)
+    file = str(campaign_file(args.campaign))
+    tests = _selected_tests(campaign, args.test, file)
+    _check_output(args.json)
+    if args.plot is not None and os.path.exists(args.plot) and not os.path.isdir(args.plot):
+        raise InputError("exists and is not a directory", field="--plot", file=args.plot)
+    picked = {r.name: r for r in _picked(campaign, tests, file)}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            result = identify(campaign, tests, args.params, method=args.method, picked=picked,
+                              tension_model=args.tension_model)
+        except InputError as err:
+            raise InputError(err.message, field=err.field, file=err.file or file) from None
+    for w in caught:
+        print(f"stcs-ident: warning: {w.message}", file=sys.stderr)
+    if args.json:
+        _write(args.json, to_json(result.summary()))
+    if args.plot is not None:
+        from .plots_identify import save_identify_figures
+
+        save_identify_figures(result, args.plot)
+    if args.json != "-":
+        sys.stdout.write(result.text())
+    return 0
+
+
 def _forward(args) -> int:
     from .campaign_io import campaign_file, load_campaign
     from .compare import compare_forward
@@ -212,7 +257,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     try:
-        return {"forward": _forward, "spectra": _spectra, "simulate": _simulate}[args.command](args)
+        return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,
+                "identify": _identify}[args.command](args)
     except InputError as err:
         if args.debug:
             traceback.print_exc()
