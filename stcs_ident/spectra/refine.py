@@ -1,0 +1,169 @@
+"""Refinement of detected peaks: the band each is fitted in, and which detections are modes.
+
+Each candidate is fitted (by a band fitter given by the caller: the
+free-decay or the ambient likelihood) in a band of about eight
+half-power widths around it, never wider than 0.45 of the distance to the
+next candidate nor a quarter of its frequency; the nearest candidate on
+each side enters the fit as a fixed pole. The overview's width is only a
+guess, so a fit whose peak is wider than its band, or that fails, is
+repeated once in a wider band.
+
+A fit describes a mode when it converged, its damping ratio is below
+10 % (wider shapes are the colour of the noise, not a cable mode), it
+lies within two half-power widths of the detection, and it is
+significant (a z-like score of at least 6 against the background alone).
+Detections that are not modes are dropped one at a time, the weakest
+first, and their neighbours refitted without them (a spurious neighbour
+narrows a true mode's band), until every remaining one is a mode or is
+too strong (10 dB above the floor, and no wider than a mode with 10 %
+damping) to drop: those are reported from the overview, unless they lie
+within two half-power widths of a fitted mode (ripple on its resonance).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .overview import Candidate
+
+__all__ = ["FALLBACK_SNR_DB", "MAX_DAMPING", "MIN_SIGNIFICANCE", "refine"]
+
+MIN_SIGNIFICANCE = 6.0  # a fitted mode below this z-like score is a detection on a skirt or on noise
+FALLBACK_SNR_DB = 10.0  # a peak whose fit failed is still reported (overview estimate) if this strong
+MAX_DAMPING = 0.1  # a fitted ζ at or above this describes a broad spectral shape, not a cable mode
+BAND_HALF_POWER_WIDTHS = 8.0
+BAND_NEIGHBOUR_FRACTION = 0.45
+BAND_MAX_RELATIVE = 0.25
+
+# A band fitter: (centre Hz, half-width Hz, neighbour poles [(f, σ)], -3 dB width Hz) -> fit or None; a fit
+# has .frequency, .decay_rate, .damping, .significance and .converged.
+BandFitter = Callable[[float, float, list, float], object]
+
+
+def _candidate_pole(c: Candidate, resolution: float) -> tuple[float, float]:
+    """(frequency, decay rate) of a candidate from its -3 dB width less the resolution."""
+    return c.frequency, np.pi * max(c.half_power_width - resolution, 0.25 * resolution)
+
+
+def _band_limit(c: Candidate, neighbours: list[Candidate], nyquist: float) -> float:
+    gaps = [abs(n.frequency - c.frequency) for n in neighbours]
+    return min([BAND_NEIGHBOUR_FRACTION * g for g in gaps] + [BAND_MAX_RELATIVE * c.frequency, nyquist - c.frequency])
+
+
+def _plausible(c: Candidate, fit, cell_width: float) -> bool:
+    """A converged fit that describes the detected peak: a cable mode (ζ < MAX_DAMPING) near the candidate.
+
+    Near means within two half-power widths (the candidate's or the
+    fitted one, 2σ/2π), or three resolution cells: on a randomly excited
+    resonance the highest bin can lie well off the pole.
+    """
+    if fit is None or not fit.converged or fit.damping >= MAX_DAMPING:
+        return False
+    width = max(c.half_power_width, fit.decay_rate / np.pi)
+    return abs(fit.frequency - c.frequency) <= max(2.0 * width, 3.0 * cell_width)
+
+
+def _strong(c: Candidate) -> bool:
+    """A peak to report even when its fit fails: FALLBACK_SNR_DB high and as narrow as a cable mode (2ζf)."""
+    return c.snr_db >= FALLBACK_SNR_DB and c.half_power_width <= 2 * MAX_DAMPING * c.frequency
+
+
+def _fit_candidate(
+    c: Candidate, neighbours: list[Candidate], fit_band: BandFitter, resolution, min_half_width, nyquist, cell_width
+):
+    """Fit one candidate in a band of about eight half-power widths.
+
+    The overview's width is only a guess (ripple, resolution): when the
+    fitted peak is wider than the band allows for, or the fit fails or is
+    insignificant, the band is widened once (up to its limit) and the fit
+    repeated.
+    """
+    limit = _band_limit(c, neighbours, nyquist)
+    width = max(BAND_HALF_POWER_WIDTHS * max(c.half_power_width - resolution, resolution), min_half_width)
+    half_width = min(width, limit)
+    poles = [_candidate_pole(n, resolution) for n in neighbours]
+    fit = fit_band(c.frequency, half_width, poles, c.half_power_width)
+    if _plausible(c, fit, cell_width) and fit.significance >= MIN_SIGNIFICANCE:
+        wanted = min(BAND_HALF_POWER_WIDTHS * fit.decay_rate / np.pi, limit)
+        start = fit.frequency
+    else:
+        wanted, start = limit, c.frequency
+    if wanted > 1.5 * half_width:
+        wider = fit_band(start, wanted, poles, c.half_power_width)
+        if _plausible(c, wider, cell_width):
+            fit = wider
+    return fit
+
+
+def refine(
+    candidates: list[Candidate],
+    fit_band: BandFitter,
+    resolution: float,
+    min_half_width: float,
+    nyquist: float,
+    cell_width: float,
+) -> list[tuple[Candidate, object]]:
+    """Fit every candidate with its active neighbours, dropping non-modes one at a time (module docstring).
+
+    Parameters
+    ----------
+    candidates : list of Candidate
+        In frequency order.
+    fit_band : BandFitter
+    resolution : float
+        Resolution of the overview spectrum, Hz (subtracted from its peak widths).
+    min_half_width : float
+        Narrowest band half-width, Hz.
+    nyquist : float
+        Hz.
+    cell_width : float
+        Width of an independent cell of the overview spectrum, Hz.
+
+    Returns
+    -------
+    list of (Candidate, fit or None)
+        The candidates kept, in frequency order; None where the fit failed
+        on a peak too strong to drop.
+    """
+    active = list(range(len(candidates)))
+    cache: dict = {}
+    fits: dict = {}
+
+    def doubtful(i):
+        fit = fits[i]
+        if not _plausible(candidates[i], fit, cell_width):
+            return not _strong(candidates[i])
+        return fit.significance < MIN_SIGNIFICANCE
+
+    while True:
+        for pos, i in enumerate(active):
+            near = tuple(active[j] for j in (pos - 1, pos + 1) if 0 <= j < len(active))
+            if (i, near) not in cache:
+                cache[(i, near)] = _fit_candidate(
+                    candidates[i],
+                    [candidates[j] for j in near],
+                    fit_band,
+                    resolution,
+                    min_half_width,
+                    nyquist,
+                    cell_width,
+                )
+            fits[i] = cache[(i, near)]
+        weak = [i for i in active if doubtful(i)]
+        if not weak:
+            return _without_satellites([(candidates[i], fits[i]) for i in active], cell_width)
+        active.remove(min(weak, key=lambda i: candidates[i].snr_db))
+
+
+def _without_satellites(pairs, cell_width: float) -> list[tuple[Candidate, object]]:
+    """Failed fits become None; a failed one within two half-power widths of a fitted mode is ripple on it: dropped."""
+    modes = [fit for c, fit in pairs if _plausible(c, fit, cell_width)]
+    out = []
+    for c, fit in pairs:
+        if _plausible(c, fit, cell_width):
+            out.append((c, fit))
+        elif all(abs(c.frequency - m.frequency) > 2 * max(c.half_power_width, m.decay_rate / np.pi) for m in modes):
+            out.append((c, None))
+    return out
