@@ -195,13 +195,13 @@ def test_simulate_refuses_a_non_empty_directory(simulated, capsys):
     (["--test", "case1-L4", "--params", "tension,EI,length,mass_per_length,end_stiffness,position"], "params"),
 ])
 def test_identify_bad_input_exits_2(capsys, argv, field):
-    code, out, err = run(["identify", HAN, *argv], capsys)
+    code, _out, err = run(["identify", HAN, *argv], capsys)
     assert code == 2 and err.count("\n") == 1 and field in err and "campaign.toml" in err
 
 
 def test_identify_han2020_case1(tmp_path, capsys):
     out_json = tmp_path / "identify.json"
-    code, out, err = run(["identify", HAN, "--test", "case1-L4", "--test", "case1-L5", "--json", out_json], capsys)
+    code, _out, err = run(["identify", HAN, "--test", "case1-L4", "--test", "case1-L5", "--json", out_json], capsys)
     assert code == 0, err
     data = json.loads(out_json.read_text())
     assert data["method"] == "lsq"
