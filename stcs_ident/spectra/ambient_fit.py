@@ -33,7 +33,10 @@ Expected periodogram
 
 Uncertainty
     The inverse Fisher information of the Whittle likelihood,
-    F = Σ ∂E ∂Eᵀ / E², with the linear coefficients marginalised.
+    F = Σ ∂E ∂Eᵀ / E², with the linear coefficients marginalised, each
+    variance widened to the sandwich (misfit-robust) estimate where that
+    is larger: in crowded bands of broad resonances the fixed shapes of
+    the neighbours are only approximate.
 """
 
 from __future__ import annotations
@@ -111,12 +114,12 @@ class _Problem:
 
 
 def _design(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, np.ndarray]:
-    """Real basis (m, 2 + q) of the expected periodogram and its derivative wrt (f, σ) for the mode term."""
+    """Real basis (m, 1 + q) of the expected periodogram and the derivative of its mode column wrt (f, σ)."""
     z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
     h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples)
-    basis = np.column_stack([h.real, h.imag, problem.fixed])
+    basis = np.column_stack([h.real, problem.fixed])
     dz = (2j * np.pi * problem.dt, -problem.dt)
-    deriv = np.stack([np.column_stack([(dh * d).real, (dh * d).imag]) for d in dz], axis=-1)  # (m, 2, 2)
+    deriv = np.stack([(dh * d).real for d in dz], axis=-1)  # (m, 2): d Re H / d(f, σ)
     return basis, deriv
 
 
@@ -124,7 +127,7 @@ def _expected(theta: np.ndarray, problem: _Problem):
     basis, deriv = _design(theta[:2], problem)
     lin = theta[2:]
     mean = basis @ lin
-    grad = np.column_stack([deriv[:, :, 0] @ lin[:2], deriv[:, :, 1] @ lin[:2], basis])
+    grad = np.column_stack([deriv * lin[0], basis])
     return mean, grad
 
 
@@ -137,12 +140,12 @@ def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
 def _linear_start(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, float]:
     """Linear coefficients for given (f, σ)."""
     basis, _ = _design(theta_nl, problem)
-    return _whittle_linear(basis, problem.periodogram, problem.nonnegative)
+    return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=4)  # a start only
 
 
 def _null_neg_log_likelihood(problem: _Problem) -> float:
     """Whittle -log-likelihood of the background and neighbours alone (no mode)."""
-    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[2:], iterations=12)[1]
+    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[1:], iterations=12)[1]
 
 
 def _whittle_linear(
@@ -248,6 +251,23 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, 
     return theta, False
 
 
+def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray) -> np.ndarray:
+    """Covariance of (f, σ): the inverse Fisher information, widened to the sandwich estimate where larger.
+
+    The sandwich F⁻¹ J F⁻¹, J = Σ_k s_k s_kᵀ with the per-bin scores
+    s_k = ∂E_k (I_k − E_k) / E_k², equals F⁻¹ when the model is right and
+    grows when it is not (wrong neighbour shapes, a second mode in the
+    band): each variance is the larger of the two, the correlation F's.
+    """
+    fisher = _fisher(grad, mean)
+    cov = _marginal_covariance(fisher)
+    scores = grad * ((periodogram - mean) / mean**2)[:, None]
+    inverse = np.linalg.pinv(fisher, rcond=1e-12)
+    sandwich = (inverse @ (scores.T @ scores) @ inverse)[:2, :2]
+    widen = np.sqrt(np.maximum(np.diag(sandwich) / np.diag(cov), 1.0))
+    return cov * np.outer(widen, widen)
+
+
 def _marginal_covariance(fisher: np.ndarray) -> np.ndarray:
     """Covariance of the first two parameters with the others marginalised (Schur complement)."""
     a = fisher[:2, :2]
@@ -316,22 +336,23 @@ def fit_ambient(
     u = mode_shape(white[near])
     y = white @ u.conj()
     fixed = _fixed_basis(k * df, f_initial, half_width, neighbours, k, n_samples, dt)
-    # Linear coefficients: mode (Re, Im), neighbours, constant, slope; powers are ≥ 0.
-    nonnegative = np.array([True, False] + [True] * len(neighbours) + [True, False])
+    # Linear coefficients: mode, neighbours, constant, slope; powers are ≥ 0.
+    nonnegative = np.array([True] + [True] * len(neighbours) + [True, False])
     problem = _Problem(np.abs(y) ** 2, 2 * np.pi * k / n_samples, n_samples, dt, fixed, nonnegative)
-    f_start = _smoothed_peak(problem.periodogram, k * df, max(peak_width, 3 * df))
+    # Starting frequencies: the overview's, and the band's maximum after smoothing over 3 bins (a narrow
+    # peak) and over a quarter of the overview's width (a broad one, whose bins scatter).
+    starts = [f_initial] + [_smoothed_peak(problem.periodogram, k * df, w) for w in (3 * df, 0.25 * peak_width)]
     limits = (
         (f_initial - half_width, f_initial + half_width),
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
     )
-    theta = _grid_start(f_start, problem, limits)
+    theta = _grid_start(starts, problem, limits)
     theta, ok = _scoring(theta, problem, limits)
     mean, grad = _expected(theta, problem)
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
-    fisher = _fisher(grad[:, free], mean)
     try:
-        cov = _marginal_covariance(fisher)
+        cov = _robust_covariance(grad[:, free], mean, problem.periodogram)
     except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
@@ -361,18 +382,20 @@ def _smoothed_peak(periodogram: np.ndarray, freq: np.ndarray, width: float) -> f
     return float(freq[int(np.argmax(smooth))])
 
 
-def _grid_start(f_start: float, problem: _Problem, limits) -> np.ndarray:
+def _grid_start(starts: list[float], problem: _Problem, limits) -> np.ndarray:
+    """The best (least -log-likelihood) of the starting frequencies × DAMPING_GRID, linear terms fitted."""
     best, best_nll = None, np.inf
-    for zeta in DAMPING_GRID:
-        theta_nl = np.array([f_start, zeta * 2 * np.pi * f_start])
-        if not limits[1][0] < theta_nl[1] < limits[1][1]:
-            continue
-        lin, nll = _linear_start(theta_nl, problem)
-        if nll < best_nll:
-            best, best_nll = np.concatenate([theta_nl, lin]), nll
+    for f_start in dict.fromkeys(starts):  # unique, in order
+        for zeta in DAMPING_GRID:
+            theta_nl = np.array([f_start, zeta * 2 * np.pi * f_start])
+            if not limits[1][0] < theta_nl[1] < limits[1][1]:
+                continue
+            lin, nll = _linear_start(theta_nl, problem)
+            if nll < best_nll:
+                best, best_nll = np.concatenate([theta_nl, lin]), nll
     if best is None:
-        lin, _ = _linear_start(np.array([f_start, limits[1][1] / 2]), problem)
-        best = np.concatenate([[f_start, limits[1][1] / 2], lin])
+        theta_nl = np.array([starts[0], limits[1][1] / 2])
+        best = np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
     return best
 
 

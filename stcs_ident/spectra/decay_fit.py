@@ -338,7 +338,12 @@ def pole_statistics(f_d: float, sigma: float, cov: np.ndarray) -> tuple[float, f
     f_n = omega_n / (2 * np.pi)
     grad_f = np.array([f_d, sigma / (2 * np.pi) ** 2]) / f_n
     grad_zeta = np.array([-sigma * (2 * np.pi) ** 2 * f_d, (2 * np.pi * f_d) ** 2]) / omega_n**3
-    return float(f_n), float(np.sqrt(grad_f @ cov @ grad_f)), float(sigma / omega_n), float(np.sqrt(grad_zeta @ cov @ grad_zeta))
+    return (
+        float(f_n),
+        float(np.sqrt(grad_f @ cov @ grad_f)),
+        float(sigma / omega_n),
+        float(np.sqrt(grad_zeta @ cov @ grad_zeta)),
+    )
 
 
 def _result(theta, cov, state, bands, dt, noise_var, ok) -> DecayFit:

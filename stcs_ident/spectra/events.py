@@ -111,7 +111,7 @@ def _jumps(energy: np.ndarray, history: int, jump_db: float) -> np.ndarray:
     ahead = (cum[PERSIST:] - cum[:-PERSIST]) / PERSIST  # ahead[k]: mean of frames k … k+PERSIST−1
     span = history - PERSIST + 1
     # Largest mean over windows starting in [k − history, k − PERSIST] (all ending before k); near the
-    # record's start the filter's reflection keeps the window inside the frames seen so far.
+    # record's start the filter repeats the first value, so the window stays inside the frames seen so far.
     largest = ndimage.maximum_filter1d(ahead, size=span, origin=(span - 1) // 2, mode="nearest")
     k = np.arange(first, ahead.size)
     before = largest[k - PERSIST]

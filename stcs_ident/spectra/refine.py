@@ -65,9 +65,13 @@ def _plausible(c: Candidate, fit, cell_width: float) -> bool:
     return abs(fit.frequency - c.frequency) <= max(2.0 * width, 3.0 * cell_width)
 
 
-def _strong(c: Candidate) -> bool:
-    """A peak to report even when its fit fails: FALLBACK_SNR_DB high and as narrow as a cable mode (2ζf)."""
-    return c.snr_db >= FALLBACK_SNR_DB and c.half_power_width <= 2 * MAX_DAMPING * c.frequency
+def _strong(c: Candidate, cell_width: float) -> bool:
+    """A peak to report even when its fit fails: FALLBACK_SNR_DB high and as narrow as a cable mode (2ζf).
+
+    (Or no wider than four resolution cells: the overview cannot resolve a narrower peak.)
+    """
+    narrow = c.half_power_width <= max(2 * MAX_DAMPING * c.frequency, 4 * cell_width)
+    return c.snr_db >= FALLBACK_SNR_DB and narrow
 
 
 def _fit_candidate(
@@ -134,7 +138,7 @@ def refine(
     def doubtful(i):
         fit = fits[i]
         if not _plausible(candidates[i], fit, cell_width):
-            return not _strong(candidates[i])
+            return not _strong(candidates[i], cell_width)
         return fit.significance < MIN_SIGNIFICANCE
 
     while True:
