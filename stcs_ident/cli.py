@@ -171,16 +171,24 @@ def _picked(campaign, tests, file):
     return analyse_campaign(campaign, tests, progress=_progress)
 
 
-def _spectra(args) -> int:
+def _prepare(args):
+    """Load the campaign and check the selection and the outputs before any work."""
     from .campaign_io import campaign_file, load_campaign
-    from .report import spectra_text, to_json
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
     tests = _selected_tests(campaign, args.test, file)
     _check_output(args.json)
-    if args.plot is not None and os.path.exists(args.plot) and not os.path.isdir(args.plot):
-        raise InputError("exists and is not a directory", field="--plot", file=args.plot)
+    plot = getattr(args, "plot", None)
+    if plot is not None and os.path.exists(plot) and not os.path.isdir(plot):
+        raise InputError("exists and is not a directory", field="--plot", file=plot)
+    return campaign, file, tests
+
+
+def _spectra(args) -> int:
+    from .report import spectra_text, to_json
+
+    campaign, file, tests = _prepare(args)
     results = _picked(campaign, tests, file)
     skipped = [t.name for t in campaign.tests if t.record is None and (not tests or t.name in tests)]
     if args.json:
@@ -200,16 +208,10 @@ def _spectra(args) -> int:
 def _identify(args) -> int:
     import warnings
 
-    from .campaign_io import campaign_file, load_campaign
     from .identify import identify
     from .report import to_json
 
-    campaign = load_campaign(args.campaign)
-    file = str(campaign_file(args.campaign))
-    tests = _selected_tests(campaign, args.test, file)
-    _check_output(args.json)
-    if args.plot is not None and os.path.exists(args.plot) and not os.path.isdir(args.plot):
-        raise InputError("exists and is not a directory", field="--plot", file=args.plot)
+    campaign, file, tests = _prepare(args)
     picked = {r.name: r for r in _picked(campaign, tests, file)}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -232,16 +234,12 @@ def _identify(args) -> int:
 
 
 def _forward(args) -> int:
-    from .campaign_io import campaign_file, load_campaign
     from .compare import compare_forward
     from .report import forward_text, to_json
 
-    campaign = load_campaign(args.campaign)
-    file = str(campaign_file(args.campaign))
     if args.modes is not None and args.modes < 1:
         raise InputError(f"must be >= 1, got {args.modes}", field="--modes")
-    tests = _selected_tests(campaign, args.test, file)
-    _check_output(args.json)
+    campaign, file, tests = _prepare(args)
     picked = {r.name: (r.modes, r.frequencies) for r in _picked(campaign, tests, file)}
     result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked)
     text = forward_text(result)
