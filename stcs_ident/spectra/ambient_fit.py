@@ -15,21 +15,26 @@ Expected periodogram
     c(τ) = Re(C r^|τ|) with a complex C. Near +f_d, the expected (not the
     true) periodogram of N samples is exactly
 
-        E I(ω) = α Re H(u) + β Im H(u),   u = r e^{−iω},
+        E I(ω) = α Re H(u) + β Im H(u),   u = r e^{−iω},   |β| ≤ α,
         H(u) = 2 G(u) − 1,   G(u) = Σ_{τ=0}^{N−1} (1 − τ/N) u^τ
              = 1/(1 − u) − u (1 − u^N) / (N (1 − u)²),
 
     the SDOF spectrum convolved with the Fejér kernel in closed form: the
     leakage of a peak only a few bins wide is modelled, not suffered
-    ("debiased Whittle", Sykulski et al. 2019, Biometrika 106(2)). Other
-    modes add α_j Re H(u_j) with fixed poles and α_j ≥ 0, and noise and far
-    tails a constant and a slope. Nothing else: with a curvature term, a
+    ("debiased Whittle", Sykulski et al. 2019, Biometrika 106(2)). The
+    dispersive part β (of order ζ α for one mode; leaving it out biases
+    the frequency by up to one σ in long records) is bounded by α, so a
+    mode is always a peak, never a mere wiggle. Other modes add
+    α_j Re H(u_j) with fixed poles and α_j ≥ 0, and noise and far tails a
+    constant (≥ 0) and a slope. Nothing else: with a curvature term, a
     dispersive part of a neighbour or a neighbour of either sign, the
     background alone could carve a bump between two neighbours and mimic
     (and weaken the test of) the mode. The periodogram bins are then
     independent exponential variables with these means (asymptotically),
     and the Whittle likelihood Σ [log E_k + I_k / E_k] is maximised by
-    Fisher scoring over (f_d, σ) and the linear coefficients.
+    Fisher scoring over (f_d, σ) and the linear coefficients, the bounded
+    ones held at their bound while the step would cross it; the start is
+    the best of a few frequencies × a grid of ζ.
 
 Uncertainty
     The inverse Fisher information of the Whittle likelihood,
@@ -50,7 +55,7 @@ from .decay_fit import pole_statistics
 __all__ = ["AmbientFit", "fit_ambient"]
 
 MAX_ITERATIONS = 60
-DAMPING_GRID = np.logspace(-4.0, -1.0, 10)
+DAMPING_GRID = np.logspace(-4.0, -1.0, 7)
 
 
 @dataclass(frozen=True)
@@ -114,12 +119,15 @@ class _Problem:
 
 
 def _design(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, np.ndarray]:
-    """Real basis (m, 1 + q) of the expected periodogram and the derivative of its mode column wrt (f, σ)."""
+    """Real basis (m, 2 + q) of the expected periodogram and its derivative wrt (f, σ) for the mode term."""
     z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
     h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples)
-    basis = np.column_stack([h.real, problem.fixed])
+    # α Re H + β Im H with |β| ≤ α, written as p (Re H + Im H) + q (Re H − Im H) with p, q ≥ 0.
+    basis = np.column_stack([h.real + h.imag, h.real - h.imag, problem.fixed])
     dz = (2j * np.pi * problem.dt, -problem.dt)
-    deriv = np.stack([(dh * d).real for d in dz], axis=-1)  # (m, 2): d Re H / d(f, σ)
+    deriv = np.stack(
+        [np.column_stack([(dh * d).real + (dh * d).imag, (dh * d).real - (dh * d).imag]) for d in dz], axis=-1
+    )  # (m, 2, 2)
     return basis, deriv
 
 
@@ -127,7 +135,7 @@ def _expected(theta: np.ndarray, problem: _Problem):
     basis, deriv = _design(theta[:2], problem)
     lin = theta[2:]
     mean = basis @ lin
-    grad = np.column_stack([deriv * lin[0], basis])
+    grad = np.column_stack([deriv[:, :, 0] @ lin[:2], deriv[:, :, 1] @ lin[:2], basis])
     return mean, grad
 
 
@@ -140,12 +148,12 @@ def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
 def _linear_start(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, float]:
     """Linear coefficients for given (f, σ)."""
     basis, _ = _design(theta_nl, problem)
-    return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=4)  # a start only
+    return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=3)  # a start only
 
 
 def _null_neg_log_likelihood(problem: _Problem) -> float:
     """Whittle -log-likelihood of the background and neighbours alone (no mode)."""
-    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[1:], iterations=12)[1]
+    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[2:], iterations=12)[1]
 
 
 def _whittle_linear(
@@ -336,12 +344,16 @@ def fit_ambient(
     u = mode_shape(white[near])
     y = white @ u.conj()
     fixed = _fixed_basis(k * df, f_initial, half_width, neighbours, k, n_samples, dt)
-    # Linear coefficients: mode, neighbours, constant, slope; powers are ≥ 0.
-    nonnegative = np.array([True] + [True] * len(neighbours) + [True, False])
+    # Linear coefficients: mode (p, q), neighbours, constant, slope; powers are ≥ 0.
+    nonnegative = np.array([True, True] + [True] * len(neighbours) + [True, False])
     problem = _Problem(np.abs(y) ** 2, 2 * np.pi * k / n_samples, n_samples, dt, fixed, nonnegative)
     # Starting frequencies: the overview's, and the band's maximum after smoothing over 3 bins (a narrow
     # peak) and over a quarter of the overview's width (a broad one, whose bins scatter).
-    starts = [f_initial] + [_smoothed_peak(problem.periodogram, k * df, w) for w in (3 * df, 0.25 * peak_width)]
+    starts = [f_initial]
+    for width in (3 * df, 0.25 * peak_width):
+        f_max = _smoothed_peak(problem.periodogram, k * df, width)
+        if all(abs(f_max - f) > 2 * df for f in starts):
+            starts.append(f_max)
     limits = (
         (f_initial - half_width, f_initial + half_width),
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
@@ -359,7 +371,7 @@ def fit_ambient(
         return None
     null = _null_neg_log_likelihood(problem)
     significance = np.sqrt(max(2.0 * (null - _neg_log_likelihood(mean, problem.periodogram)), 0.0))
-    variance_y = 2.0 * theta[2]  # c(0) of the modal term in y
+    variance_y = 2.0 * (theta[2] + theta[3])  # c(0) = 2α of the modal term in y, α = p + q
     shape = u * noise_scale
     shape = shape / np.linalg.norm(shape)
     amplitude = np.sqrt(max(variance_y, 0.0)) * np.abs(u) * noise_scale * np.sign(np.cos(np.angle(u)))
@@ -385,7 +397,7 @@ def _smoothed_peak(periodogram: np.ndarray, freq: np.ndarray, width: float) -> f
 def _grid_start(starts: list[float], problem: _Problem, limits) -> np.ndarray:
     """The best (least -log-likelihood) of the starting frequencies × DAMPING_GRID, linear terms fitted."""
     best, best_nll = None, np.inf
-    for f_start in dict.fromkeys(starts):  # unique, in order
+    for f_start in starts:
         for zeta in DAMPING_GRID:
             theta_nl = np.array([f_start, zeta * 2 * np.pi * f_start])
             if not limits[1][0] < theta_nl[1] < limits[1][1]:

@@ -64,14 +64,13 @@ Why a parametric fit (measured; seeded simulations, /tmp benchmarks)
 
     On the 105 records of tests/test_spectra_acceptance.py (the project's
     simulator; three cables, 1–5 sensors, ζ 0.1–2 %, 0–40 dB): median
-    |error| / CRB 1.21 over 277 free-decay modes, median |error / 1σ| 0.72
-    over all found modes. 35 of its 786 "visible" modes are not found:
-    8 have |φ| < 5 % at every sensor (a lone sensor at their node: the
-    test counts the skirts of the neighbouring modes as visibility), most
-    others are weak modes between broad (ζ ≈ 2 %) ambient resonances.
+    |error| / CRB 1.20 over 273 free-decay modes, median |error / 1σ| 0.71
+    over all modes found (0.3 % beyond 4); 9 of 725 visible modes missed:
+    weak high modes seen by one sensor, and the upper modes of the stay
+    where ζ ≈ 1.8 % makes neighbouring resonances overlap in ambient data.
 
     Time (this 2-core machine): 16 channels × 600 s × 256 Hz with 20 modes,
-    ambient about 0.6 s, ten blows about 1.0 s.
+    ambient 0.6–0.8 s, ten blows 0.8–0.9 s.
 """
 
 from __future__ import annotations
