@@ -24,14 +24,15 @@ from pathlib import Path
 from typing import Any
 
 from .errors import CampaignError, ModelError
-from .model import Attachment, Boundary, Cable, Campaign, Setup, Test
+from .model import Attachment, Boundary, Cable, Campaign, Published, Setup, Test
 
 __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 
 #: Name of the campaign file inside a campaign directory.
 CAMPAIGN_FILE = "campaign.toml"
 
-_TOP_KEYS = ("campaign", "cable", "setup", "test")
+_TOP_KEYS = ("campaign", "cable", "setup", "test", "published")
+_PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
 _SETUP_KEYS = ("name", "attachment")
@@ -122,7 +123,22 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     found = _tables(data.get("setup", []), "setup")
     setups = [_parse_setup(t, i, cable.length) for i, t in enumerate(found, 1)]
     tests = [_parse_test(t, i) for i, t in enumerate(_tables(data.get("test", []), "test"), 1)]
-    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory)
+    published = [_parse_published(t, i) for i, t in enumerate(_tables(data.get("published", []), "published"), 1)]
+    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published))
+
+
+def _parse_published(table: dict[str, Any], index: int) -> Published:
+    """Build one ``[[published]]``: a result published elsewhere, shown beside ours."""
+    where = f"published[#{index}]"
+    _check_keys(table, _PUBLISHED_KEYS, where)
+    basis = table.get("basis")
+    return Published(
+        parameter=_string(_required(table, "parameter", where), f"{where}.parameter"),
+        low=_number(_required(table, "low", where), f"{where}.low"),
+        high=_number(table.get("high", table.get("low")), f"{where}.high"),
+        basis=None if basis is None else _number(basis, f"{where}.basis"),
+        source=_string(table.get("source", ""), f"{where}.source", empty_ok=True),
+    )
 
 
 def _parse_cable(table: dict[str, Any]) -> Cable:
@@ -349,6 +365,8 @@ def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
         lines += ["", *_setup_lines(setup)]
     for test in campaign.tests:
         lines += ["", *_test_lines(test)]
+    for item in campaign.published:
+        lines += ["", *_published_lines(item)]
     return "\n".join(lines) + "\n"
 
 
@@ -387,6 +405,16 @@ def _setup_lines(setup: Setup) -> list[str]:
             f"  mass = {_toml_float(a.mass)}",
             f"  stiffness = {_toml_float(a.stiffness)}",
         ]
+    return lines
+
+
+def _published_lines(item: Published) -> list[str]:
+    lines = ["[[published]]", f"parameter = {_toml_string(item.parameter)}",
+             f"low = {_toml_float(item.low)}", f"high = {_toml_float(item.high)}"]
+    if item.basis is not None:
+        lines.append(f"basis = {_toml_float(item.basis)}")
+    if item.source:
+        lines.append(f"source = {_toml_string(item.source)}")
     return lines
 
 

@@ -222,14 +222,20 @@ def _identify(args) -> int:
             raise InputError(err.message, field=err.field, file=err.file or file) from None
     for w in caught:
         print(f"stcs-ident: warning: {w.message}", file=sys.stderr)
+    from .identify.published import published_comparison
+
+    summary = result.summary()
+    summary["published"] = published_comparison(campaign, summary)
     if args.json:
-        _write(args.json, to_json(result.summary()))
+        _write(args.json, to_json(summary))
     if args.plot is not None:
         from .plots_identify import save_identify_figures
 
         save_identify_figures(result, args.plot)
     if args.json != "-":
         sys.stdout.write(result.text())
+        for item in summary["published"]:
+            sys.stdout.write(f"\nPublished beside ours: {item['statement']}\n")
     return 0
 
 

@@ -277,6 +277,44 @@ class Test:
 
 
 @dataclass(frozen=True)
+class Published:
+    """A result published elsewhere for this campaign, to be shown beside ours.
+
+    Parameters
+    ----------
+    parameter : str
+        The identified quantity it compares with, as ``identify`` names it
+        (``"EI_ratio"``, ``"tension_ratio"``).
+    low, high : float
+        The published value or range.
+    basis : float or None
+        The value the published ratio is relative to, when it is not this
+        campaign's nominal (SI units).
+    source : str
+        Where it was published.
+    """
+
+    parameter: str
+    low: float
+    high: float
+    basis: float | None = None
+    source: str = ""
+
+    def __post_init__(self):
+        where = f"published[{self.parameter}]"
+        if not isinstance(self.parameter, str) or not self.parameter:
+            raise ModelError("must be a non-empty string", field="published.parameter")
+        low = _finite(self.low, f"{where}.low")
+        high = _finite(self.high, f"{where}.high")
+        if high < low:
+            raise ModelError(f"must be >= low ({low}), got {high}", field=f"{where}.high")
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+        if self.basis is not None:
+            object.__setattr__(self, "basis", _positive(self.basis, f"{where}.basis"))
+
+
+@dataclass(frozen=True)
 class Campaign:
     """One cable, its setups and its tests."""
 
@@ -286,10 +324,12 @@ class Campaign:
     tests: tuple[Test, ...] = ()
     description: str = ""
     directory: str | None = None
+    published: tuple[Published, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="campaign.name")
+        object.__setattr__(self, "published", tuple(self.published))
         object.__setattr__(self, "setups", tuple(self.setups))
         object.__setattr__(self, "tests", tuple(self.tests))
         _unique((s.name for s in self.setups), "setup")

@@ -210,3 +210,25 @@ def test_identify_han2020_case1(tmp_path, capsys):
     for t in data["tests"]:
         rms_after = np.sqrt(np.mean(np.square(t["after_error"])))
         assert rms_after < 0.45  # below the paper's own correction (0.45 %, 0.41 %)
+
+
+def test_identify_states_the_published_value_beside_ours(capsys):
+    """han2020 ships the paper's reported EI ratio (1.01–1.02 of its own ~93.9 kN m²);
+    identify prints ours beside it, with its uncertainty."""
+    code, out, err = run(["identify", HAN, "--test", "case1-L4", "--test", "case1-L5", "--json", "-"], capsys)
+    assert code == 0, err
+    [item] = json.loads(out)["published"]
+    assert item["parameter"] == "EI_ratio" and item["published"] == [1.01, 1.02]
+    assert item["uncertainty_in_basis"] > 0 and "this identification" in item["statement"]
+    code, out, _ = run(["identify", HAN, "--test", "case1-L4", "--test", "case1-L5"], capsys)
+    assert "Published beside ours: EI_ratio: published 1.01–1.02" in out
+
+
+@pytest.mark.parametrize("table,field", [
+    ('[[published]]\nparameter = "EI_ratio"\nlow = 1.2\nhigh = 1.1\n', "published[EI_ratio].high"),
+    ('[[published]]\nparameter = "EI_ratio"\nlow = 1.0\ncolour = 1\n', "published[#1].colour"),
+    ('[[published]]\nlow = 1.0\n', "published[#1].parameter"),
+])
+def test_bad_published_table_exits_2(tmp_path, capsys, table, field):
+    code, _, err = run(["forward", _write(tmp_path, GOOD + table)], capsys)
+    assert code == 2 and field in err and "campaign.toml" in err
