@@ -145,7 +145,7 @@ def cases(quick: bool) -> list[Case]:
 
     hanger, stay = structures()
     n = 1 if quick else 5
-    seeds = lambda base: tuple(range(base, base + n))  # noqa: E731
+    seeds = lambda base: tuple(range(base, base + n))
     return [
         Case(hanger, "ambient", 200.0, 600.0, Ambient(200.0), (), seeds(101)),
         Case(hanger, "hand", 200.0, 30.0, None,
@@ -416,12 +416,12 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="one record per case and one timing repeat (~30 s)")
     args = parser.parse_args(argv)
     try:
-        import pyoma2  # noqa: F401
+        import pyoma2
     except ImportError:
         print(PYOMA_MISSING)
         return 0
     logging.getLogger("pyoma2").setLevel(logging.WARNING)
-    import pyoma2.algorithms.fdd  # noqa: F401  (imports outside the timed calls)
+    import pyoma2.algorithms.fdd
     import pyoma2.setup.single  # noqa: F401
 
     import stcs_ident.spectra.peaks  # noqa: F401

@@ -177,7 +177,7 @@ def test_exponential_kernel_recursion_equals_the_double_sum():
     shapes = modal_basis(CABLE, [], TENSION, 20.0)
     L, spacing = 3.0, 0.05
     C = _exponential_gram(shapes, LENGTH, L, spacing)
-    x = np.linspace(0, LENGTH, int(math.ceil(LENGTH / spacing)) + 1)
+    x = np.linspace(0, LENGTH, math.ceil(LENGTH / spacing) + 1)
     w = np.full(x.size, x[1] - x[0])
     w[[0, -1]] /= 2
     v = shapes(x) * w[:, None]

@@ -74,9 +74,9 @@ def _case(seed):
                          for i in range(n))
     else:
         ambient = Ambient(rms_pressure=50.0)
-    return dict(name=name, cable=cable, atts=atts, H=H, duration=duration, fs=fs, n_modes=n_modes,
-                positions=positions, kind=kind, snr=snr, zeta=zeta, impulses=impulses, ambient=ambient,
-                nominal_error=float(rng.uniform(0.9, 1.1)), seed=seed)
+    return {"name": name, "cable": cable, "atts": atts, "H": H, "duration": duration, "fs": fs, "n_modes": n_modes,
+                "positions": positions, "kind": kind, "snr": snr, "zeta": zeta, "impulses": impulses, "ambient": ambient,
+                "nominal_error": float(rng.uniform(0.9, 1.1)), "seed": seed}
 
 
 def _simulate(case, snr):
@@ -86,12 +86,12 @@ def _simulate(case, snr):
 
 
 def _visible(clean, noise, fs, freqs):
-    nper = 2 ** int(round(math.log2(max(256, clean.shape[0] / 8))))
+    nper = 2 ** round(math.log2(max(256, clean.shape[0] / 8)))
     f, p_clean = welch(clean, fs=fs, nperseg=nper, axis=0)
     _, p_noise = welch(noise, fs=fs, nperseg=nper, axis=0)
     floor = np.maximum(p_noise, 1e-300)
     edges = np.concatenate([[freqs[0] / 2], (freqs[1:] + freqs[:-1]) / 2, [freqs[-1] + (freqs[-1] - freqs[-2]) / 2]])
-    at = lambda x: np.argmin(np.abs(f - x))  # noqa: E731
+    at = lambda x: np.argmin(np.abs(f - x))
     out = []
     for k, fk in enumerate(freqs):
         band = np.abs(f - fk) <= 2 * (f[1] - f[0])
