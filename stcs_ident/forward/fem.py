@@ -27,7 +27,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ComputationError, ModelError
-from ..model import Attachment, Cable
+from ..model import (
+    Attachment,
+    Cable,
+    _finite,  # the model's check of a finite number, naming the field
+)
 
 __all__ = [
     "FEModel",
@@ -335,7 +339,7 @@ def fe_modes(
 def _check_inputs(cable: Cable, tension: float, n_elements: int, tension_model: str, grading: float) -> float:
     if not isinstance(cable, Cable):
         raise ModelError("must be a Cable", field="cable")
-    tension = _number(tension, "tension")
+    tension = _finite(tension, "tension")
     if tension < 0:
         raise ModelError(f"must be >= 0, got {tension!r}", field="tension")
     if tension == 0 and cable.EI == 0:
@@ -346,21 +350,9 @@ def _check_inputs(cable: Cable, tension: float, n_elements: int, tension_model: 
         raise ModelError("must be > 0 for the sag term (or use tension_model='none')", field="tension")
     if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) or n_elements < 2:
         raise ModelError(f"must be an integer >= 2, got {n_elements!r}", field="n_elements")
-    if _number(grading, "grading") < 0:
+    if _finite(grading, "grading") < 0:
         raise ModelError(f"must be >= 0, got {grading!r}", field="grading")
     return tension
-
-
-def _number(value, name: str) -> float:
-    if isinstance(value, bool):
-        raise ModelError(f"must be a number, got {value!r}", field=name)
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(f"must be a number, got {value!r}", field=name) from None
-    if not math.isfinite(v):
-        raise ModelError(f"must be finite, got {value!r}", field=name)
-    return v
 
 
 def _merge_attachments(cable: Cable, attachments: Sequence[Attachment]) -> np.ndarray:
