@@ -45,6 +45,19 @@ def _parser() -> argparse.ArgumentParser:
     idf.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     idf.add_argument("--plot", metavar="DIR", help="write the figures into DIR")
     idf.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    dia = sub.add_parser("diagnose", help="what the model gets wrong, its cause among physical effects, and the gain")
+    dia.add_argument("campaign", help="campaign directory or its campaign.toml")
+    dia.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+    dia.add_argument("--effects", metavar="LIST",
+                     help="effects to consider, comma-separated (default all: tension, bending_stiffness, "
+                          "attachment_position, attachment_mass, unmodeled_mass, unmodeled_support, "
+                          "end_restraint, length)")
+    dia.add_argument("--max-effects", type=int, choices=(1, 2), default=2,
+                     help="largest number of effects in one hypothesis (default 2)")
+    dia.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")
+    dia.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
+    dia.add_argument("--out", metavar="DIR", help="write the report (report.md, figures, CSV tables) into DIR")
+    dia.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     return parser
 
 
@@ -239,6 +252,34 @@ def _identify(args) -> int:
     return 0
 
 
+def _diagnose(args) -> int:
+    from .diagnose import diagnose
+    from .report import to_json
+
+    campaign, file, tests = _prepare(args)
+    if args.out is not None and os.path.exists(args.out) and not os.path.isdir(args.out):
+        raise InputError("exists and is not a directory", field="--out", file=args.out)
+    spectra = _picked(campaign, tests, file)
+    picked = {r.name: r for r in spectra}
+    try:
+        result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,
+                          tension_model=args.tension_model,
+                          progress=lambda k, n, label: _progress(f"diagnose: hypothesis {k} of {n} ({label})"))
+    except InputError as err:
+        raise InputError(err.message, field=err.field, file=err.file or file) from None
+    if args.json:
+        _write(args.json, to_json(result.summary()))
+    if args.out is not None:
+        from .diagnose.report import write_report
+
+        write_report(result, args.out, spectra=spectra)
+    if args.json != "-":
+        sys.stdout.write(result.text())
+        if args.out is not None:
+            sys.stdout.write(f"report: {os.path.join(args.out, 'report.md')}\n")
+    return 0
+
+
 def _forward(args) -> int:
     from .compare import compare_forward
     from .report import forward_text, to_json
@@ -262,7 +303,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,
-                "identify": _identify}[args.command](args)
+                "identify": _identify, "diagnose": _diagnose}[args.command](args)
     except InputError as err:
         if args.debug:
             traceback.print_exc()

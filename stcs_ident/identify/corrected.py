@@ -34,7 +34,8 @@ def corrected_campaign(campaign: Campaign, result: IdentificationResult) -> Camp
             ends = {"A": ("boundary_a",), "B": ("boundary_b",), "AB": ("boundary_a", "boundary_b")}[p.member]
             cable = replace(cable, **{end: Boundary(value) for end in ends})
         else:
-            atts = setups[p.setup]
-            atts[p.index] = replace(atts[p.index], **{p.kind: value})
+            for setup, index in p.slots or ((p.setup, p.index),):
+                atts = setups[setup]
+                atts[index] = replace(atts[index], **{p.kind: value})
     new_setups = tuple(replace(s, attachments=tuple(setups[s.name])) for s in campaign.setups)
     return replace(campaign, cable=cable, setups=new_setups, tests=tuple(tests[t.name] for t in campaign.tests))

@@ -30,11 +30,10 @@ SAME_POINT = 1e-5
 #: χ² difference (relative) below which two minima explain the data equally well.
 SAME_CHI2 = 1e-6
 
-_TOLERANCES = {"xtol": 1e-14, "ftol": 1e-14, "gtol": 1e-14}
 
 
 def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str = "auto",
-            max_nfev: int = 200, seed: int = 0) -> IdentificationResult:
+            max_nfev: int = 200, seed: int = 0, tol: float = 1e-14) -> IdentificationResult:
     """Least-squares estimate of the problem's parameters with their covariance.
 
     Parameters
@@ -53,6 +52,9 @@ def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str
         Function evaluations per local fit.
     seed : int
         Seed of the scan's random candidates (three or more positions).
+    tol : float
+        ``xtol``, ``ftol`` and ``gtol`` of each local fit (the diagnosis,
+        which fits many hypotheses, uses 1e-10).
 
     Returns
     -------
@@ -66,9 +68,9 @@ def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str
     """
     starts = _starts(problem, n_starts, seed) if starts is None else np.atleast_2d(np.asarray(starts, float))
     starts = np.clip(starts, problem.lower, problem.upper)
-    solutions = [_local_fit(problem, x0, max_nfev) for x0 in starts]
+    solutions = [_local_fit(problem, x0, max_nfev, tol) for x0 in starts]
     best = min(solutions, key=lambda s: s[1])[0]
-    solutions += [_local_fit(problem, m, max_nfev) for m in mirror_images(problem, best)]
+    solutions += [_local_fit(problem, m, max_nfev, tol) for m in mirror_images(problem, best)]
     x, chi2, alternatives, notes = _choose(problem, solutions)
     return finish(problem, x, chi2, "lsq", scale_rule=scale_rule, alternatives=alternatives, notes=notes)
 
@@ -116,7 +118,7 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     )
 
 
-def _local_fit(problem: Problem, x0: np.ndarray, max_nfev: int) -> tuple[np.ndarray, float]:
+def _local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:
     """One bounded trust-region fit from ``x0``: (x, χ²)."""
     def residuals(x):
         r = problem.residuals(x)
@@ -130,7 +132,7 @@ def _local_fit(problem: Problem, x0: np.ndarray, max_nfev: int) -> tuple[np.ndar
     eps = 1e-10 * (problem.upper - problem.lower)
     x0 = np.clip(x0, problem.lower + eps, problem.upper - eps)
     res = least_squares(residuals, x0, jac=jacobian, bounds=(problem.lower, problem.upper), method="trf",
-                        x_scale="jac", max_nfev=max_nfev, **_TOLERANCES)
+                        x_scale="jac", max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol)
     return res.x, float(2 * res.cost)
 
 

@@ -101,6 +101,11 @@ class Parameter:
         Place of the attachment in its setup (ascending position).
     reference_stiffness : float
         √(EI·H) (N m/rad) of the fixity of an ``end_stiffness`` parameter.
+    slots : tuple of (str, int)
+        For an attachment parameter shared by several setups (the diagnosis's
+        unmodeled mass or support, added to every setup): the (setup, index)
+        pairs it sets. Empty for an attachment of one setup (``setup`` and
+        ``index``).
     """
 
     kind: str
@@ -112,6 +117,13 @@ class Parameter:
     setup: str | None = None
     index: int | None = None
     reference_stiffness: float = 1.0
+    slots: tuple[tuple[str, int], ...] = ()
+
+    def slot(self, setup: str) -> int | None:
+        """Index of the attachment this parameter sets in ``setup`` (None: not in it)."""
+        if self.slots:
+            return dict(self.slots).get(setup)
+        return self.index if setup == self.setup else None
 
     @property
     def name(self) -> str:
@@ -156,7 +168,7 @@ class Parameter:
         if self.kind == "tension":
             return self.member == test.name
         if KINDS[self.kind][0] == "attachment":
-            return self.setup == test.setup
+            return self.slot(test.setup) is not None
         return True
 
 
@@ -359,7 +371,8 @@ def _with_bounds(p: Parameter, bounds: Mapping[str, tuple[float, float]], length
         raise InputError(f"the lower bound must be >= 0, got {lo:g}", field=field)
     if p.kind == "end_stiffness" and hi > 1:
         raise InputError(f"the fixity lies in [0, 1], got upper bound {hi:g}", field=field)
-    return Parameter(p.kind, p.member, p.nominal, p.scale, lo, hi, p.setup, p.index, p.reference_stiffness)
+    return Parameter(p.kind, p.member, p.nominal, p.scale, lo, hi, p.setup, p.index, p.reference_stiffness,
+                     p.slots)
 
 
 def overrides_for(test: Test, parameters: Sequence[Parameter], X: np.ndarray, n_attachments: int,
@@ -383,7 +396,7 @@ def overrides_for(test: Test, parameters: Sequence[Parameter], X: np.ndarray, n_
         elif KINDS[p.kind][0] == "attachment":
             if slot not in out:
                 out[slot] = np.tile(nominal_attachments[slot], (k, 1))
-            out[slot][:, p.index] = p.to_value(column)
+            out[slot][:, p.slot(test.setup)] = p.to_value(column)
         else:
             out[slot] = p.to_value(column) * np.ones(k)
     return out

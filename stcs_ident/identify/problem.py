@@ -190,6 +190,10 @@ class Problem:
                    for k in ("position", "mass", "stiffness")}
             for name, atts in self._atts.items()
         }
+        groups: dict[str, list[int]] = {}
+        for i, m in enumerate(self.measurements):
+            groups.setdefault(m.test.setup, []).append(i)
+        self._groups = list(groups.values())
         self.measured = np.concatenate([m.frequencies for m in self.measurements])
         self.sigma = np.concatenate([m.uncertainty for m in self.measurements])
         self.lower = np.array([q.lower for q in self.parameters])
@@ -220,23 +224,30 @@ class Problem:
         X = np.asarray(X, float)
         single = X.ndim == 1
         X = np.atleast_2d(X)
-        out = []
+        k = X.shape[0]
         cable = self.campaign.cable
-        for m in self.measurements:
-            ov = overrides_for(m.test, self.parameters, X, len(self._atts[m.name]), self._nominal_atts[m.name])
-            ok = _valid_rows(ov, cable.length, self._nominal_atts[m.name]["positions"])
-            f = np.full((X.shape[0], m.modes.size), np.nan)
-            if ok.any():
-                sub = {k: v[ok] for k, v in ov.items()}
-                tension = sub.pop("tension")
-                try:
-                    F = batch_frequencies(cable, self._atts[m.name], tension, int(m.modes.max()),
-                                          tension_model=self.tension_model, **sub)
-                except ModelError as err:
-                    raise InputError(f"the model refused a parameter value: {err.message}",
-                                     field=err.field) from err
-                f[ok] = F[:, m.modes - 1]
-            out.append(f)
+        out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
+        # One solver call per setup: the tests of a setup differ only in their overrides' values.
+        for group in self._groups:
+            first = self.measurements[group[0]]
+            ovs = [overrides_for(self.measurements[i].test, self.parameters, X, len(self._atts[first.name]),
+                                 self._nominal_atts[first.name]) for i in group]
+            ov = {key: np.concatenate([o[key] for o in ovs]) for key in ovs[0]}
+            ok = _valid_rows(ov, cable.length, self._nominal_atts[first.name]["positions"])
+            if not ok.any():
+                continue
+            sub = {key: v[ok] for key, v in ov.items()}
+            tension = sub.pop("tension")
+            n_modes = max(int(self.measurements[i].modes.max()) for i in group)
+            try:
+                F = batch_frequencies(cable, self._atts[first.name], tension, n_modes,
+                                      tension_model=self.tension_model, **sub)
+            except ModelError as err:
+                raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
+            full = np.full((ok.size, n_modes), np.nan)
+            full[ok] = F
+            for j, i in enumerate(group):
+                out[i] = full[j * k:(j + 1) * k, self.measurements[i].modes - 1]
         F = np.concatenate(out, axis=1)
         return F[0] if single else F
 

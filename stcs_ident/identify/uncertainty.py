@@ -26,8 +26,11 @@ from ..errors import StcsWarning
 CORRELATION_LIMIT = 0.995
 #: Condition number of the column-normalised Jacobian above which the fit is ill-conditioned.
 CONDITION_LIMIT = 1e3
-#: A column this small relative to the largest has no effect on the data.
-NO_EFFECT = 1e-9
+#: A column this small relative to the largest has no effect on the data. The Jacobian is a central
+#: difference with a relative step of 1e-6 on frequencies refined to about 1e-12 relative, so a
+#: parameter without effect still shows a column of order 1e-12 / 1e-6 = 1e-6 of a real one's
+#: (observed 8e-9 for a massless attachment's position).
+NO_EFFECT = 1e-6
 
 SCALE_RULES = ("auto", "birge", "never")
 

@@ -1,0 +1,112 @@
+"""Diagnosis: does the nominal model explain the data, and if not, which effect is missing?
+
+:func:`diagnose` fits the nominal model, every single effect of the
+vocabulary and every pair (:mod:`.hypotheses`, :mod:`.fitting`), ranks them
+by AICc, cross-validates each by leaving one mode out, and names the cause
+(:mod:`.selection`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+
+from ..errors import InputError
+from ..identify.problem import gather_measurements
+from ..model import Campaign
+from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
+from .hypotheses import EFFECTS, applicable, build, hypothesis_sets, parse_effects
+from .result import Diagnosis
+from .selection import BASELINE, select
+
+Progress = Callable[[int, int, str], None]
+
+
+def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects: str | Sequence[str] | None = None,
+             picked: Mapping[str, object] | None = None, max_effects: int = 2, tension_model: str = "uniform",
+             progress: Progress | None = None) -> Diagnosis:
+    """Diagnose the nominal model of ``campaign`` against its measured frequencies.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    tests : list of str, optional
+        Tests to use (default every test with frequencies or a record; the
+        others are skipped and listed).
+    effects : str or list of str, optional
+        Effects of the vocabulary to consider (default all of
+        :data:`~stcs_ident.diagnose.hypotheses.EFFECTS`).
+    picked : mapping, optional
+        {test: spectra or Measurement} replacing a test's table.
+    max_effects : int
+        Largest number of effects combined in one hypothesis (1 or 2).
+    tension_model : {"uniform", "per-segment", "none"}
+    progress : callable(k, n, label), optional
+        Called before each hypothesis fit.
+
+    Returns
+    -------
+    Diagnosis
+
+    Raises
+    ------
+    InputError
+        ``field="effects"`` for an unknown effect or one that has nothing
+        to act on in the measured tests (an attachment effect when no
+        measured test's setup has an attachment); ``field="frequencies"``
+        when there are fewer measured frequencies than the smallest
+        hypothesis needs; ``field="test"`` for unknown tests or no data.
+    """
+    started = time.perf_counter()
+    requested = effects is not None
+    names = parse_effects(effects)
+    if max_effects not in (1, 2):
+        raise InputError(f"must be 1 or 2, got {max_effects!r}", field="max_effects")
+    measurements, skipped = gather_measurements(campaign, tests, picked)
+    measured_tests = [m.test for m in measurements]
+    notes: list[str] = []
+    usable = []
+    for e in names:
+        why = applicable(campaign, measured_tests, e)
+        if why is None:
+            usable.append(e)
+        elif requested:
+            raise InputError(why, field="effects")
+        else:
+            notes.append(f"not considered: {why}")
+    n = sum(m.modes.size for m in measurements)
+    sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
+    smallest = min(sizes.values()) if sizes else 0
+    if not usable or n < smallest + 2:
+        raise InputError(f"{n} measured frequencies, but the smallest hypothesis ({smallest} parameter(s)) needs "
+                         f"at least {smallest + 2} (AICc needs n > k + 1)", field="frequencies")
+    sets = [s for s in hypothesis_sets(usable, max_effects) if sum(sizes[e] for e in s) + 2 <= n]
+    dropped = len(hypothesis_sets(usable, max_effects)) - len(sets)
+    if dropped:
+        notes.append(f"{dropped} hypotheses not fitted: more parameters than the {n} frequencies allow")
+    baseline = tuple(e for e in BASELINE if e in EFFECTS and applicable(campaign, measured_tests, e) is None)
+    if baseline and baseline not in sets and sum(len(build(campaign, measured_tests, (e,)).parameters)
+                                                 for e in baseline) + 2 <= n:
+        sets.append(baseline)
+    symmetric = mirror_symmetric(campaign, measurements, tension_model)
+    fits: dict[tuple[str, ...], HypothesisFit] = {}
+    timings: dict[tuple[str, ...], float] = {}
+    total = len(sets)
+    for k, s in enumerate(sets, start=1):
+        label = " + ".join(s) if s else "nominal"
+        if progress is not None:
+            progress(k, total, label)
+        t0 = time.perf_counter()
+        if not s:
+            fit = fit_nominal(campaign, measurements, tension_model)
+        else:
+            seeds = [fits[(e,)].values() for e in s if (e,) in fits and len(s) > 1]
+            fit = fit_hypothesis(campaign, measurements, s, tension_model=tension_model, seeds=seeds,
+                                 symmetric=symmetric)
+            fit.cv_rms_error = cross_validate(fit, measurements, tension_model)
+        fits[s] = fit
+        timings[s] = time.perf_counter() - t0
+    selection = select(fits, n, max_effects)
+    return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
+                     symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
+                     elapsed=time.perf_counter() - started, considered=tuple(usable))

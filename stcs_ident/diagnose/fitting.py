@@ -1,0 +1,274 @@
+"""Fitting one hypothesis: estimate, AICc and the leave-one-mode-out prediction error.
+
+The estimate is the weighted least-squares fit of :mod:`stcs_ident.identify.lsq`
+(χ² with the frequency uncertainties as weights). A free position of an
+unmodeled mass or support is found by a profile scan first: the amplitude
+(and every other parameter) is fitted with the attachment held at each point
+of a grid over the span (half the span when the configuration is symmetric
+about midspan), and the best points start the full fit. Pairs of effects
+also start from the estimates of their single effects.
+
+AICc (Hurvich & Tsai) with known measurement uncertainties:
+
+    AICc = χ² + 2k + 2k(k + 1) / (n − k − 1)
+
+(n measured frequencies, k free parameters; χ² is −2 log L up to a constant).
+
+Leave-one-mode-out cross-validation: for each mode number, the frequencies of
+that mode are removed from every test, the hypothesis is refitted (started
+from the full-data estimate) and the removed frequencies are predicted. A
+parameter with no data left in a fold (the tension of a test whose only mode
+was removed) keeps its nominal value: the prediction is then an honest
+prediction of an unseen test.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..forward import batch_frequencies
+from ..identify.lsq import _local_fit, fit_lsq
+from ..identify.problem import Measurement, Problem
+from ..identify.result import IdentificationResult
+from ..model import Campaign, Test
+from .hypotheses import UNMODELED, Hypothesis, build, free_positions
+
+#: Unmodeled attachments kept from the profile scan as starts of the full fit.
+PROFILE_STARTS = 3
+#: Points of the profile scan over the span (about half of them on a symmetric configuration).
+PROFILE_POINTS = 17
+#: Function evaluations of one local fit of the profile scan (a start, not an estimate).
+PROFILE_NFEV = 30
+#: Tolerance of the local fits: parameters to 1e-10 relative, far below their uncertainty.
+TOL = 1e-10
+
+
+@dataclass
+class HypothesisFit:
+    """One fitted hypothesis.
+
+    Attributes
+    ----------
+    hypothesis : Hypothesis
+    result : IdentificationResult or None
+        None for the nominal model (nothing fitted).
+    predicted : ndarray
+        Model frequencies of every measured frequency (tests in order), Hz.
+    chi2 : float
+    aicc : float
+    rms_error : float
+        Root mean square of the relative errors, %.
+    cv_rms_error : float or None
+        Leave-one-mode-out prediction error, % (None when a fold has fewer
+        data than parameters).
+    notes : list of str
+    profile : list of (position m, χ²), optional
+        The profile scan of an unmodeled attachment's position.
+    """
+
+    hypothesis: Hypothesis
+    result: IdentificationResult | None
+    predicted: np.ndarray
+    chi2: float
+    aicc: float
+    rms_error: float
+    cv_rms_error: float | None = None
+    notes: list[str] = field(default_factory=list)
+    profile: list[tuple[float, float]] = field(default_factory=list)
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        return self.hypothesis.effects
+
+    @property
+    def n_parameters(self) -> int:
+        return len(self.hypothesis.parameters)
+
+    def values(self) -> dict[tuple[str, str | None], float]:
+        """SI value of every parameter, keyed by (kind, member)."""
+        if self.result is None:
+            return {}
+        return {(p.kind, p.member): float(v) for p, v in zip(self.result.parameters, self.result.values)}
+
+
+def aicc(chi2: float, n: int, k: int) -> float:
+    """Corrected Akaike criterion for least squares with known uncertainties (inf if n ≤ k + 1)."""
+    if n - k - 1 <= 0:
+        return math.inf
+    return chi2 + 2 * k + 2 * k * (k + 1) / (n - k - 1)
+
+
+def rms_percent(predicted: np.ndarray, measured: np.ndarray) -> float:
+    """Root mean square of (predicted − measured) / measured, %."""
+    return float(np.sqrt(np.mean(((predicted - measured) / measured * 100.0) ** 2)))
+
+
+def nominal_prediction(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> np.ndarray:
+    """Frequencies of the nominal model at every measured mode."""
+    out = []
+    for m in measurements:
+        atts = campaign.setup(m.test.setup).attachments
+        f = batch_frequencies(campaign.cable, atts, m.test.tension, int(m.modes.max()), tension_model=tension_model)
+        out.append(np.asarray(f)[m.modes - 1])
+    return np.concatenate(out)
+
+
+def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> HypothesisFit:
+    measured = np.concatenate([m.frequencies for m in measurements])
+    sigma = np.concatenate([m.uncertainty for m in measurements])
+    f = nominal_prediction(campaign, measurements, tension_model)
+    chi2 = float(np.sum(((f - measured) / sigma) ** 2))
+    rms = rms_percent(f, measured)
+    hyp = Hypothesis((), campaign, (), ())
+    return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms)
+
+
+def _quiet(fn, notes: list[str]):
+    """Run ``fn`` collecting warnings as notes (the diagnosis reports them, pytest must not fail on them)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = fn()
+    for w in caught:
+        text = str(w.message).splitlines()[0]
+        if text not in notes:
+            notes.append(text)
+    return out
+
+
+def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None], float]],
+                 nominal: bool = True) -> np.ndarray:
+    """Variable vectors of ``problem`` from SI values by (kind, member); missing ones nominal.
+
+    An unmodeled amplitude missing from a seed starts at 1 % of its upper bound rather than
+    at zero (a trust-region fit creeps away from a bound slowly).
+    """
+    start = problem.start.copy()
+    for j, p in enumerate(problem.parameters):
+        if p.slots and p.kind in ("mass", "stiffness"):
+            start[j] = 0.01 * problem.upper[j]
+    rows = [start] if nominal or not seeds else []
+    for seed in seeds:
+        x = start.copy()
+        for j, p in enumerate(problem.parameters):
+            v = seed.get((p.kind, p.member))
+            if v is None:
+                continue
+            if p.kind == "end_stiffness":
+                from ..identify.parameters import fixity
+
+                x[j] = fixity(v, p.reference_stiffness)
+            else:
+                x[j] = v / p.scale
+        rows.append(np.clip(x, problem.lower, problem.upper))
+    return np.unique(np.array(rows), axis=0)
+
+
+def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effects: Sequence[str], *,
+                   tension_model: str = "uniform", seeds: Sequence[Mapping] = (), symmetric: bool = False,
+                   max_nfev: int = 200) -> HypothesisFit:
+    """Fit the hypothesis ``effects`` (at least one effect) to the measurements."""
+    tests = [m.test for m in measurements]
+    notes: list[str] = []
+    extra = [e for e in effects if e in UNMODELED]
+    profile: list[tuple[float, float]] = []
+    seeds = list(seeds)
+    positions: dict[str, float] = {}
+    for e in extra:
+        given = [s[("position", UNMODELED[e])] for s in seeds if ("position", UNMODELED[e]) in s]
+        if given:
+            positions[e] = given[0]
+    if extra:
+        scanned = extra[0]
+        grid = free_positions(campaign, tests, PROFILE_POINTS)
+        if symmetric:
+            grid = grid[grid <= campaign.cable.length / 2 + 1e-9]
+        rows = []
+        previous: dict = {}
+        for x in grid:
+            hyp = build(campaign, tests, effects, {**positions, scanned: float(x)}, fixed=(scanned,))
+            problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+            starts = _starts_from(problem, [previous, *seeds] if previous else seeds, nominal=not previous)
+            xb, c = _quiet(lambda problem=problem, starts=starts: min(
+                (_local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
+            values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
+            values[("position", UNMODELED[scanned])] = float(x)
+            previous = values
+            rows.append((c, float(x), values))
+            profile.append((float(x), c))
+        rows.sort(key=lambda r: r[0])
+        chosen: list[tuple] = []
+        spacing = 1.5 * (grid[1] - grid[0]) if grid.size > 1 else 0.0
+        for r in rows:
+            if all(abs(r[1] - c[1]) > spacing for c in chosen):
+                chosen.append(r)
+            if len(chosen) == PROFILE_STARTS:
+                break
+        positions[scanned] = chosen[0][1]
+        seeds = [c[2] for c in chosen] + seeds
+    hyp = build(campaign, tests, effects, positions)
+    problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+    starts = _starts_from(problem, seeds)
+    has_position = any(p.kind == "position" and not p.slots for p in problem.parameters)
+    options = {} if has_position else {"n_starts": 0}
+    result = _quiet(lambda: fit_lsq(problem, starts=None if has_position and not seeds else starts,
+                                    max_nfev=max_nfev, tol=TOL, **options), notes)
+    if has_position and seeds and not extra:  # the scan of recorded attachments' positions, besides the seeds
+        other = _quiet(lambda: fit_lsq(problem, max_nfev=max_nfev, tol=TOL), [])
+        if other.chi2 < result.chi2 * (1 - 1e-9):
+            result = other
+    notes += [n for n in result.notes if n not in notes]
+    n = problem.n_data
+    predicted = problem.predict(result.estimate)
+    fit = HypothesisFit(hyp, result, predicted, result.chi2, aicc(result.chi2, n, len(hyp.parameters)),
+                        rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile))
+    return fit
+
+
+def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tension_model: str,
+                   max_nfev: int = 100) -> float | None:
+    """Leave-one-mode-out prediction error of a fitted hypothesis, % (None if a fold cannot be fitted)."""
+    if fit.result is None:
+        return fit.rms_error
+    hyp = fit.hypothesis
+    full = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+    x_full = fit.result.estimate
+    measured = full.measured
+    modes = np.concatenate([m.modes for m in measurements])
+    predicted = np.full(measured.size, np.nan)
+    for mode in np.unique(modes):
+        kept = []
+        for m in measurements:
+            keep = m.modes != mode
+            if keep.any():
+                kept.append(Measurement(m.test, m.modes[keep], m.frequencies[keep], m.uncertainty[keep], m.source))
+        used = [j for j, p in enumerate(hyp.parameters) if any(p.applies_to(m.test) for m in kept)]
+        x = full.start.copy()
+        n_kept = sum(m.modes.size for m in kept)
+        if not used or n_kept <= len(used):
+            return None
+        sub = Problem(hyp.campaign, kept, [hyp.parameters[j] for j in used], tension_model)
+        x_sub, _ = _quiet(lambda sub=sub, used=used: _local_fit(sub, x_full[used], max_nfev, TOL), [])
+        x[used] = x_sub
+        left = modes == mode
+        predicted[left] = full.predict(x)[left]
+    if not np.all(np.isfinite(predicted)):
+        return None
+    return rms_percent(predicted, measured)
+
+
+def mirror_symmetric(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> bool:
+    """Whether an extra mass at x and at l − x give the same frequencies (a configuration symmetric
+    about midspan), checked numerically on the measured tests' setups."""
+    tests: list[Test] = [m.test for m in measurements]
+    length = campaign.cable.length
+    f = []
+    for x in (0.31 * length, 0.69 * length):
+        hyp = build(campaign, tests, ("unmodeled_mass",), {"unmodeled_mass": x}, fixed=("unmodeled_mass",))
+        problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+        f.append(problem.predict(np.array([0.05 * campaign.cable.mass_per_length * length])))
+    return bool(np.allclose(f[0], f[1], rtol=1e-9, atol=0))

@@ -1,0 +1,233 @@
+"""The diagnosis result: the ``diagnose`` JSON of ``interface.md`` and a text summary."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..identify.problem import Measurement
+from ..model import Campaign
+from .fitting import HypothesisFit
+from .hypotheses import UNMODELED
+from .selection import BASELINE, Selection, ranking
+
+
+def _finite_or_none(v: float | None) -> float | None:
+    return None if v is None or not math.isfinite(v) else float(v)
+
+
+def effect_parameters(fit: HypothesisFit, length: float, symmetric: bool) -> tuple[dict, dict]:
+    """Values and standard uncertainties by effect, in the units of ``interface.md``.
+
+    A position on a configuration symmetric about midspan is given in
+    [0, l/2] (x and l − x cannot be told apart).
+    """
+    values: dict = {}
+    sigmas: dict = {}
+    if fit.result is None:
+        return values, sigmas
+    res = fit.result
+    for p, owner, x, s, v in zip(res.parameters, fit.hypothesis.owners, res.estimate, res.uncertainty, res.values):
+        v, s_si = float(v), float(p.value_uncertainty(x, s))
+        val, sig = values.setdefault(owner, {}), sigmas.setdefault(owner, {})
+        if owner == "tension":
+            val.setdefault("ratio", {})[p.member] = float(x)
+            sig.setdefault("ratio", {})[p.member] = _finite_or_none(float(s))
+        elif owner == "bending_stiffness":
+            val["EI"], sig["EI"] = v, _finite_or_none(s_si)
+        elif owner == "length":
+            val["length"], sig["length"] = v, _finite_or_none(s_si)
+        elif owner == "end_restraint":
+            key = "rotational_stiffness" if p.member == "AB" else f"rotational_stiffness_{p.member}"
+            val[key], sig[key] = (_finite_or_none(v) if math.isfinite(v) else "inf"), _finite_or_none(s_si)
+            val["fixity" if p.member == "AB" else f"fixity_{p.member}"] = float(x)
+        elif owner in UNMODELED:
+            if p.kind == "position":
+                if symmetric and v > length / 2:
+                    v = length - v
+                val["position"], sig["position"] = v, _finite_or_none(s_si)
+            else:
+                val[p.kind], sig[p.kind] = v, _finite_or_none(s_si)
+        else:
+            key = "position" if owner == "attachment_position" else "mass"
+            val.setdefault(key, {})[p.member] = v
+            sig.setdefault(key, {})[p.member] = _finite_or_none(s_si)
+    return values, sigmas
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What :func:`~stcs_ident.diagnose.diagnose` found.
+
+    Attributes
+    ----------
+    campaign : Campaign
+    measurements : tuple of Measurement
+    fits : dict
+        {effects: HypothesisFit}; ``()`` is the nominal model.
+    selection : Selection
+    symmetric : bool
+        Whether the measured setups are symmetric about midspan.
+    skipped, notes : tuple
+    timings : dict
+        Seconds per hypothesis (fit and cross-validation).
+    elapsed : float
+        Seconds in all.
+    considered : tuple of str
+        The effects that made hypotheses.
+    """
+
+    campaign: Campaign
+    measurements: tuple[Measurement, ...]
+    fits: dict
+    selection: Selection
+    symmetric: bool
+    skipped: tuple = ()
+    notes: tuple = ()
+    timings: dict = field(default_factory=dict)
+    elapsed: float = 0.0
+    considered: tuple = ()
+
+    @property
+    def measured(self) -> np.ndarray:
+        return np.concatenate([m.frequencies for m in self.measurements])
+
+    @property
+    def nominal(self) -> HypothesisFit:
+        return self.fits[()]
+
+    @property
+    def corrected(self) -> HypothesisFit:
+        """The fit of the named cause (the nominal model when the cause is empty)."""
+        return self.fits[self.selection.effects]
+
+    @property
+    def baseline(self) -> HypothesisFit | None:
+        """Tension and EI re-estimated (the paper's correction), or what of it applies."""
+        for key in (BASELINE, ("tension",)):
+            if key in self.fits:
+                return self.fits[key]
+        return None
+
+    @property
+    def ranked(self) -> list[HypothesisFit]:
+        return ranking(self.fits)
+
+    def parameters(self, fit: HypothesisFit) -> tuple[dict, dict]:
+        return effect_parameters(fit, self.campaign.cable.length, self.symmetric)
+
+    def per_test(self, fit: HypothesisFit) -> list[np.ndarray]:
+        """``fit.predicted`` split by test."""
+        out, k = [], 0
+        for m in self.measurements:
+            out.append(fit.predicted[k:k + m.modes.size])
+            k += m.modes.size
+        return out
+
+    def summary(self) -> dict:
+        """The ``diagnose`` JSON of ``interface.md`` (plus optional keys)."""
+        nominal, corrected, baseline = self.nominal, self.corrected, self.baseline
+        tests = []
+        parts = {"nominal": self.per_test(nominal), "corrected": self.per_test(corrected)}
+        if baseline is not None:
+            parts["baseline"] = self.per_test(baseline)
+        for i, m in enumerate(self.measurements):
+            entry = {"name": m.name, "setup": m.test.setup, "modes": [int(k) for k in m.modes],
+                     "measured": m.frequencies.tolist(), "uncertainty": m.uncertainty.tolist(), "source": m.source}
+            for label, values in parts.items():
+                entry[label] = values[i].tolist()
+            for label, values in parts.items():
+                entry[f"{label}_error"] = ((values[i] - m.frequencies) / m.frequencies * 100.0).tolist()
+            tests.append(entry)
+        ranked = self.ranked
+        best = ranked[0].aicc
+        hypotheses = []
+        for f in ranked:
+            values, sigmas = self.parameters(f)
+            hypotheses.append({"effects": list(f.effects), "parameters": values, "uncertainty": sigmas,
+                               "n_parameters": f.n_parameters, "chi2": f.chi2, "rms_error": f.rms_error,
+                               "aicc": _finite_or_none(f.aicc), "delta_aicc": _finite_or_none(f.aicc - best),
+                               "cv_rms_error": _finite_or_none(f.cv_rms_error), "notes": list(f.notes)})
+        sel = self.selection
+        values, sigmas = self.parameters(corrected)
+        gain = {"rms_error_nominal": nominal.rms_error, "rms_error_corrected": corrected.rms_error,
+                "cv_rms_error_nominal": nominal.cv_rms_error,
+                "cv_rms_error_corrected": _finite_or_none(corrected.cv_rms_error)}
+        if baseline is not None:
+            gain["rms_error_baseline"] = baseline.rms_error
+            gain["cv_rms_error_baseline"] = _finite_or_none(baseline.cv_rms_error)
+        return {
+            "campaign": self.campaign.name,
+            "tests": tests,
+            "hypotheses": hypotheses,
+            "cause": {"effects": list(sel.effects), "principal": sel.principal, "parameters": values,
+                      "uncertainty": sigmas, "ambiguous_with": [list(a) for a in sel.ambiguous_with],
+                      "explained_by_nominal": sel.explained, "p_value_nominal": sel.p_value,
+                      "removal_cost": {k: _finite_or_none(v) for k, v in sel.removal_cost.items()},
+                      "statement": sel.statement, "description": self.cause_text()},
+            "gain": gain,
+            "symmetric": self.symmetric,
+            "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
+            "notes": list(self.notes),
+            "seconds": self.elapsed,
+        }
+
+    def cause_text(self) -> str:
+        """The named cause in plain words, with values and uncertainties."""
+        sel = self.selection
+        if not sel.effects:
+            return sel.statement
+        values, sigmas = self.parameters(self.corrected)
+        parts = [_describe(e, values.get(e, {}), sigmas.get(e, {}), self.campaign.cable) for e in sel.effects]
+        delta = self.nominal.aicc - self.corrected.aicc
+        text = f"{'; '.join(parts)} explain{'s' if len(parts) == 1 else ''} the residual pattern"
+        text = text[0].upper() + text[1:]
+        text += f" (ΔAICc = {delta:.1f} against the nominal model; principal effect: {sel.principal})."
+        if sel.ambiguous_with:
+            text += (" Not told apart from: " + "; ".join(" + ".join(a) for a in sel.ambiguous_with)
+                     + " (ΔAICc < 2).")
+        return text
+
+    def text(self) -> str:
+        """Human-readable summary for the terminal."""
+        from .report import diagnosis_text
+
+        return diagnosis_text(self)
+
+
+def _pm(value: float, sigma: float | None, digits: int = 3) -> str:
+    if sigma is None or not math.isfinite(sigma):
+        return f"{value:.{digits}g}"
+    return f"{value:.{digits}g} ± {sigma:.2g}"
+
+
+def _describe(effect: str, val: dict, sig: dict, cable) -> str:
+    if effect == "tension":
+        ratios = ", ".join(f"{t}: {_pm(v, sig['ratio'].get(t), 4)}" for t, v in val["ratio"].items())
+        return f"tensions differ from the measured ones (true/measured {ratios})"
+    if effect == "bending_stiffness":
+        return (f"an effective bending stiffness EI = {_pm(val['EI'] / 1e3, _div(sig.get('EI'), 1e3))} kN m² "
+                f"({val['EI'] / cable.EI:.3g} × nominal)")
+    if effect == "length":
+        return f"a vibrating length of {_pm(val['length'], sig.get('length'), 5)} m (nominal {cable.length:g} m)"
+    if effect == "end_restraint":
+        k = val.get("rotational_stiffness")
+        shown = "clamped" if k == "inf" else f"{_pm(k, sig.get('rotational_stiffness'))} N m/rad"
+        return f"anchorages restrained by a rotational stiffness {shown} (fixity {val.get('fixity', math.nan):.3f})"
+    if effect == "unmodeled_mass":
+        return (f"an unmodeled mass of {_pm(val['mass'], sig.get('mass'))} kg near "
+                f"{_pm(val['position'], sig.get('position'))} m")
+    if effect == "unmodeled_support":
+        return (f"an unmodeled support of {_pm(val['stiffness'], sig.get('stiffness'))} N/m near "
+                f"{_pm(val['position'], sig.get('position'))} m")
+    if effect == "attachment_position":
+        where = ", ".join(f"{a} at {_pm(v, sig['position'].get(a))} m" for a, v in val["position"].items())
+        return f"attachments elsewhere than recorded ({where})"
+    masses = ", ".join(f"{a}: {_pm(v, sig['mass'].get(a))} kg" for a, v in val["mass"].items())
+    return f"attachment masses differ from the recorded ones ({masses})"
+
+
+def _div(v: float | None, d: float) -> float | None:
+    return None if v is None else v / d
