@@ -100,9 +100,9 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         if not s:
             fit = fit_nominal(campaign, measurements, tension_model)
         else:
-            seeds = [fits[(e,)].values() for e in s if (e,) in fits and len(s) > 1]
+            seeds = _pair_seeds(fits, s) if len(s) > 1 else []
             fit = fit_hypothesis(campaign, measurements, s, tension_model=tension_model, seeds=seeds,
-                                 symmetric=symmetric)
+                                 symmetric=symmetric, scan=len(s) == 1)
             fit.cv_rms_error = cross_validate(fit, measurements, tension_model)
         fits[s] = fit
         timings[s] = time.perf_counter() - t0
@@ -110,3 +110,17 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
                      elapsed=time.perf_counter() - started, considered=tuple(usable))
+
+
+def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
+    """Starts of a pair: each single effect's estimate and profile minima, completed by the other's estimate."""
+    singles = [fits[(e,)] for e in effects if (e,) in fits]
+    seeds = []
+    for i, fit in enumerate(singles):
+        others: dict = {}
+        for j, other in enumerate(singles):
+            if j != i:
+                others.update(other.values())
+        for point in [fit.values(), *fit.minima]:
+            seeds.append({**others, **point})
+    return seeds

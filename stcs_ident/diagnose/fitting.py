@@ -69,6 +69,9 @@ class HypothesisFit:
     notes : list of str
     profile : list of (position m, χ²), optional
         The profile scan of an unmodeled attachment's position.
+    minima : list of dict
+        The best distinct points of the profile scan (SI values by (kind,
+        member)): the starts of pairs that contain this effect.
     """
 
     hypothesis: Hypothesis
@@ -80,6 +83,7 @@ class HypothesisFit:
     cv_rms_error: float | None = None
     notes: list[str] = field(default_factory=list)
     profile: list[tuple[float, float]] = field(default_factory=list)
+    minima: list[dict] = field(default_factory=list)
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -170,8 +174,14 @@ def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None
 
 def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effects: Sequence[str], *,
                    tension_model: str = "uniform", seeds: Sequence[Mapping] = (), symmetric: bool = False,
-                   max_nfev: int = 200) -> HypothesisFit:
-    """Fit the hypothesis ``effects`` (at least one effect) to the measurements."""
+                   scan: bool = True, max_nfev: int = 200) -> HypothesisFit:
+    """Fit the hypothesis ``effects`` (at least one effect) to the measurements.
+
+    ``seeds`` are starts (SI values by (kind, member)); with ``scan`` an
+    unmodeled attachment's position is scanned first (the single effects),
+    without it its starts come from the seeds (the pairs, seeded with the
+    single effects' profile minima).
+    """
     tests = [m.test for m in measurements]
     notes: list[str] = []
     extra = [e for e in effects if e in UNMODELED]
@@ -182,7 +192,8 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         given = [s[("position", UNMODELED[e])] for s in seeds if ("position", UNMODELED[e]) in s]
         if given:
             positions[e] = given[0]
-    if extra:
+    minima: list[dict] = []
+    if extra and scan:
         scanned = extra[0]
         grid = free_positions(campaign, tests, PROFILE_POINTS)
         if symmetric:
@@ -192,7 +203,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         for x in grid:
             hyp = build(campaign, tests, effects, {**positions, scanned: float(x)}, fixed=(scanned,))
             problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
-            starts = _starts_from(problem, [previous, *seeds] if previous else seeds, nominal=not previous)
+            starts = _starts_from(problem, [previous] if previous else seeds, nominal=not previous)
             xb, c = _quiet(lambda problem=problem, starts=starts: min(
                 (_local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
@@ -209,7 +220,8 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             if len(chosen) == PROFILE_STARTS:
                 break
         positions[scanned] = chosen[0][1]
-        seeds = [c[2] for c in chosen] + seeds
+        minima = [c[2] for c in chosen]
+        seeds = minima + seeds
     hyp = build(campaign, tests, effects, positions)
     problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
     starts = _starts_from(problem, seeds)
@@ -225,7 +237,8 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     n = problem.n_data
     predicted = problem.predict(result.estimate)
     fit = HypothesisFit(hyp, result, predicted, result.chi2, aicc(result.chi2, n, len(hyp.parameters)),
-                        rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile))
+                        rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
+                        minima=minima)
     return fit
 
 

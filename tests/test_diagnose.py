@@ -1,0 +1,169 @@
+"""Diagnosis: selection rules, the JSON contract and bad input (fast cases from exact frequencies).
+
+The hidden-effect tests that run the whole pipeline from simulated records
+are in test_diagnose_hidden.py.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from stcs_ident.cli import main
+from stcs_ident.diagnose import EFFECTS, diagnose
+from stcs_ident.diagnose.fitting import aicc
+from stcs_ident.diagnose.hypotheses import parse_effects
+from stcs_ident.errors import InputError
+from stcs_ident.forward import batch_frequencies
+from stcs_ident.identify.problem import Measurement
+from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.spectra.effects import Effects, true_model
+
+CABLE = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5)
+SETUP = Setup("S", (Attachment("clamp", 2.7, 15.0),))
+TENSIONS = (4.0e5, 5.0e5)
+N_MODES = 6
+#: Relative frequency uncertainty of the synthetic measurements (a good record gives 1e-5 to 1e-4).
+REL_SIGMA = 5e-5
+
+
+def synthetic(effects=None, seed=0, setup=SETUP, tensions=TENSIONS, n_modes=N_MODES, noise=True):
+    """Campaign (nominal) and measurements from the true model with ``effects``, noise REL_SIGMA."""
+    rng = np.random.default_rng(seed)
+    tests, picked = [], {}
+    for i, H in enumerate(tensions):
+        cable, atts, h = true_model(CABLE, setup.attachments, H, effects)
+        f = batch_frequencies(cable, atts, h, n_modes)
+        sigma = REL_SIGMA * f
+        if noise:
+            f = f + rng.normal(0.0, sigma)
+        test = Test(f"T{i + 1}", setup.name, H)
+        tests.append(test)
+        picked[test.name] = Measurement(test, np.arange(1, n_modes + 1), f, sigma, "given")
+    return Campaign("synthetic", CABLE, (setup,), tuple(tests)), picked
+
+
+def test_aicc_penalises_parameters_and_small_samples():
+    assert aicc(10.0, 20, 0) == 10.0
+    assert aicc(10.0, 20, 2) == pytest.approx(10.0 + 4 + 12 / 17)
+    assert aicc(10.0, 3, 2) == np.inf
+
+
+def test_no_effect_gives_an_empty_cause():
+    campaign, picked = synthetic(None, seed=3)
+    d = diagnose(campaign, picked=picked, max_effects=1)
+    s = d.summary()
+    assert s["cause"]["effects"] == [] and s["cause"]["principal"] is None
+    assert s["cause"]["explained_by_nominal"] and s["cause"]["p_value_nominal"] >= 1e-3
+    assert s["gain"]["rms_error_corrected"] == s["gain"]["rms_error_nominal"]
+
+
+def test_hidden_bending_stiffness_is_named_with_its_value():
+    campaign, picked = synthetic(Effects(EI_ratio=1.25), seed=1)
+    d = diagnose(campaign, picked=picked, max_effects=1)
+    s = d.summary()
+    assert s["cause"]["principal"] == "bending_stiffness"
+    # 5e-5 relative noise on 12 frequencies of a cable with ξ ≈ 11: EI to well under 1 %.
+    assert s["cause"]["parameters"]["bending_stiffness"]["EI"] == pytest.approx(1.25 * CABLE.EI, rel=0.01)
+    assert s["gain"]["rms_error_corrected"] < 0.1 * s["gain"]["rms_error_nominal"]
+
+
+def test_json_follows_the_contract(tmp_path):
+    campaign, picked = synthetic(Effects(tension_ratio=1.02), seed=2)
+    s = diagnose(campaign, picked=picked, max_effects=1).summary()
+    assert {"campaign", "tests", "hypotheses", "cause", "gain"} <= set(s)
+    for t in s["tests"]:
+        assert {"name", "modes", "measured", "nominal", "corrected", "nominal_error", "corrected_error"} <= set(t)
+        assert len(t["nominal"]) == len(t["modes"]) == len(t["corrected_error"])
+    h = s["hypotheses"]
+    assert [x["delta_aicc"] for x in h] == sorted(x["delta_aicc"] for x in h) and h[0]["delta_aicc"] == 0
+    for x in h:
+        assert {"effects", "parameters", "n_parameters", "rms_error", "aicc", "delta_aicc", "cv_rms_error"} <= set(x)
+    assert {"effects", "principal", "parameters", "ambiguous_with"} <= set(s["cause"])
+    assert {"rms_error_nominal", "rms_error_corrected", "cv_rms_error_baseline", "cv_rms_error_corrected"} <= set(
+        s["gain"])
+    assert s["cause"]["principal"] == "tension"
+    ratios = s["cause"]["parameters"]["tension"]["ratio"]
+    assert ratios == pytest.approx({"T1": 1.02, "T2": 1.02}, rel=1e-3)
+    json.dumps(s, allow_nan=False)  # strict JSON: no NaN or inf
+
+
+def test_a_mass_on_a_symmetric_cable_is_reported_in_the_first_half():
+    bare = Setup("S")
+    campaign, picked = synthetic(Effects(extra_mass=(6.0, 5.6)), seed=4, setup=bare)
+    d = diagnose(campaign, effects="unmodeled_mass", picked=picked)
+    assert d.symmetric
+    cause = d.summary()["cause"]
+    assert cause["effects"] == ["unmodeled_mass"]
+    assert cause["parameters"]["unmodeled_mass"]["position"] == pytest.approx(8.0 - 5.6, abs=0.02 * 8.0)
+    assert cause["parameters"]["unmodeled_mass"]["mass"] == pytest.approx(6.0, rel=0.05)
+
+
+def test_effect_names_come_from_the_vocabulary():
+    assert parse_effects(None) == EFFECTS
+    assert parse_effects("length, tension") == ("tension", "length")
+    with pytest.raises(InputError, match="unknown effect 'sag'") as err:
+        parse_effects("tension,sag")
+    assert err.value.field == "effects"
+
+
+# --- bad input through the command line: exit 2, one line naming the file and the field, nothing written
+
+
+def _campaign_dir(tmp_path, tests_toml, setup_toml='[[setup]]\nname = "S"\n'):
+    d = tmp_path / "camp"
+    d.mkdir()
+    (d / "campaign.toml").write_text(
+        '[campaign]\nname = "c"\n[cable]\nlength = 8.0\nmass_per_length = 30.0\nEI = 2.0e5\n'
+        + setup_toml + tests_toml, encoding="utf-8")
+    return d
+
+
+def _run(capsys, argv):
+    code = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    return code, err
+
+
+TWO_TESTS = ('[[test]]\nname = "T1"\nsetup = "S"\ntension = 4.0e5\nfrequencies = [8.65, 18.88, 33.44, 48.84]\n'
+             '[[test]]\nname = "T2"\nsetup = "S"\ntension = 5.0e5\nfrequencies = [9.40, 20.24, 35.31, 50.91]\n')
+
+
+def test_cli_unknown_effect_is_refused(tmp_path, capsys):
+    d = _campaign_dir(tmp_path, TWO_TESTS)
+    out = tmp_path / "out.json"
+    code, err = _run(capsys, ["diagnose", str(d), "--effects", "tension,wind", "--json", str(out)])
+    assert code == 2 and len(err) == 1
+    assert "campaign.toml" in err[0] and "field 'effects'" in err[0] and "'wind'" in err[0]
+    assert not out.exists()
+
+
+def test_cli_too_few_modes_is_refused(tmp_path, capsys):
+    d = _campaign_dir(tmp_path, '[[test]]\nname = "T1"\nsetup = "S"\ntension = 4.0e5\nfrequencies = [8.65, 18.88]\n')
+    out = tmp_path / "report"
+    code, err = _run(capsys, ["diagnose", str(d), "--out", str(out)])
+    assert code == 2 and len(err) == 1
+    assert "field 'frequencies'" in err[0] and "2 measured frequencies" in err[0]
+    assert not out.exists()
+
+
+def test_cli_attachment_effect_without_a_setup_that_has_one_is_refused(tmp_path, capsys):
+    setups = '[[setup]]\nname = "S"\n[[setup]]\nname = "W"\n  [[setup.attachment]]\n  name = "W1"\n  position = 4.0\n  mass = 5.0\n'
+    d = _campaign_dir(tmp_path, TWO_TESTS, setups)
+    code, err = _run(capsys, ["diagnose", str(d), "--effects", "attachment_position"])
+    assert code == 2 and len(err) == 1
+    assert "field 'effects'" in err[0] and "setup" in err[0]
+
+
+def test_cli_writes_json(tmp_path, capsys):
+    d = _campaign_dir(tmp_path, TWO_TESTS)
+    out = tmp_path / "d.json"
+    code = main(["diagnose", str(d), "--max-effects", "1", "--json", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0
+    data = json.loads(out.read_text())
+    assert data["campaign"] == "c" and data["hypotheses"]
+    assert "hypothesis 1 of" in captured.err  # progress
+    assert "Cause:" in captured.out
