@@ -39,7 +39,9 @@ comes with pyOMA-2's scikit-learn), the time with BLAS limited to one
 thread, and prints the load average.
 
 Run: ``python benchmarks/spectra.py [--quick]`` (about 1.5 minutes on two idle
-cores; ``--quick``: one record per case, one timing repeat, about 25 s).
+cores; ``--quick``: one record per case, one timing repeat, about 25 s), or
+``python benchmarks/spectra.py --throughput [--repeat N]`` for the find_peaks
+throughput case alone (N runs, default 5; pyOMA-2 not needed).
 """
 
 from __future__ import annotations
@@ -326,11 +328,8 @@ def timed(func, repeat: int) -> list[float]:
     return times
 
 
-def throughput(quick: bool) -> dict:
-    """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and pyOMA FDD wall time."""
-    from pyoma2.algorithms.fdd import FDD
-    from pyoma2.setup.single import SingleSetup
-
+def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) -> dict:
+    """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time."""
     from stcs_ident.forward import count_below
     from stcs_ident.spectra.peaks import find_peaks
     from stcs_ident.spectra.simulate import NYQUIST_FRACTION, Ambient
@@ -347,7 +346,7 @@ def throughput(quick: bool) -> dict:
     truth = true_frequencies(stay, n_true)
     gaps = np.diff(truth)
     spacing = np.minimum(np.r_[np.inf, gaps], np.r_[gaps, np.inf])
-    repeat = 1 if quick else 3
+    repeat = repeat or (1 if quick else 3)
 
     holder = {}
     ours_default = timed(lambda: holder.update(result=find_peaks(record)), repeat)
@@ -367,6 +366,14 @@ def throughput(quick: bool) -> dict:
             err[k] = abs(found[j] / ft - 1)
 
     nxseg = pyoma_nxseg(fs, record.n_samples, truth[0], stay.damping)
+    result = {"shape": record.acceleration.shape, "t_sim": t_sim, "ours": ours_default, "ours_1": ours_single,
+              "fdd": None, "nxseg": nxseg, "n_true": n_true, "missed": [k + 1 for k in np.flatnonzero(np.isnan(err))],
+              "n_peaks": len(holder["result"].peaks), "err": float(np.nanmedian(err)), "fdd_err": float("nan"),
+              "repeat": repeat}
+    if not with_fdd:
+        return result
+    from pyoma2.algorithms.fdd import FDD
+    from pyoma2.setup.single import SingleSetup
 
     def fdd():
         setup = SingleSetup(record.acceleration, fs)
@@ -376,11 +383,9 @@ def throughput(quick: bool) -> dict:
             setup.mpe("FDD", sel_freq=list(truth), DF=PYOMA_DF_FRACTION * gaps.min())
         holder["fdd"] = np.asarray(setup["FDD"].result.Fn, dtype=float)
 
-    t_fdd = timed(fdd, repeat)
-    return {"shape": record.acceleration.shape, "t_sim": t_sim, "ours": ours_default, "ours_1": ours_single,
-            "fdd": t_fdd, "nxseg": nxseg, "n_true": n_true, "missed": [k + 1 for k in np.flatnonzero(np.isnan(err))],
-            "n_peaks": len(holder["result"].peaks), "err": float(np.nanmedian(err)),
-            "fdd_err": float(np.median(np.abs(holder["fdd"] / truth - 1))), "repeat": repeat}
+    result["fdd"] = timed(fdd, repeat)
+    result["fdd_err"] = float(np.median(np.abs(holder["fdd"] / truth - 1)))
+    return result
 
 
 def print_throughput(tp: dict) -> None:
@@ -398,8 +403,9 @@ def print_throughput(tp: dict) -> None:
              f"{n_found}/{tp['n_true']} found, {fmt_err(tp['err'])}")]
     if tp["ours_1"] is not None:
         rows.append(("find_peaks, BLAS limited to 1 thread", tp["ours_1"], f"<= {THROUGHPUT_TARGET:g}", "same"))
-    rows.append((f"pyOMA FDD, nxseg {tp['nxseg']}, at truth", tp["fdd"], "",
-                 f"{tp['n_true']} given, {fmt_err(tp['fdd_err'])}"))
+    if tp["fdd"] is not None:
+        rows.append((f"pyOMA FDD, nxseg {tp['nxseg']}, at truth", tp["fdd"], "",
+                     f"{tp['n_true']} given, {fmt_err(tp['fdd_err'])}"))
     for name, times, target, acc in rows:
         cells = (name, f"{statistics.median(times):.2f}", f"{min(times):.2f}", target, acc)
         print("  " + " ".join(x.rjust(w) for x, w in zip(cells, widths)))
@@ -414,7 +420,13 @@ def print_throughput(tp: dict) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one record per case and one timing repeat (~30 s)")
+    parser.add_argument("--throughput", action="store_true",
+                        help="only the find_peaks throughput case (no pyOMA-2 needed), --repeat runs")
+    parser.add_argument("--repeat", type=int, default=5, help="timing runs with --throughput (default 5)")
     args = parser.parse_args(argv)
+    if args.throughput:
+        print_throughput(throughput(quick=False, with_fdd=False, repeat=max(1, args.repeat)))
+        return 0
     try:
         import pyoma2
     except ImportError:

@@ -272,7 +272,7 @@ def _diagnose(args) -> int:
     if args.out is not None:
         from .diagnose.report import write_report
 
-        write_report(result, args.out, spectra=spectra)
+        write_report(result, args.out, spectra=spectra, tension_model=args.tension_model)
     if args.json != "-":
         sys.stdout.write(result.text())
         if args.out is not None:

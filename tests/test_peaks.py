@@ -10,7 +10,6 @@ white. Tolerances are written out with their reason.
 from __future__ import annotations
 
 import json
-import time
 
 import numpy as np
 import pytest
@@ -356,7 +355,9 @@ def test_non_finite_record_is_refused():
 
 
 @pytest.mark.slow
-def test_sixteen_channels_ten_minutes_within_two_seconds():
+def test_sixteen_channels_ten_minutes_finds_every_mode():
+    # Its time (the 2 s) is measured by benchmarks/spectra.py --throughput, not asserted here:
+    # a timed test fails on a loaded machine and says nothing about the code.
     rng = np.random.default_rng(0)
     fs, length = 256.0, 100.0
     positions = np.linspace(4.7, 89.0, 16)
@@ -364,10 +365,7 @@ def test_sixteen_channels_ten_minutes_within_two_seconds():
     x = ambient(truth, 0.005, positions, length, fs, 600.0, rng)
     x += 0.2 * x.std() * rng.standard_normal(x.shape)
     record = make_record(x, fs, positions)
-    elapsed = []
-    for _ in range(2):  # the faster of two runs: the first pays for imports and caches
-        start = time.perf_counter()
-        result = find_peaks(record)
-        elapsed.append(time.perf_counter() - start)
+    result = find_peaks(record)
     assert len(result.peaks) == 20
-    assert min(elapsed) <= 2.0
+    found = np.sort([p.frequency for p in result.peaks])
+    assert np.all(np.abs(found - truth) < 0.01 * truth)

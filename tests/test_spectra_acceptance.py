@@ -13,7 +13,7 @@ the neighbouring modes: a peak, not the tail of a neighbour at a node) and
 stands 10 dB above the spectrum of the noise alone. No peak may
 carry a wrong number without being flagged doubtful, and every visible mode
 should be found and correctly numbered (the issue's goal; the test bounds
-the misses at 2 % of the visible modes, the level reached so far). For free decays at ≥ 20 dB the
+the misses at the level reached so far, 2 of 725). For free decays at ≥ 20 dB the
 frequency errors are compared with the Cramér–Rao bound of the case
 (spectra/crb.py: Yao & Pandit's bound for damped sinusoids with common
 frequency and decay across channels, per-channel amplitude and noise):
@@ -162,8 +162,9 @@ def test_spectra_acceptance_over_simulated_records():
     print(f"{N_RECORDS} records, {n_visible} visible modes, {len(missed)} missed, {len(mislabelled)} mislabelled, "
           f"median error/CRB {np.median(ratios):.2f} over {len(ratios)} modes")
     assert not mislabelled, mislabelled[:5]
-    # The issue asks for no miss at all; today a few fast-decaying high modes
-    # seen by one sensor and heavily damped (ζ > 1.5 %) ambient modes of the
-    # stay are missed (see the issue note). This bound guards what is reached.
-    assert len(missed) <= 0.02 * n_visible, missed[:10]
+    # The issue asks for no miss at all. Left (seed 100: the stay, ambient, ζ = 1.8 %, 4 sensors): mode 10
+    # is not detected (in a band filled with broad resonances its peak rises 4.0 dB above the valley beside
+    # it, under the 4.4 dB threshold), and mode 9's fit, with mode 10 unmodelled in its band, ends 2.03 % off.
+    # This bound guards what is reached.
+    assert len(missed) <= 2, missed
     assert np.median(ratios) <= 2.0

@@ -8,6 +8,7 @@ by AICc, cross-validates each by leaving one mode out, and names the cause
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 
@@ -21,10 +22,13 @@ from .selection import BASELINE, select
 
 Progress = Callable[[int, int, str], None]
 
+#: Largest number of worker processes by default.
+MAX_WORKERS = 8
+
 
 def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects: str | Sequence[str] | None = None,
              picked: Mapping[str, object] | None = None, max_effects: int = 2, tension_model: str = "uniform",
-             progress: Progress | None = None) -> Diagnosis:
+             progress: Progress | None = None, workers: int | None = None) -> Diagnosis:
     """Diagnose the nominal model of ``campaign`` against its measured frequencies.
 
     Parameters
@@ -42,7 +46,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         Largest number of effects combined in one hypothesis (1 or 2).
     tension_model : {"uniform", "per-segment", "none"}
     progress : callable(k, n, label), optional
-        Called before each hypothesis fit.
+        Called as each hypothesis fit is done (k of n).
+    workers : int, optional
+        Processes fitting hypotheses in parallel (default: the CPUs this
+        process may use, at most :data:`MAX_WORKERS`; 1 fits in this process).
 
     Returns
     -------
@@ -91,21 +98,16 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     symmetric = mirror_symmetric(campaign, measurements, tension_model)
     fits: dict[tuple[str, ...], HypothesisFit] = {}
     timings: dict[tuple[str, ...], float] = {}
-    total = len(sets)
-    for k, s in enumerate(sets, start=1):
-        label = " + ".join(s) if s else "nominal"
-        if progress is not None:
-            progress(k, total, label)
-        t0 = time.perf_counter()
-        if not s:
-            fit = fit_nominal(campaign, measurements, tension_model)
-        else:
-            seeds = _pair_seeds(fits, s) if len(s) > 1 else []
-            fit = fit_hypothesis(campaign, measurements, s, tension_model=tension_model, seeds=seeds,
-                                 symmetric=symmetric, scan=len(s) == 1)
-            fit.cv_rms_error = cross_validate(fit, measurements, tension_model)
-        fits[s] = fit
-        timings[s] = time.perf_counter() - t0
+    done = 0
+    # Single effects first (their estimates and profile minima seed the pairs), each stage in parallel.
+    for stage in ([s for s in sets if len(s) <= 1], [s for s in sets if len(s) > 1]):
+        jobs = [(campaign, measurements, s, tension_model, symmetric, _pair_seeds(fits, s) if len(s) > 1 else [])
+                for s in stage]
+        for s, fit, seconds in _map(_fit_job, jobs, workers):
+            fits[s], timings[s] = fit, seconds
+            done += 1
+            if progress is not None:
+                progress(done, len(sets), " + ".join(s) if s else "nominal")
     selection = select(fits, n, max_effects)
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
@@ -124,3 +126,40 @@ def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
         for point in [fit.values(), *fit.minima]:
             seeds.append({**others, **point})
     return seeds
+
+
+def _fit_job(job) -> tuple[tuple[str, ...], HypothesisFit, float]:
+    """Fit and cross-validate one hypothesis (runs in a worker process)."""
+    campaign, measurements, effects, tension_model, symmetric, seeds = job
+    t0 = time.perf_counter()
+    if not effects:
+        fit = fit_nominal(campaign, measurements, tension_model)
+    else:
+        fit = fit_hypothesis(campaign, measurements, effects, tension_model=tension_model, seeds=seeds,
+                             symmetric=symmetric, scan=len(effects) == 1)
+        fit.cv_rms_error = cross_validate(fit, measurements, tension_model)
+    return effects, fit, time.perf_counter() - t0
+
+
+def _default_workers() -> int:
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_WORKERS))
+
+
+def _map(fn, jobs: list, workers: int | None):
+    """``fn`` over ``jobs``, results as they finish; in worker processes when more than one is useful."""
+    workers = _default_workers() if workers is None else max(1, int(workers))
+    if workers == 1 or len(jobs) < 2:
+        yield from map(fn, jobs)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=context) as pool:
+        futures = [pool.submit(fn, job) for job in jobs]
+        for future in as_completed(futures):
+            yield future.result()

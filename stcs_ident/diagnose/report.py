@@ -1,8 +1,34 @@
-"""Text and report of a diagnosis."""
+"""Text and report of a diagnosis.
+
+:func:`diagnosis_text` is the terminal summary. :func:`write_report` writes a
+report directory: the tables first (:mod:`.tables`, pandas → CSV and
+Markdown), the figures second (:mod:`.figures`), the prose last, every
+number of it from the data.
+"""
 
 from __future__ import annotations
 
 import math
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import InputError
+from .tables import (
+    CSV_FILES,
+    cause_table,
+    effects_label,
+    frequency_table,
+    gain_table,
+    markdown_table,
+    nominal_comparison,
+    ranking_table,
+)
 
 
 def _num(v, fmt="{:.3f}") -> str:
@@ -33,11 +59,302 @@ def diagnosis_text(diagnosis) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_report(diagnosis, out_dir, spectra=()) -> None:
-    """Write ``report.md`` with the tables into ``out_dir`` (placeholder until the full report lands)."""
-    import os
+def _file_stem(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".") or "test"
 
-    from ..report import write_atomic
 
-    os.makedirs(out_dir, exist_ok=True)
-    write_atomic(os.path.join(out_dir, "report.md"), "```\n" + diagnosis_text(diagnosis) + "```\n")
+def _pct(v) -> str:
+    return "-" if v is None or not math.isfinite(v) else f"{v:.3f} %"
+
+
+def _data_section(d, spectra) -> list[str]:
+    cable = d.campaign.cable
+    records = {ts.name: ts for ts in spectra}
+    rows = []
+    for m in d.measurements:
+        where = f"record {os.path.basename(records[m.name].record)}" if m.name in records else "campaign table"
+        rows.append({"test": m.name, "setup": m.test.setup, "tension_kN": m.test.tension / 1e3,
+                     "modes": " ".join(str(int(k)) for k in m.modes), "frequencies": where,
+                     "uncertainty_Hz": f"{m.uncertainty.min():.2g} – {m.uncertainty.max():.2g}"
+                     if m.uncertainty.min() != m.uncertainty.max() else f"{m.uncertainty[0]:.2g}",
+                     "uncertainty from": m.source})
+    n = d.measured.size
+    out = ["## Data", "",
+           (f"Cable: length {cable.length:g} m, mass {cable.mass_per_length:g} kg/m, nominal EI "
+           f"{cable.EI / 1e3:.4g} kN m². {len(d.measurements)} tests, {n} measured frequencies"
+           f"{' (setups symmetric about midspan: a position x and l − x are not told apart)' if d.symmetric else ''}."),
+           "", markdown_table(pd.DataFrame(rows), {"tension_kN": "{:.1f}"},
+                              {"test": "test", "setup": "setup", "tension_kN": "tension (kN)", "modes": "modes",
+                               "frequencies": "frequencies from", "uncertainty_Hz": "uncertainty (Hz)",
+                               "uncertainty from": "uncertainty from"})]
+    if d.skipped:
+        out.append("Skipped tests: " + "; ".join(f"{name} ({reason})" for name, reason in d.skipped) + ".\n")
+    out.append(f"Effects considered: {', '.join(d.considered) or 'none'}.\n")
+    return out
+
+
+def _forward_section(forward, table: pd.DataFrame) -> list[str]:
+    out = ["## Nominal model against the measurements", "",
+           ("Taut string, pinned beam and the exact dynamic-stiffness model (DSM) with the nominal cable and "
+           "tensions; errors are (model − measured) / measured in %."), ""]
+    columns = {"test": "test", "mode": "mode", "measured": "measured (Hz)", "taut_string": "string (Hz)",
+               "taut_string_error_%": "err %", "beam_pinned": "beam (Hz)", "beam_pinned_error_%": "err %",
+               "dsm": "DSM (Hz)", "dsm_error_%": "err %"}
+    columns = {c: h for c, h in columns.items() if c in table.columns}
+    fmt = {c: ("{:.2f}" if c.endswith("%") else "{:.3f}") for c in columns if c not in ("test", "mode")}
+    out.append(markdown_table(table, fmt, columns))
+    rms = []
+    for t in forward.tests:
+        if t.measured is None:
+            continue
+        errs = {c: t.error(c) for c in ("taut_string", "beam_pinned", "dsm")}
+        rms.append(f"{t.name}: string {np.sqrt(np.nanmean(errs['taut_string'] ** 2)):.2f} %, beam "
+                   f"{np.sqrt(np.nanmean(errs['beam_pinned'] ** 2)):.2f} %, DSM {np.sqrt(np.nanmean(errs['dsm'] ** 2)):.2f} %")
+    if rms:
+        out.append("rms errors — " + "; ".join(rms) + ".\n")
+    for check in forward.reference_checks:
+        out.append(f"- {check.sentence()}")
+    if forward.reference_checks:
+        out.append("")
+    return out
+
+
+def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
+    from scipy.stats import chi2 as chi2_distribution
+
+    from .selection import ALPHA, AMBIGUITY
+
+    n = d.measured.size
+    gate = float(chi2_distribution.isf(ALPHA, n))
+    columns = {"rank": "#", "effects": "hypothesis", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
+               "delta_aicc": "ΔAICc", "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %", "cause": "cause",
+               "parameters": "key parameter values"}
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "delta_aicc": "{:.1f}", "rms_error_%": "{:.3f}",
+           "cv_rms_error_%": "{:.3f}"}
+    return ["## Hypotheses ranked by AICc", "", markdown_table(ranking, fmt, columns),
+            "How to read this:", "",
+            (f"- χ² sums the squared misfits in units of the frequency uncertainties; k is the number of fitted "
+            f"parameters, n = {n} the number of measured frequencies."),
+            ("- AICc = χ² + 2k + 2k(k + 1)/(n − k − 1) trades misfit against parameters; lower is better and "
+            "ΔAICc is measured from the best hypothesis."),
+            (f"- Hypotheses within ΔAICc < {AMBIGUITY:g} of the chosen one are not told apart (ambiguous); of "
+            "nested ones the simpler is preferred."),
+            (f"- The χ² gate: the nominal model is accepted (no cause named) when its χ² is below the "
+            f"{100 * (1 - ALPHA):g} % quantile of the χ² distribution with n degrees of freedom ({gate:.1f} here). "
+            f"The nominal χ² is {d.nominal.chi2:.4g}: {'accepted' if d.selection.explained else 'rejected'}."),
+            ("- rms % is the root mean square relative error in-sample; CV rms % predicts each mode number left "
+            "out of the fit (leave-one-mode-out cross-validation), the honest measure of the gain."), ""]
+
+
+def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
+    from scipy.stats import chi2 as chi2_distribution
+
+    from .selection import ALPHA, BASELINE
+
+    sel = d.selection
+    n = d.measured.size
+    out = ["## Named cause", "", d.cause_text(), "", sel.statement, ""]
+    if sel.effects:
+        out.append(f"Principal effect: {sel.principal}. Removal cost (AICc rise when an effect is dropped): "
+                   + "; ".join(f"{e} {_num(v, '{:.1f}')}" for e, v in sel.removal_cost.items()) + ".")
+        out.append("Ambiguous alternatives (ΔAICc < 2): "
+                   + ("; ".join(effects_label(a) for a in sel.ambiguous_with) if sel.ambiguous_with else "none") + ".")
+        out += ["", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
+    best = d.ranked[0]
+    searched = max((len(e) for e in d.fits if e != BASELINE), default=0)
+    if best is not d.corrected and best.effects == BASELINE and len(BASELINE) > searched:
+        out += [(f"The first-ranked {effects_label(best.effects)} is the baseline (the source paper's correction), fitted "
+                f"as a reference with more effects than the hypotheses searched (at most {searched} here), so it "
+                "is not named as the cause."), ""]
+    dof = n - best.n_parameters
+    if dof > 0 and best.chi2 > chi2_distribution.isf(ALPHA, dof):
+        red = best.chi2 / dof
+        out.append(f"**Model error dominates the measurement uncertainty.** Even the best hypothesis "
+                   f"({effects_label(best.effects)}) leaves χ² = {best.chi2:.4g} for {dof} degrees of freedom (reduced "
+                   f"χ² {red:.3g}): its misfit is {math.sqrt(red):.3g} times the stated frequency uncertainties "
+                   f"({', '.join(sorted({m.source for m in d.measurements}))}). No hypothesis of the vocabulary "
+                   f"explains the data within their uncertainty; the ranking shows which explains them least badly, "
+                   f"and parameter uncertainties are scaled by the reduced χ².")
+        out.append("")
+    if "profile" in figures:
+        out += ["![Profile of the position](profile.png)", "",
+                ("χ² with the unmodeled attachment held at each position of a grid (every other parameter "
+                 "refitted), the scan that started the fit; the red line is the named cause's estimate."), ""]
+    return out
+
+
+def _before_after_section(d, freq: pd.DataFrame, figures: dict) -> list[str]:
+    out = ["## Residual pattern", "", f"![Residuals per mode]({figures['residuals']})", "",
+           "Error in % per mode for each test; the grey band is ± one measurement uncertainty.", "",
+           "## Before and after, per test", ""]
+    have_baseline = d.baseline is not None
+    columns = {"mode": "mode", "measured_Hz": "measured", "uncertainty_Hz": "σ", "nominal_Hz": "nominal",
+               "nominal_error_%": "err %"}
+    if have_baseline:
+        columns |= {"baseline_Hz": "baseline", "baseline_error_%": "err %"}
+    columns |= {"corrected_Hz": "corrected", "corrected_error_%": "err %"}
+    fmt = {c: ("{:.3f}" if c.endswith("%") else "{:.2g}" if c == "uncertainty_Hz" else "{:.4f}") for c in columns}
+    fmt["mode"] = "{}"
+    for m in d.measurements:
+        out += [f"### {m.name}", "", markdown_table(freq[freq["test"] == m.name], fmt, columns)]
+    return out
+
+
+def _gain_section(d, gain: pd.DataFrame) -> list[str]:
+    g = d.summary()["gain"]
+    sentence = (f"The rms error against the measured frequencies is {_pct(g['rms_error_nominal'])} with the nominal "
+                f"model")
+    if "rms_error_baseline" in g:
+        sentence += f", {_pct(g['rms_error_baseline'])} with tension and EI re-estimated (baseline)"
+    sentence += (f" and {_pct(g['rms_error_corrected'])} with the named cause ({effects_label(d.corrected.effects)}); "
+                 f"cross-validated, nominal {_pct(g['cv_rms_error_nominal'])}")
+    if "rms_error_baseline" in g:
+        sentence += f", baseline {_pct(g.get('cv_rms_error_baseline'))}"
+    sentence += f", corrected {_pct(g['cv_rms_error_corrected'])}."
+    out = ["## Gain", "", sentence, ""]
+    if d.selection.effects and d.corrected.rms_error > d.nominal.rms_error:
+        out += [(f"The corrected model lowers χ² (errors in Hz weighted by the uncertainties) but its relative "
+                f"rms error ({_pct(d.corrected.rms_error)}) is larger than the nominal model's "
+                f"({_pct(d.nominal.rms_error)})."), ""]
+    columns = {"model": "model", "effects": "effects", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
+               "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %"}
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
+    return out + [markdown_table(gain, fmt, columns)]
+
+
+def _notes_section(d, extra: list[str]) -> list[str]:
+    notes = list(d.notes) + [f"{effects_label(d.corrected.effects)}: {note}" for note in d.corrected.notes] + extra
+    if d.baseline is not None and d.baseline is not d.corrected:
+        notes += [f"baseline ({effects_label(d.baseline.effects)}): {note}" for note in d.baseline.notes]
+    notes += [f"skipped {name}: {reason}" for name, reason in d.skipped]
+    out = ["## Notes", ""] + [f"- {note}" for note in notes] if notes else []
+    return out + ([""] if notes else [])
+
+
+def report_markdown(diagnosis, tables: dict, figures: dict, forward, spectra=(), notes=()) -> str:
+    """``report.md`` from the tables (``report_tables``) and the figure file names."""
+    d = diagnosis
+    lines = [f"# Diagnosis of {d.campaign.name}", "",
+             (f"{len(d.measurements)} tests, {d.measured.size} measured frequencies, {len(d.fits)} hypotheses "
+             f"fitted in {d.elapsed:.1f} s."), "", "**Cause:** " + d.cause_text(), "",
+             "**Gain:** rms error nominal " + _pct(d.nominal.rms_error) + ", corrected "
+             + _pct(d.corrected.rms_error) + " (cross-validated " + _pct(d.corrected.cv_rms_error) + ").", ""]
+    lines += _data_section(d, spectra)
+    if figures.get("spectra"):
+        lines += ["## Spectra", ""]
+        for name, file in figures["spectra"]:
+            lines += [f"### {name}", "", f"![Spectra of {name}]({file})", ""]
+    lines += _forward_section(forward, tables["nominal_comparison"])
+    lines += _ranking_section(d, tables["ranking"])
+    lines += _cause_section(d, tables["cause"], figures)
+    lines += _before_after_section(d, tables["frequencies"], figures)
+    lines += _gain_section(d, tables["gain"])
+    lines += _notes_section(d, list(notes))
+    lines += ["## Files", "", "Tables as CSV: " + ", ".join(f"[{f}]({f})" for f in CSV_FILES) + ".", ""]
+    return "\n".join(lines)
+
+
+def _tension_model_note(d, forward) -> list[str]:
+    dsm = np.concatenate([t.dsm[[t.modes.index(int(k)) for k in m.modes]]
+                          for t, m in zip(forward.tests, d.measurements)])
+    if np.allclose(dsm, d.nominal.predicted, rtol=1e-9, atol=0.0):
+        return []
+    return [(f"the nominal comparison (tension model '{forward.tension_model}') differs from the diagnosis's nominal "
+            f"model by up to {np.max(np.abs(dsm / d.nominal.predicted - 1)) * 100:.2g} %: pass the tension model "
+            "the diagnosis used")]
+
+
+def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform") -> Path:
+    """Write the diagnosis report into ``out_dir``, whole or not at all.
+
+    ``out_dir`` gets ``report.md`` (tables, figures and the named cause in
+    plain words), the tables as CSV (:data:`CSV_FILES`) and the figures as
+    PNG: ``residuals.png``, ``profile.png`` when the cause is an unmodeled
+    mass or support, and ``spectra_<test>.png`` for each test with a record.
+    The report is built in a temporary directory beside ``out_dir`` and
+    renamed; an existing ``out_dir`` is replaced as a whole only once the
+    new report is complete, and left untouched if anything fails.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+    out_dir : path-like
+    spectra : sequence of TestSpectra, optional
+        The spectra the frequencies were picked from (one figure each).
+    tension_model : {"uniform", "per-segment", "none"}
+        The tension model the diagnosis used (for the nominal comparison).
+
+    Returns
+    -------
+    Path
+        ``out_dir``.
+
+    Raises
+    ------
+    InputError
+        If ``out_dir`` exists and is not a directory, or is a non-empty
+        directory that is not a report (holds no ``report.md``).
+    """
+    from . import figures as diagnosis_figures
+
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InputError("exists and is not a directory", field="out_dir", file=str(out))
+    if out.is_dir() and any(out.iterdir()) and not (out / "report.md").is_file():
+        # replacing a directory as a whole deletes what it holds: only ever an earlier report
+        raise InputError("is a non-empty directory without report.md: not a report, not replaced", field="out_dir",
+                         file=str(out))
+    d = diagnosis
+    forward, comparison = nominal_comparison(d, spectra, tension_model)
+    tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
+              "nominal_comparison": comparison, "cause": cause_table(d)}
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    try:
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o777 & ~mask)  # mkdtemp makes 0700; give the mode a plain mkdir would
+        for name, frame in tables.items():
+            frame.to_csv(tmp / f"{name}.csv", index=False)
+        figures: dict = {"spectra": []}
+        if spectra:
+            from ..plots import plot_test_spectra
+
+            used = {m.name for m in d.measurements}
+            for ts in spectra:
+                if ts.name in used:
+                    file = f"spectra_{_file_stem(ts.name)}.png"
+                    _save(plot_test_spectra(ts)["figure"], tmp / file)
+                    figures["spectra"].append((ts.name, file))
+        _save(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
+        figures["residuals"] = "residuals.png"
+        if diagnosis_figures.profile_scans(d):
+            _save(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
+            figures["profile"] = "profile.png"
+        text = report_markdown(d, tables, figures, forward, spectra, _tension_model_note(d, forward))
+        (tmp / "report.md").write_text(text, encoding="utf-8")
+        _install(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
+
+
+def _save(fig, path: Path) -> None:
+    fig.savefig(path, dpi=110, format="png")
+
+
+def _install(tmp: Path, out: Path) -> None:
+    """Rename the finished ``tmp`` to ``out``; an old ``out`` is replaced only as a whole."""
+    if not out.exists():
+        os.replace(tmp, out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+    os.replace(out, old / "previous")
+    try:
+        os.replace(tmp, out)
+    except BaseException:
+        os.replace(old / "previous", out)
+        raise
+    finally:
+        shutil.rmtree(old, ignore_errors=True)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, ModelError
+from ..errors import ComputationError, InputError, ModelError
 from ..forward import batch_frequencies
 from ..model import Campaign, Test
 from .parameters import KINDS, Parameter, overrides_for
@@ -240,8 +240,7 @@ class Problem:
             tension = sub.pop("tension")
             n_modes = max(int(self.measurements[i].modes.max()) for i in group)
             try:
-                F = batch_frequencies(cable, self._atts[first.name], tension, n_modes,
-                                      tension_model=self.tension_model, **sub)
+                F = self._solve(self._atts[first.name], tension, n_modes, sub)
             except ModelError as err:
                 raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
             full = np.full((ok.size, n_modes), np.nan)
@@ -250,6 +249,18 @@ class Problem:
                 out[i] = full[j * k:(j + 1) * k, self.measurements[i].modes - 1]
         F = np.concatenate(out, axis=1)
         return F[0] if single else F
+
+    def _solve(self, atts, tension: np.ndarray, n_modes: int, overrides: dict) -> np.ndarray:
+        """The solver on many rows; a row whose roots do not converge (an extreme trial point of a
+        fit) becomes NaN instead of failing the whole batch."""
+        cable = self.campaign.cable
+        try:
+            return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model, **overrides)
+        except ComputationError:
+            if tension.size == 1:
+                return np.full((1, n_modes), np.nan)
+        return np.concatenate([self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()})
+                               for i in range(tension.size)])
 
     def residuals(self, x) -> np.ndarray:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""

@@ -6,7 +6,10 @@ half-power widths around it, never wider than 0.45 of the distance to the
 next candidate nor a quarter of its frequency; the nearest candidate on
 each side enters the fit as a fixed pole. The overview's width is only a
 guess, so a fit whose peak is wider than its band, or that fails, is
-repeated once in a wider band.
+repeated once in a wider band; one still doubtful is tried last in a band
+reaching 0.9 of the way to its neighbours (a heavily damped mode between
+close neighbours: within 0.45 of the gap its skirts pass for background
+and the fit settles on ripple).
 
 A fit describes a mode when it converged, its damping ratio is below
 10 % (wider shapes are the colour of the noise, not a cable mode), it
@@ -18,6 +21,8 @@ narrows a true mode's band), until every remaining one is a mode or is
 too strong (10 dB above the floor, and no wider than a mode with 10 %
 damping) to drop: those are reported from the overview, unless they lie
 within two half-power widths of a fitted mode (ripple on its resonance).
+Proposals of the coarser overviews (multi-resolution detection) are
+never reported from the overview: only a fit confirms them.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ FALLBACK_SNR_DB = 10.0  # a peak whose fit failed is still reported (overview es
 MAX_DAMPING = 0.1  # a fitted ζ at or above this describes a broad spectral shape, not a cable mode
 BAND_HALF_POWER_WIDTHS = 8.0
 BAND_NEIGHBOUR_FRACTION = 0.45
+BAND_NEIGHBOUR_FRACTION_WIDE = 0.9  # last try for a doubtful fit: the band reaches over to the neighbours' peaks
 BAND_MAX_RELATIVE = 0.25
 
 # A band fitter: (centre Hz, half-width Hz, neighbour poles [(f, σ)], -3 dB width Hz) -> fit or None; a fit
@@ -47,9 +53,11 @@ def _candidate_pole(c: Candidate, resolution: float) -> tuple[float, float]:
     return c.frequency, np.pi * max(c.half_power_width - resolution, 0.25 * resolution)
 
 
-def _band_limit(c: Candidate, neighbours: list[Candidate], nyquist: float) -> float:
+def _band_limit(
+    c: Candidate, neighbours: list[Candidate], nyquist: float, fraction: float = BAND_NEIGHBOUR_FRACTION
+) -> float:
     gaps = [abs(n.frequency - c.frequency) for n in neighbours]
-    return min([BAND_NEIGHBOUR_FRACTION * g for g in gaps] + [BAND_MAX_RELATIVE * c.frequency, nyquist - c.frequency])
+    return min([fraction * g for g in gaps] + [BAND_MAX_RELATIVE * c.frequency, nyquist - c.frequency])
 
 
 def _plausible(c: Candidate, fit, cell_width: float) -> bool:
@@ -68,10 +76,11 @@ def _plausible(c: Candidate, fit, cell_width: float) -> bool:
 def _strong(c: Candidate, cell_width: float) -> bool:
     """A peak to report even when its fit fails: FALLBACK_SNR_DB high and as narrow as a cable mode (2ζf).
 
-    (Or no wider than four resolution cells: the overview cannot resolve a narrower peak.)
+    (Or no wider than four resolution cells: the overview cannot resolve a narrower peak.) A proposal of
+    a coarser overview is never strong: only its fit can confirm it.
     """
     narrow = c.half_power_width <= max(2 * MAX_DAMPING * c.frequency, 4 * cell_width)
-    return c.snr_db >= FALLBACK_SNR_DB and narrow
+    return c.snr_db >= FALLBACK_SNR_DB and narrow and not c.proposal
 
 
 def _fit_candidate(
@@ -82,7 +91,9 @@ def _fit_candidate(
     The overview's width is only a guess (ripple, resolution): when the
     fitted peak is wider than the band allows for, or the fit fails or is
     insignificant, the band is widened once (up to its limit) and the fit
-    repeated.
+    repeated. A fit still doubtful is tried last in a band reaching 0.9 of
+    the way to the neighbours (kept only if it then describes a significant
+    mode near the detection).
     """
     limit = _band_limit(c, neighbours, nyquist)
     width = max(BAND_HALF_POWER_WIDTHS * max(c.half_power_width - resolution, resolution), min_half_width)
@@ -98,6 +109,15 @@ def _fit_candidate(
         wider = fit_band(start, wanted, poles, c.half_power_width)
         if _plausible(c, wider, cell_width):
             fit = wider
+    if neighbours and not (_plausible(c, fit, cell_width) and fit.significance >= MIN_SIGNIFICANCE):
+        # A broad mode between close neighbours: within 0.45 of the gap its skirts look like the background
+        # (constant, slope, the neighbours' tails) and the fit settles on ripple. Reaching over to the
+        # neighbours' peaks pins the background down.
+        widest = _band_limit(c, neighbours, nyquist, BAND_NEIGHBOUR_FRACTION_WIDE)
+        if widest > 1.2 * max(half_width, wanted):
+            wide = fit_band(c.frequency, widest, poles, c.half_power_width)
+            if _plausible(c, wide, cell_width) and wide.significance >= MIN_SIGNIFICANCE:
+                fit = wide
     return fit
 
 

@@ -1,0 +1,179 @@
+"""Figures of a diagnosis (headless, Agg).
+
+Each function builds on a :class:`matplotlib.figure.Figure` or a given Axes,
+never on pyplot's global state, and returns what it drew so that tests can
+inspect it (as :mod:`stcs_ident.plots`). matplotlib is imported only when a
+figure is made.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..plots import _figure
+from .hypotheses import UNMODELED
+
+#: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
+RESIDUAL_STYLE = {
+    "nominal": ("nominal model", "0.35", "o", -0.18),
+    "baseline": ("baseline: tension + EI refitted", "tab:blue", "s", 0.0),
+    "corrected": ("corrected: named cause", "tab:red", "^", 0.18),
+}
+
+
+def _models(diagnosis) -> dict:
+    """{"nominal" | "baseline" | "corrected": (fit, label)} of the models to compare."""
+    d = diagnosis
+    out = {"nominal": d.nominal}
+    if d.baseline is not None:
+        out["baseline"] = d.baseline
+    out["corrected"] = d.corrected
+    return out
+
+
+def plot_residuals(diagnosis, fig=None) -> dict:
+    """Error in % per mode for each test: nominal, baseline and corrected.
+
+    The grey band is ± one standard uncertainty of the measured frequency,
+    in % of it: a model inside the band agrees with the measurement.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+    fig : matplotlib.figure.Figure, optional
+
+    Returns
+    -------
+    dict with the figure, the axes (one per test), the plotted lines by
+    model (``lines``: {model: [Line2D per test]}) and the uncertainty bands.
+    """
+    d = diagnosis
+    n = len(d.measurements)
+    ncols = 1 if n == 1 else 2
+    nrows = math.ceil(n / ncols)
+    fig = fig or _figure(figsize=(5.2 * ncols, 2.7 * nrows + 0.9), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    models = _models(d)
+    if models["corrected"] is models["nominal"]:
+        models.pop("corrected")  # the cause is empty: corrected is the nominal model
+    per_test = {key: d.per_test(fit) for key, fit in models.items()}
+    lines: dict[str, list] = {key: [] for key in models}
+    bands = []
+    for i, (m, ax) in enumerate(zip(d.measurements, axes)):
+        k = m.modes.astype(float)
+        u = m.uncertainty / m.frequencies * 100.0
+        edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
+        bands.append(ax.stairs(u, edges, baseline=-u, fill=True, color="0.85", lw=0,
+                               label="measurement uncertainty (±1σ)"))
+        ax.axhline(0.0, color="0.5", lw=0.6)
+        for key in models:
+            label, colour, marker, dx = RESIDUAL_STYLE[key]
+            err = (per_test[key][i] - m.frequencies) / m.frequencies * 100.0
+            lines[key].append(ax.plot(k + dx, err, marker=marker, color=colour, lw=0.8, ms=5, label=label)[0])
+        ax.set_title(f"{m.name} (setup {m.test.setup}, {m.test.tension / 1e3:.4g} kN)", fontsize=9)
+        ax.set_xticks(m.modes)
+        ax.set_xlim(k[0] - 0.6, k[-1] + 0.6)
+        ax.grid(True, axis="y", lw=0.3, alpha=0.6)
+        if i % ncols == 0:
+            ax.set_ylabel("error (%)")
+        if i >= n - ncols:
+            ax.set_xlabel("mode")
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside upper center", ncols=len(labels), fontsize=8, frameon=False)
+    return {"figure": fig, "axes": list(axes[:n]), "lines": lines, "bands": bands}
+
+
+def profile_scans(diagnosis) -> dict:
+    """{effect: fit} of the profile scan of each unmodeled attachment of the named cause.
+
+    The fit that scanned the position: the cause's own when it scanned it,
+    else the single-effect hypothesis (pairs start from the single effects'
+    profile minima and are not scanned again).
+    """
+    d = diagnosis
+    out = {}
+    for e in d.selection.effects:
+        if e not in UNMODELED:
+            continue
+        own = [x for x in d.corrected.effects if x in UNMODELED]
+        if d.corrected.profile and own and own[0] == e:
+            out[e] = d.corrected
+        elif (e,) in d.fits and d.fits[(e,)].profile:
+            out[e] = d.fits[(e,)]
+    return out
+
+
+def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
+    """χ² against the position of an unmodeled mass or support of the named cause (the profile scan).
+
+    Every other parameter is refitted at each position of the grid; the
+    cause's estimate (and its standard uncertainty) is marked. On a
+    configuration symmetric about midspan only [0, l/2] is scanned.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+    effect : {"unmodeled_mass", "unmodeled_support"}, optional
+        Default: the first one of the cause.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    dict with the figure, the axes, the profile line, the estimate line and
+    the fit whose scan is drawn (``scan``).
+
+    Raises
+    ------
+    ValueError
+        When the cause has no such effect or its position was not scanned.
+    """
+    d = diagnosis
+    scans = profile_scans(d)
+    effect = effect if effect is not None else next(iter(scans), None)
+    if effect not in scans:
+        raise ValueError(f"no profile scan of {effect!r} in the named cause {d.selection.effects}")
+    scan = scans[effect]
+    if ax is None:
+        fig = _figure(figsize=(9.5, 3.8), layout="constrained")
+        ax = fig.subplots()
+    fig = ax.figure
+    x, chi2 = np.array(sorted(scan.profile)).T
+    whose = "" if scan is d.corrected else f" of '{' + '.join(scan.effects)}' alone"
+    line = ax.semilogy(x, chi2, "o-", color="k", lw=0.9, ms=4,
+                       label=f"profile scan{whose}: χ² with\nthe other parameters refitted")[0]
+    values, sigmas = d.parameters(d.corrected)
+    position, sigma = values[effect]["position"], sigmas[effect].get("position")
+    if sigma is not None and math.isfinite(sigma):
+        ax.axvspan(position - sigma, position + sigma, color="tab:red", alpha=0.15, lw=0, label="estimate ± 1σ")
+    estimate = ax.axvline(position, color="tab:red", lw=1.0, label=f"estimate {position:.3g} m")
+    ax.plot([position], [d.corrected.chi2], "*", color="tab:red", ms=11,
+            label=f"named cause (χ² = {d.corrected.chi2:.4g})")
+    ax.axhline(d.nominal.chi2, color="0.5", lw=0.8, ls="--", label=f"nominal model (χ² = {d.nominal.chi2:.4g})")
+    length = d.campaign.cable.length
+    ax.set_xlim(0.0, length / 2 if d.symmetric else length)
+    ax.set_xlabel("position from end A (m)" + (", mirrored into [0, l/2]: symmetric setup" if d.symmetric else ""))
+    ax.set_ylabel("χ²")
+    ax.set_title(f"{' + '.join(d.corrected.effects)}: where is the {effect.replace('unmodeled_', '')}?", fontsize=9)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # never over the data
+    return {"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": scan}
+
+
+def plot_profiles(diagnosis, fig=None) -> dict:
+    """:func:`plot_profile` of every scanned unmodeled attachment of the cause, one above the other.
+
+    Returns
+    -------
+    dict with the figure and the :func:`plot_profile` results by effect (``panels``).
+    """
+    effects = list(profile_scans(diagnosis))
+    if not effects:
+        raise ValueError("the named cause has no unmodeled attachment with a profile scan")
+    fig = fig or _figure(figsize=(9.5, 3.6 * len(effects)), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(effects), 1))
+    panels = {e: plot_profile(diagnosis, e, ax) for e, ax in zip(effects, axes)}
+    return {"figure": fig, "panels": panels}

@@ -1,0 +1,169 @@
+"""The tables of a diagnosis report, as pandas DataFrames (→ CSV and Markdown).
+
+Every number of the report comes from these tables: the ranking of the
+hypotheses, the frequencies per test and mode, the gain, the named cause's
+parameters and the nominal comparison (taut string, pinned beam, DSM).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+#: Units of the effect parameters of ``interface.md`` (the keys of ``Diagnosis.parameters``).
+UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",
+         "mass": "kg", "position": "m", "stiffness": "N/m"}
+#: Files of the report, besides the figures.
+CSV_FILES = ("ranking.csv", "frequencies.csv", "gain.csv", "nominal_comparison.csv", "cause.csv")
+
+
+def effects_label(effects) -> str:
+    """``a + b`` for a hypothesis's effects, ``nominal`` for none."""
+    return " + ".join(effects) if effects else "nominal"
+
+
+def parameter_rows(values: dict, sigmas: dict) -> list[dict]:
+    """One row per parameter of ``Diagnosis.parameters(fit)``: effect, parameter, value, uncertainty, unit.
+
+    A parameter with one value per member (a test's tension ratio, an
+    attachment's position) is named ``kind[member]``; a clamped end's
+    rotational stiffness is ``inf``.
+    """
+    rows = []
+    for effect, entries in values.items():
+        for key, value in entries.items():
+            unit = UNITS.get(key.split("_A")[0].split("_B")[0], "-")
+            sig = sigmas.get(effect, {}).get(key)
+            if isinstance(value, dict):
+                for member, v in value.items():
+                    s = (sig or {}).get(member)
+                    rows.append({"effect": effect, "parameter": f"{key}[{member}]", "value": float(v),
+                                 "uncertainty": math.nan if s is None else float(s), "unit": unit})
+            else:
+                v = math.inf if value == "inf" else (math.nan if value is None else float(value))
+                rows.append({"effect": effect, "parameter": key, "value": v,
+                             "uncertainty": math.nan if sig is None else float(sig), "unit": unit})
+    return rows
+
+
+def _short(rows: list[dict]) -> str:
+    """Key parameter values in one cell: ``EI = 1.05e+05 N m^2; ratio[T1] = 0.981``."""
+    parts = []
+    for r in rows:
+        unit = "" if r["unit"] == "-" else f" {r['unit']}"
+        parts.append(f"{r['parameter']} = {r['value']:.4g}{unit}")
+    return "; ".join(parts)
+
+
+def _reduced_chi2(fit, n: int) -> float:
+    dof = n - fit.n_parameters
+    return fit.chi2 / dof if dof > 0 else math.nan
+
+
+def ranking_table(diagnosis) -> pd.DataFrame:
+    """Every hypothesis, best AICc first: effects, k, χ², reduced χ², AICc, ΔAICc, rms and CV rms (%)."""
+    d = diagnosis
+    n = d.measured.size
+    ranked = d.ranked
+    best = ranked[0].aicc
+    rows = []
+    for rank, f in enumerate(ranked, start=1):
+        rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters, "chi2": f.chi2,
+                     "reduced_chi2": _reduced_chi2(f, n), "aicc": f.aicc, "delta_aicc": f.aicc - best,
+                     "rms_error_%": f.rms_error,
+                     "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
+                     "cause": f.effects == d.selection.effects, "parameters": _short(parameter_rows(*d.parameters(f))),
+                     "seconds": d.timings.get(f.effects, math.nan)})
+    return pd.DataFrame(rows)
+
+
+def frequency_table(diagnosis) -> pd.DataFrame:
+    """Per test and mode: measured (with uncertainty), nominal, baseline, corrected (Hz) and errors (%)."""
+    d = diagnosis
+    models = {"nominal": d.nominal, "baseline": d.baseline, "corrected": d.corrected}
+    split = {key: (d.per_test(fit) if fit is not None else None) for key, fit in models.items()}
+    frames = []
+    for i, m in enumerate(d.measurements):
+        data = {"test": m.name, "setup": m.test.setup, "mode": m.modes, "measured_Hz": m.frequencies,
+                "uncertainty_Hz": m.uncertainty}
+        for key, values in split.items():
+            data[f"{key}_Hz"] = values[i] if values is not None else np.full(m.modes.size, np.nan)
+        for key in models:
+            data[f"{key}_error_%"] = (data[f"{key}_Hz"] - m.frequencies) / m.frequencies * 100.0
+        data["source"] = m.source
+        frames.append(pd.DataFrame(data))
+    return pd.concat(frames, ignore_index=True)
+
+
+def gain_table(diagnosis) -> pd.DataFrame:
+    """rms error (%) in-sample and cross-validated of the nominal, baseline and corrected models."""
+    d = diagnosis
+    n = d.measured.size
+    rows = []
+    for key, fit in (("nominal", d.nominal), ("baseline", d.baseline), ("corrected", d.corrected)):
+        if fit is None:
+            continue
+        rows.append({"model": key, "effects": effects_label(fit.effects), "k": fit.n_parameters, "chi2": fit.chi2,
+                     "reduced_chi2": _reduced_chi2(fit, n), "aicc": fit.aicc, "rms_error_%": fit.rms_error,
+                     "cv_rms_error_%": math.nan if fit.cv_rms_error is None else fit.cv_rms_error})
+    return pd.DataFrame(rows)
+
+
+def cause_table(diagnosis) -> pd.DataFrame:
+    """The parameters of the named cause (no rows when the cause is empty)."""
+    d = diagnosis
+    rows = parameter_rows(*d.parameters(d.corrected)) if d.selection.effects else []
+    return pd.DataFrame(rows, columns=["effect", "parameter", "value", "uncertainty", "unit"])
+
+
+def nominal_comparison(diagnosis, spectra=(), tension_model: str = "uniform"):
+    """The ``forward`` comparison (taut string, pinned beam, DSM against measured) of the diagnosed tests.
+
+    Returns
+    -------
+    (ForwardResult, DataFrame)
+        The table has one row per test and mode.
+    """
+    from ..compare import compare_forward
+
+    d = diagnosis
+    names = [m.name for m in d.measurements]
+    picked = {ts.name: (ts.modes, ts.frequencies) for ts in spectra if ts.name in names}
+    for m in d.measurements:  # frequencies the diagnosis used that are not the campaign's table
+        test = d.campaign.test(m.name)
+        table = dict(zip(test.modes or (), test.frequencies or ()))
+        if m.name not in picked and any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies)):
+            picked[m.name] = (m.modes, m.frequencies)
+    result = compare_forward(d.campaign, names, None, tension_model, picked=picked)
+    frames = []
+    for t in result.tests:
+        frame = t.to_dataframe()
+        frame.insert(0, "test", t.name)
+        frames.append(frame)
+    return result, pd.concat(frames, ignore_index=True)
+
+
+def _cell(value, fmt: str) -> str:
+    if isinstance(value, str):
+        return value.replace("|", "\\|")
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else ""
+    return fmt.format(value)
+
+
+def markdown_table(frame: pd.DataFrame, formats: dict | None = None, columns: dict | None = None) -> str:
+    """A pipe table of ``frame``: ``formats`` {column: "{:.3f}"}, ``columns`` {column: header} (and order)."""
+    formats = formats or {}
+    columns = columns or {c: c for c in frame.columns}
+    numeric = {c: pd.api.types.is_numeric_dtype(frame[c]) and not pd.api.types.is_bool_dtype(frame[c])
+               for c in columns}
+    lines = ["| " + " | ".join(columns.values()) + " |",
+             "|" + "|".join("---:" if numeric[c] else ":---" for c in columns) + "|"]
+    for row in frame.itertuples(index=False):
+        record = dict(zip(frame.columns, row))
+        lines.append("| " + " | ".join(_cell(record[c], formats.get(c, "{}")) for c in columns) + " |")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,231 @@
+"""The diagnosis report directory: report.md, the CSV tables and the PNG figures, written whole or not at all."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stcs_ident.campaign_io import load_campaign
+from stcs_ident.cli import main
+from stcs_ident.diagnose import diagnose
+from stcs_ident.diagnose import figures as diagnosis_figures
+from stcs_ident.diagnose.report import CSV_FILES, write_report
+from stcs_ident.errors import InputError
+from stcs_ident.forward import natural_frequencies
+from stcs_ident.model import Cable, Campaign, Setup, Test
+
+ROOT = Path(__file__).resolve().parents[1]
+HAN = ROOT / "campaigns" / "han2020"
+HAN_TESTS = ["case1-L4", "case1-L5"]
+PNG = b"\x89PNG\r\n\x1a\n"
+#: Values written to CSV with pandas' default float format come back to the last bit.
+EXACT = {"rtol": 1e-12, "atol": 0.0}
+
+# A taut bare strand (f1 ≈ 3 Hz) for the simulated campaign with records.
+CABLE = Cable(length=20.0, mass_per_length=10.0, EI=2000.0)
+TENSION = 10.0 * (2 * 20.0 * 3.0) ** 2
+
+
+@pytest.fixture(scope="module")
+def han_diagnosis():
+    return diagnose(load_campaign(HAN), HAN_TESTS, max_effects=1)
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    """A campaign with records whose true cable carries a 15 kg mass at 6 m: (diagnosis, spectra)."""
+    pytest.importorskip("h5py")
+    from stcs_ident.spectra.effects import Effects
+    from stcs_ident.spectra.pipeline import analyse_campaign
+    from stcs_ident.spectra.simulate import Impulse
+    from stcs_ident.spectra.simulate_campaign import simulate_campaign
+
+    nominal = Campaign("sim", CABLE, (Setup("bare"),),
+                       (Test("T1", "bare", TENSION), Test("T2/b", "bare", 1.1 * TENSION)))
+    out = simulate_campaign(nominal, tmp_path_factory.mktemp("sim") / "campaign", positions=[3.1, 7.3],
+                            duration=60.0, sampling_rate=50.0, impulses=[Impulse(0.5, 2.74, 20.0)], snr_db=40.0,
+                            effects=Effects(extra_mass=(15.0, 6.0)), seed=1)
+    campaign = load_campaign(out)
+    spectra = analyse_campaign(campaign)
+    d = diagnose(campaign, picked={s.name: s for s in spectra}, max_effects=1,
+                 effects=["tension", "bending_stiffness", "unmodeled_mass"])
+    return d, spectra
+
+
+def _is_png(path: Path) -> bool:
+    return path.read_bytes()[:8] == PNG
+
+
+def _listing(directory: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(directory.iterdir())}
+
+
+def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis):
+    d = han_diagnosis
+    out = write_report(d, tmp_path / "report")
+    assert out == tmp_path / "report"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary left behind
+    files = {p.name for p in out.iterdir()}
+    assert files == {"report.md", "residuals.png", "profile.png", *CSV_FILES}
+
+    text = (out / "report.md").read_text(encoding="utf-8")
+    assert d.cause_text() in text and d.selection.statement in text
+    g = d.summary()["gain"]
+    for key in ("rms_error_nominal", "rms_error_baseline", "rms_error_corrected", "cv_rms_error_corrected"):
+        assert f"{g[key]:.3f} %" in text
+    assert "Model error dominates the measurement uncertainty" in text  # table rounding vs a 0.3 % model error
+    assert "How to read this" in text and "99.9 % quantile" in text
+    for png in ("residuals.png", "profile.png"):
+        assert f"]({png})" in text and _is_png(out / png)
+
+    ranking = pd.read_csv(out / "ranking.csv")
+    assert len(ranking) == len(d.fits) and ranking["rank"].tolist() == list(range(1, len(d.fits) + 1))
+    assert ranking["effects"].iloc[-1] == "nominal"  # the nominal model is the worst of all here
+    assert ranking["delta_aicc"].iloc[0] == 0.0 and ranking["delta_aicc"].is_monotonic_increasing
+    assert ranking.loc[ranking["cause"], "effects"].tolist() == ["unmodeled_mass"]
+
+    freq = pd.read_csv(out / "frequencies.csv")
+    assert len(freq) == 12 and freq["test"].unique().tolist() == HAN_TESTS
+    np.testing.assert_allclose(freq["measured_Hz"], d.measured, **EXACT)
+    np.testing.assert_allclose(freq["corrected_Hz"], d.corrected.predicted, **EXACT)
+    np.testing.assert_allclose(freq["baseline_Hz"], d.baseline.predicted, **EXACT)
+    np.testing.assert_allclose(freq["nominal_error_%"],
+                               (freq["nominal_Hz"] - freq["measured_Hz"]) / freq["measured_Hz"] * 100, rtol=1e-12)
+    assert (freq["uncertainty_Hz"] > 0).all()
+
+    gain = pd.read_csv(out / "gain.csv")
+    assert gain["model"].tolist() == ["nominal", "baseline", "corrected"]
+    np.testing.assert_allclose(gain["rms_error_%"], [g["rms_error_nominal"], g["rms_error_baseline"],
+                                                     g["rms_error_corrected"]], **EXACT)
+
+    comparison = pd.read_csv(out / "nominal_comparison.csv")
+    assert len(comparison) == 12
+    np.testing.assert_allclose(comparison["measured"], d.measured, **EXACT)
+    np.testing.assert_allclose(comparison["dsm"], d.nominal.predicted, rtol=1e-12)  # the same nominal model
+    assert {"taut_string_error_%", "beam_pinned_error_%", "dsm_error_%"} <= set(comparison.columns)
+
+    cause = pd.read_csv(out / "cause.csv")
+    assert cause.columns.tolist() == ["effect", "parameter", "value", "uncertainty", "unit"]
+    assert cause["parameter"].tolist() == ["mass", "position"] and cause["unit"].tolist() == ["kg", "m"]
+    values, _ = d.parameters(d.corrected)
+    np.testing.assert_allclose(cause["value"], [values["unmodeled_mass"]["mass"],
+                                                values["unmodeled_mass"]["position"]], **EXACT)
+
+
+def test_report_shows_the_spectra_of_tests_with_records(tmp_path, simulated):
+    d, spectra = simulated
+    out = write_report(d, tmp_path / "report", spectra=spectra)
+    text = (out / "report.md").read_text(encoding="utf-8")
+    for name, file in (("T1", "spectra_T1.png"), ("T2/b", "spectra_T2_b.png")):  # '/' is no file-name character
+        assert _is_png(out / file) and f"![Spectra of {name}]({file})" in text
+    assert "record T1.h5" in text
+    freq = pd.read_csv(out / "frequencies.csv")
+    np.testing.assert_allclose(freq["measured_Hz"], np.concatenate([s.frequencies for s in spectra]), **EXACT)
+    comparison = pd.read_csv(out / "nominal_comparison.csv")  # measured = picked, the stated table absent
+    np.testing.assert_allclose(comparison["measured"].dropna(), d.measured, **EXACT)
+    cause = pd.read_csv(out / "cause.csv")
+    assert cause["effect"].unique().tolist() == ["unmodeled_mass"]
+    # the mass was put at 6 m: the profile figure marks it (on a symmetric setup, in [0, l/2])
+    assert cause.loc[cause["parameter"] == "position", "value"].item() == pytest.approx(6.0, abs=0.05)
+    assert _is_png(out / "profile.png")
+
+
+def test_the_nominal_model_accepted_names_no_cause(tmp_path):
+    # frequencies of the nominal model printed to 0.01 Hz: the misfit is the rounding the uncertainty stands for
+    tests = tuple(Test(name, "bare", h, frequencies=tuple(round(float(f), 2)
+                                                          for f in natural_frequencies(CABLE, (), h, 6)),
+                       modes=(1, 2, 3, 4, 5, 6)) for name, h in (("T1", TENSION), ("T2", 1.2 * TENSION)))
+    d = diagnose(Campaign("rounded", CABLE, (Setup("bare"),), tests), max_effects=1, effects=["bending_stiffness"])
+    assert d.selection.explained
+    out = write_report(d, tmp_path / "report")
+    assert not (out / "profile.png").exists() and _is_png(out / "residuals.png")
+    assert pd.read_csv(out / "cause.csv").empty
+    text = (out / "report.md").read_text(encoding="utf-8")
+    assert d.selection.statement in text and "Model error dominates" not in text
+
+
+def test_an_existing_report_is_replaced_as_a_whole(tmp_path, han_diagnosis):
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "report.md").write_text("# an older report")
+    (out / "stale.csv").write_text("old")
+    (out / "sub").mkdir()
+    write_report(han_diagnosis, out)
+    assert not (out / "stale.csv").exists() and not (out / "sub").exists()
+    assert (out / "report.md").read_text(encoding="utf-8").startswith("# Diagnosis of han2020")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    write_report(han_diagnosis, empty)
+    assert (empty / "report.md").exists()
+
+
+def test_a_directory_that_is_not_a_report_is_not_replaced(tmp_path, han_diagnosis):
+    out = tmp_path / "data"
+    out.mkdir()
+    (out / "measurements.csv").write_text("precious")
+    with pytest.raises(InputError, match="without report.md") as caught:
+        write_report(han_diagnosis, out)
+    assert caught.value.field == "out_dir"
+    assert _listing(out) == {"measurements.csv": b"precious"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["data"]
+
+
+@pytest.mark.parametrize("existing", [True, False])
+def test_a_failure_midway_leaves_the_old_report_and_no_temporary(tmp_path, han_diagnosis, monkeypatch, existing):
+    out = tmp_path / "report"
+    if existing:
+        write_report(han_diagnosis, out)
+        before = _listing(out)
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("figure failed")
+
+    monkeypatch.setattr(diagnosis_figures, "plot_profile", broken)  # after the CSVs and most figures
+    with pytest.raises(RuntimeError, match="figure failed"):
+        write_report(han_diagnosis, out)
+    if existing:
+        assert _listing(out) == before
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+    else:
+        assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_at_the_output_path_is_refused(tmp_path, han_diagnosis):
+    target = tmp_path / "report"
+    target.write_text("mine")
+    with pytest.raises(InputError, match="not a directory") as caught:
+        write_report(han_diagnosis, target)
+    assert caught.value.field == "out_dir" and caught.value.file == str(target)
+    assert target.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+def test_figures_return_what_they_drew(han_diagnosis):
+    d = han_diagnosis
+    drawn = diagnosis_figures.plot_residuals(d)
+    assert len(drawn["axes"]) == len(d.measurements)
+    assert set(drawn["lines"]) == {"nominal", "baseline", "corrected"}
+    first = drawn["lines"]["nominal"][0].get_ydata()
+    m = d.measurements[0]
+    np.testing.assert_allclose(first, (d.per_test(d.nominal)[0] - m.frequencies) / m.frequencies * 100, rtol=1e-12)
+    profile = diagnosis_figures.plot_profile(d)
+    assert profile["scan"] is d.corrected and len(profile["profile"].get_xdata()) == len(d.corrected.profile)
+    position = d.parameters(d.corrected)[0]["unmodeled_mass"]["position"]
+    assert profile["estimate"].get_xdata()[0] == position
+    with pytest.raises(ValueError, match="no profile scan"):
+        diagnosis_figures.plot_profile(d, "unmodeled_support")  # not in the cause
+
+
+def test_cli_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "rep"
+    argv = ["diagnose", str(HAN), "--test", "case1-L4", "--test", "case1-L5", "--max-effects", "1"]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert f"report: {out / 'report.md'}" in capsys.readouterr().out
+    assert (out / "report.md").exists() and all((out / f).exists() for f in CSV_FILES)
+    target = tmp_path / "file"
+    target.write_text("mine")
+    assert main([*argv, "--out", str(target)]) == 2
+    assert "--out" in capsys.readouterr().err and target.read_text() == "mine"
