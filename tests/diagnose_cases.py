@@ -20,7 +20,6 @@ from stcs_ident.spectra.pipeline import analyse_test
 from stcs_ident.spectra.simulate import Impulse
 from stcs_ident.spectra.simulate_campaign import simulate_campaign
 
-
 #: Modes picked per record (the spectra pipeline's default is 30).
 MAX_MODES = 12
 
