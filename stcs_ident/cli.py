@@ -54,6 +54,8 @@ def _parser() -> argparse.ArgumentParser:
                           "end_restraint, length)")
     dia.add_argument("--max-effects", type=int, choices=(1, 2), default=2,
                      help="largest number of effects in one hypothesis (default 2)")
+    dia.add_argument("--all-hypotheses", action="store_true",
+                     help="fit every pair of effects even when the nominal model explains the data")
     dia.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")
     dia.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     dia.add_argument("--out", metavar="DIR", help="write the report (report.md, figures, CSV tables) into DIR")
@@ -263,7 +265,7 @@ def _diagnose(args) -> int:
     picked = {r.name: r for r in spectra}
     try:
         result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,
-                          tension_model=args.tension_model,
+                          tension_model=args.tension_model, all_hypotheses=args.all_hypotheses,
                           progress=lambda k, n, label: _progress(f"diagnose: hypothesis {k} of {n} ({label})"))
     except InputError as err:
         raise InputError(err.message, field=err.field, file=err.file or file) from None

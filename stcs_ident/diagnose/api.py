@@ -18,7 +18,7 @@ from ..model import Campaign
 from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
 from .hypotheses import EFFECTS, applicable, build, hypothesis_sets, parse_effects
 from .result import Diagnosis
-from .selection import BASELINE, select
+from .selection import BASELINE, explains, select
 
 Progress = Callable[[int, int, str], None]
 
@@ -28,7 +28,8 @@ MAX_WORKERS = 8
 
 def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects: str | Sequence[str] | None = None,
              picked: Mapping[str, object] | None = None, max_effects: int = 2, tension_model: str = "uniform",
-             progress: Progress | None = None, workers: int | None = None) -> Diagnosis:
+             progress: Progress | None = None, workers: int | None = None,
+             all_hypotheses: bool = False) -> Diagnosis:
     """Diagnose the nominal model of ``campaign`` against its measured frequencies.
 
     Parameters
@@ -50,6 +51,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     workers : int, optional
         Processes fitting hypotheses in parallel (default: the CPUs this
         process may use, at most :data:`MAX_WORKERS`; 1 fits in this process).
+    all_hypotheses : bool
+        Fit every pair even when the nominal model explains the data (by
+        default only the single effects and the baseline are then fitted:
+        no pair can change an empty cause).
 
     Returns
     -------
@@ -100,14 +105,23 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     timings: dict[tuple[str, ...], float] = {}
     done = 0
     # Single effects first (their estimates and profile minima seed the pairs), each stage in parallel.
-    for stage in ([s for s in sets if len(s) <= 1], [s for s in sets if len(s) > 1]):
+    stages = [[s for s in sets if len(s) <= 1], [s for s in sets if len(s) > 1]]
+    total = len(sets)
+    for i, stage in enumerate(stages):
+        if i == 1 and not all_hypotheses and explains(fits[()], n):
+            # No pair can change an empty cause: fit only the baseline, which the gain needs.
+            kept = [s for s in stage if s == baseline]
+            notes.append(f"the nominal model explains the data: {len(stage) - len(kept)} pairs of effects not "
+                         f"fitted (they cannot change an empty cause; all_hypotheses fits them)")
+            total -= len(stage) - len(kept)
+            stage = kept
         jobs = [(campaign, measurements, s, tension_model, symmetric, _pair_seeds(fits, s) if len(s) > 1 else [])
                 for s in stage]
         for s, fit, seconds in _map(_fit_job, jobs, workers):
             fits[s], timings[s] = fit, seconds
             done += 1
             if progress is not None:
-                progress(done, len(sets), " + ".join(s) if s else "nominal")
+                progress(done, total, " + ".join(s) if s else "nominal")
     selection = select(fits, n, max_effects)
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,

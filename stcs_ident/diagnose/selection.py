@@ -66,6 +66,11 @@ class Selection:
     statement: str
 
 
+def explains(nominal: HypothesisFit, n: int) -> bool:
+    """Whether the nominal model explains ``n`` frequencies within their uncertainty (step 1)."""
+    return float(chi2_distribution.sf(nominal.chi2, n)) >= ALPHA
+
+
 def ranking(fits: dict[tuple[str, ...], HypothesisFit]) -> list[HypothesisFit]:
     """Fits sorted by AICc (ties: fewer parameters first)."""
     return sorted(fits.values(), key=lambda f: (f.aicc, f.n_parameters, len(f.effects)))

@@ -92,6 +92,7 @@ from .events import Event, detect_events, whole_record_event
 from .overview import Candidate, Overview, ambient_overview, decay_overviews, detect_multiresolution
 from .record import Record
 from .refine import MAX_DAMPING, refine
+from .residual import residual_candidates
 
 __all__ = ["Peak", "PeakResult", "find_peaks"]
 
@@ -259,7 +260,7 @@ def find_peaks(
     overview = overviews[0]
     candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db)
     refine = _refine_decays if events else _refine_ambient
-    peaks = _deduplicate(refine(x, fs, events, overview, candidates, record.channel_names))
+    peaks = _deduplicate(refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi)))
     if max_peaks is not None and len(peaks) > max_peaks:
         # After the fits: the overview's strongest candidates may include some that are not modes.
         strongest = sorted(peaks, key=lambda p: p.snr_db, reverse=True)[:max_peaks]
@@ -301,7 +302,7 @@ def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple
     return f_lo, f_hi
 
 
-def _refine_decays(x, fs, events, overview: Overview, candidates, names) -> list[Peak]:
+def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -> list[Peak]:
     spectra = event_spectra(x, [(e.start, e.stop) for e in events])
     resolution = 1.0 / (max(e.n_samples for e in events) / fs)
     whittle = _whittle_band(x, fs, overview)
@@ -371,13 +372,24 @@ def _whittle_band(x: np.ndarray, fs: float, overview: Overview) -> Callable:
     return fit_band
 
 
-def _refine_ambient(x, fs, events, overview: Overview, candidates, names) -> list[Peak]:
+def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band) -> list[Peak]:
+    """Whittle fits of the candidates, then of what the fitted modes leave unexplained (:mod:`.residual`)."""
     resolution = overview.frequency[1] - overview.frequency[0]
     fit_band = _whittle_band(x, fs, overview)
+    cache: dict = {}
+
+    def fitted(candidates):
+        return refine(
+            candidates, fit_band, 1.5 * resolution, BAND_MIN_WELCH_BINS * resolution, 0.5 * fs, resolution, cache
+        )
+
+    pairs = fitted(candidates)
+    modes = [(fit.frequency, fit.decay_rate, fit.amplitude) for _, fit in pairs if fit is not None]
+    extra = residual_candidates(overview, fs, modes, candidates, *band)
+    if extra:
+        pairs = fitted(sorted([c for c, _ in pairs] + extra, key=lambda c: c.frequency))
     peaks = []
-    for c, fit in refine(
-        candidates, fit_band, 1.5 * resolution, BAND_MIN_WELCH_BINS * resolution, 0.5 * fs, resolution
-    ):
+    for c, fit in pairs:
         if fit is None:
             peaks.append(_overview_peak(c, overview, names))
         else:

@@ -128,6 +128,7 @@ def refine(
     min_half_width: float,
     nyquist: float,
     cell_width: float,
+    cache: dict | None = None,
 ) -> list[tuple[Candidate, object]]:
     """Fit every candidate with its active neighbours, dropping non-modes one at a time (module docstring).
 
@@ -144,6 +145,10 @@ def refine(
         Hz.
     cell_width : float
         Width of an independent cell of the overview spectrum, Hz.
+    cache : dict, optional
+        Fits by candidate and neighbours, shared between calls on the same
+        record (a second call with more candidates refits only the
+        candidates whose neighbours changed).
 
     Returns
     -------
@@ -152,7 +157,7 @@ def refine(
         on a peak too strong to drop.
     """
     active = list(range(len(candidates)))
-    cache: dict = {}
+    cache = {} if cache is None else cache
     fits: dict = {}
 
     def doubtful(i):
@@ -164,8 +169,9 @@ def refine(
     while True:
         for pos, i in enumerate(active):
             near = tuple(active[j] for j in (pos - 1, pos + 1) if 0 <= j < len(active))
-            if (i, near) not in cache:
-                cache[(i, near)] = _fit_candidate(
+            key = (candidates[i], tuple(candidates[j] for j in near))
+            if key not in cache:
+                cache[key] = _fit_candidate(
                     candidates[i],
                     [candidates[j] for j in near],
                     fit_band,
@@ -174,7 +180,7 @@ def refine(
                     nyquist,
                     cell_width,
                 )
-            fits[i] = cache[(i, near)]
+            fits[i] = cache[key]
         weak = [i for i in active if doubtful(i)]
         if not weak:
             return _without_satellites([(candidates[i], fits[i]) for i in active], cell_width)
