@@ -346,15 +346,6 @@ def _save(fig, path: Path) -> None:
 
 def _install(tmp: Path, out: Path) -> None:
     """Rename the finished ``tmp`` to ``out``; an old ``out`` is replaced only as a whole."""
-    if not out.exists():
-        os.replace(tmp, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-    os.replace(out, old / "previous")
-    try:
-        os.replace(tmp, out)
-    except BaseException:
-        os.replace(old / "previous", out)
-        raise
-    finally:
-        shutil.rmtree(old, ignore_errors=True)
+    from ..report import replace_directory
+
+    replace_directory(tmp, out)

@@ -217,15 +217,6 @@ def _install(tmp: Path, out: Path, overwrite: bool) -> None:
     _check_target(out, overwrite)
     if out.is_dir() and not any(out.iterdir()):
         out.rmdir()
-    if not out.exists():
-        os.replace(tmp, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-    os.replace(out, old / "previous")
-    try:
-        os.replace(tmp, out)
-    except BaseException:
-        os.replace(old / "previous", out)
-        raise
-    finally:
-        shutil.rmtree(old, ignore_errors=True)
+    from ..report import replace_directory
+
+    replace_directory(tmp, out)
