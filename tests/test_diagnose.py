@@ -84,6 +84,7 @@ def test_json_follows_the_contract(tmp_path):
     assert [x["delta_aicc"] for x in h] == sorted(x["delta_aicc"] for x in h) and h[0]["delta_aicc"] == 0
     for x in h:
         assert {"effects", "parameters", "n_parameters", "rms_error", "aicc", "delta_aicc", "cv_rms_error"} <= set(x)
+    assert sorted(x["cv_rank"] for x in h) == list(range(1, len(h) + 1))
     assert {"effects", "principal", "parameters", "ambiguous_with"} <= set(s["cause"])
     assert {"rms_error_nominal", "rms_error_corrected", "cv_rms_error_baseline", "cv_rms_error_corrected"} <= set(
         s["gain"])

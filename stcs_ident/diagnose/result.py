@@ -143,13 +143,15 @@ class Diagnosis:
             tests.append(entry)
         ranked = self.ranked
         best = ranked[0].aicc
+        cv_rank = self.cv_ranks()
         hypotheses = []
         for f in ranked:
             values, sigmas = self.parameters(f)
             hypotheses.append({"effects": list(f.effects), "parameters": values, "uncertainty": sigmas,
                                "n_parameters": f.n_parameters, "chi2": f.chi2, "rms_error": f.rms_error,
                                "aicc": _finite_or_none(f.aicc), "delta_aicc": _finite_or_none(f.aicc - best),
-                               "cv_rms_error": _finite_or_none(f.cv_rms_error), "notes": list(f.notes)})
+                               "cv_rms_error": _finite_or_none(f.cv_rms_error), "cv_rank": cv_rank.get(f.effects),
+                               "notes": list(f.notes)})
         sel = self.selection
         values, sigmas = self.parameters(corrected)
         gain = {"rms_error_nominal": nominal.rms_error, "rms_error_corrected": corrected.rms_error,
@@ -174,6 +176,12 @@ class Diagnosis:
             "seconds": self.elapsed,
         }
 
+    def cv_ranks(self) -> dict[tuple[str, ...], int]:
+        """Rank (1 = best) of each hypothesis by its leave-one-mode-out prediction error."""
+        scored = sorted((f for f in self.fits.values() if f.cv_rms_error is not None),
+                        key=lambda f: (f.cv_rms_error, f.n_parameters))
+        return {f.effects: i for i, f in enumerate(scored, start=1)}
+
     def cause_text(self) -> str:
         """The named cause in plain words, with values and uncertainties."""
         sel = self.selection
@@ -185,6 +193,13 @@ class Diagnosis:
         text = f"{'; '.join(parts)} explain{'s' if len(parts) == 1 else ''} the residual pattern"
         text = text[0].upper() + text[1:]
         text += f" (ΔAICc = {delta:.1f} against the nominal model; principal effect: {sel.principal})."
+        ranks = self.cv_ranks()
+        chosen = self.corrected
+        if ranks.get(chosen.effects, 1) > 1:
+            top = next(f for f in self.fits.values() if ranks.get(f.effects) == 1)
+            text += (f" By leave-one-mode-out prediction error it ranks {ranks[chosen.effects]}; "
+                     f"{' + '.join(top.effects) or 'the nominal model'} predicts left-out modes best "
+                     f"({top.cv_rms_error:.3g} % against {chosen.cv_rms_error:.3g} %).")
         if sel.ambiguous_with:
             text += (" Not told apart from: " + "; ".join(" + ".join(a) for a in sel.ambiguous_with)
                      + " (ΔAICc < 2).")
