@@ -12,8 +12,7 @@ noise-free record peaks at the mode (6 dB above the spectrum half-way to
 the neighbouring modes: a peak, not the tail of a neighbour at a node) and
 stands 10 dB above the spectrum of the noise alone. No peak may
 carry a wrong number without being flagged doubtful, and every visible mode
-should be found and correctly numbered (the issue's goal; the test bounds
-the misses at the level reached so far, 2 of 725). For free decays at ≥ 20 dB the
+must be found (within 2 %) and correctly numbered. For free decays at ≥ 20 dB the
 frequency errors are compared with the Cramér–Rao bound of the case
 (spectra/crb.py: Yao & Pandit's bound for damped sinusoids with common
 frequency and decay across channels, per-channel amplitude and noise):
@@ -162,9 +161,9 @@ def test_spectra_acceptance_over_simulated_records():
     print(f"{N_RECORDS} records, {n_visible} visible modes, {len(missed)} missed, {len(mislabelled)} mislabelled, "
           f"median error/CRB {np.median(ratios):.2f} over {len(ratios)} modes")
     assert not mislabelled, mislabelled[:5]
-    # The issue asks for no miss at all. Left (seed 100: the stay, ambient, ζ = 1.8 %, 4 sensors): mode 10
-    # is not detected (in a band filled with broad resonances its peak rises 4.0 dB above the valley beside
-    # it, under the 4.4 dB threshold), and mode 9's fit, with mode 10 unmodelled in its band, ends 2.03 % off.
-    # This bound guards what is reached.
-    assert len(missed) <= 2, missed
+    # The hardest case, seed 100 (the stay, ambient, ζ = 1.8 %, 4 sensors): mode 10 rises only 4.0 dB above
+    # the valley beside it, under the prominence asked of a detection; it is found by the residual pass
+    # (spectra/residual.py: what the fitted modes leave unexplained), and mode 9, fitted with it as a
+    # neighbour, no longer absorbs it.
+    assert not missed, missed
     assert np.median(ratios) <= 2.0

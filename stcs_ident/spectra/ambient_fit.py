@@ -94,13 +94,21 @@ class AmbientFit:
     converged: bool
 
 
-def fejer_lorentzian(z: complex, phase: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """H(u) = 2G(u) − 1 and dH/dz at u = exp(z − iφ), for the pole z = sΔt (see the module docstring)."""
+def fejer_lorentzian(
+    z: complex, phase: np.ndarray, n: int, derivative: bool = True
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """H(u) = 2G(u) − 1 and dH/dz at u = exp(z − iφ), for the pole z = sΔt (see the module docstring).
+
+    With ``derivative=False`` only H (and None): the start grid and the
+    fixed neighbours need no derivative.
+    """
     log_u = z - 1j * phase
     u = np.exp(log_u)
     one_minus = -np.expm1(log_u)
     trunc = -np.expm1(n * log_u)  # 1 − u^N
     g = 1.0 / one_minus - u * trunc / (n * one_minus**2)
+    if not derivative:
+        return 2.0 * g - 1.0, None
     # dG/du, then du/dz = u.
     dg_du = (
         1.0 / one_minus**2 - (trunc - n * np.exp(n * log_u)) / (n * one_minus**2) - 2 * u * trunc / (n * one_minus**3)
@@ -118,12 +126,14 @@ class _Problem:
     nonnegative: np.ndarray  # (2 + q,) bool: linear coefficients that are powers (mode, neighbours, constant)
 
 
-def _design(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, np.ndarray]:
+def _design(theta_nl: np.ndarray, problem: _Problem, derivative: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
     """Real basis (m, 2 + q) of the expected periodogram and its derivative wrt (f, σ) for the mode term."""
     z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
-    h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples)
+    h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples, derivative)
     # α Re H + β Im H with |β| ≤ α, written as p (Re H + Im H) + q (Re H − Im H) with p, q ≥ 0.
     basis = np.column_stack([h.real + h.imag, h.real - h.imag, problem.fixed])
+    if not derivative:
+        return basis, None
     dz = (2j * np.pi * problem.dt, -problem.dt)
     deriv = np.stack(
         [np.column_stack([(dh * d).real + (dh * d).imag, (dh * d).real - (dh * d).imag]) for d in dz], axis=-1
@@ -147,7 +157,7 @@ def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
 
 def _linear_start(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, float]:
     """Linear coefficients for given (f, σ)."""
-    basis, _ = _design(theta_nl, problem)
+    basis, _ = _design(theta_nl, problem, derivative=False)
     return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=3)  # a start only
 
 
@@ -382,7 +392,7 @@ def _fixed_basis(freq, f_centre, half_width, neighbours, k, n, dt) -> np.ndarray
     columns = []
     phase = 2 * np.pi * k / n
     for fj, sj in neighbours:
-        h, _ = fejer_lorentzian(complex(-sj * dt, 2 * np.pi * fj * dt), phase, n)
+        h, _ = fejer_lorentzian(complex(-sj * dt, 2 * np.pi * fj * dt), phase, n, derivative=False)
         columns.append(h.real)
     columns += [np.ones(freq.size), (freq - f_centre) / half_width]
     return np.column_stack(columns)

@@ -83,10 +83,12 @@ def _nan_median(values: np.ndarray, axis: int, min_count: int) -> np.ndarray:
     return np.squeeze(median, axis=axis)
 
 
-def noise_floor(spectra: np.ndarray, dof, cell: int) -> np.ndarray:
+def noise_floor(spectra: np.ndarray, dof, cell: int, passes: int = FLOOR_PASSES) -> np.ndarray:
     """Local noise floor of each column of `spectra` (mean level of the noise; see the module docstring).
 
     `dof` is a number or one per bin (degrees of freedom of the spectrum).
+    `passes` = 1 takes the running median without leaving peaks out (for
+    a spectrum whose peaks have been taken out already).
     """
     dof = np.broadcast_to(np.asarray(dof, dtype=float), spectra.shape[:1])
     correction = _quantile_to_mean(dof, 0.5)[:, None]
@@ -99,8 +101,10 @@ def noise_floor(spectra: np.ndarray, dof, cell: int) -> np.ndarray:
     smooth_threshold = np.maximum(stats.chi2.isf(MASK_PROBABILITY, smooth_dof) / smooth_dof, 2.0)[:, None]
     masked = spectra
     floor = None
-    for _ in range(FLOOR_PASSES):
+    for k in range(passes):
         floor = _block_floor(masked, cell) / correction
+        if k == passes - 1:
+            break
         ratio = spectra / floor
         smooth = ndimage.uniform_filter1d(ratio, smoothing, axis=0, mode="nearest")
         peaks = _peak_regions(ratio, threshold, smooth) | _peak_regions(smooth, smooth_threshold)

@@ -13,9 +13,13 @@ Model spectrum
     Welch spectrum of the sum exactly: the autocovariance times the
     autocorrelation of the Hann window, transformed (so a mode narrower
     than a Welch cell has the window's line shape). The channel's
-    expected spectrum is its noise floor plus that of the modes (where
-    resonances fill the band the floor already holds part of their
-    tails: the test is then conservative).
+    expected spectrum is that of the modes plus a noise floor estimated
+    afresh (:func:`.floor.noise_floor`) from the spectrum less the modes:
+    where resonances fill the band, the overview's floor follows the
+    valleys between them, i.e. holds their tails, which the model then
+    counts again (on seed 100 of tests/test_spectra_acceptance.py the
+    Welch spectrum over floor plus model averaged 0.79 over the band
+    searched; with the floor afresh, 1.01).
 
 Detection
     The Welch spectrum over that expectation is, where the model is
@@ -28,6 +32,14 @@ Detection
     expectation. What passes is only a proposal (misfit of a fitted
     mode also leaves excess): it is reported only if its fit with the
     others confirms a mode (:mod:`.refine`).
+
+Measured
+    tests/test_spectra_acceptance.py: the 2 misses left (seed 100) are
+    found, nothing else changes. Its generator on seeds 105–404 (101
+    ambient records, 863 visible modes): misses 6 → 4, no peak mislabelled
+    or away from every mode either way. 120 pure-noise records (1, 3 and
+    16 channels, white and low-pass): no proposal. Cost on the 16-channel,
+    10-minute throughput record: about 25 ms (no proposal there).
 """
 
 from __future__ import annotations
@@ -38,7 +50,8 @@ import numpy as np
 from scipy import signal
 from scipy.fft import irfft, rfft
 
-from .overview import Candidate, Overview, _candidate, detection_threshold
+from .floor import noise_floor
+from .overview import FALSE_ALARM, Candidate, Overview, _candidate, detection_threshold
 
 __all__ = ["model_spectra", "residual_candidates"]
 
@@ -56,21 +69,32 @@ def model_spectra(overview: Overview, sampling_rate: float, modes: list[tuple[fl
     if not modes:
         return np.zeros((n_freq, n_channels))
     df = overview.frequency[1] - overview.frequency[0]
-    length = int(round(sampling_rate / df))
+    length = round(sampling_rate / df)
     window = signal.windows.hann(length, sym=False)
     lag_weight = irfft(np.abs(rfft(window, 2 * length)) ** 2, 2 * length)[:length]  # Σ_n w[n] w[n+τ]
-    lag = np.arange(length) / sampling_rate
     frequency = np.array([m[0] for m in modes])
     decay = np.array([m[1] for m in modes])
     power = np.array([np.asarray(m[2], dtype=float) ** 2 for m in modes])  # (n_modes, n_channels)
     damped = np.sqrt(np.maximum((2 * np.pi * frequency) ** 2 - decay**2, 0.0))
-    shapes = np.exp(-np.outer(lag, decay)) * np.cos(np.outer(lag, damped))  # (length, n_modes)
+    shapes = _pole_powers((-decay + 1j * damped) / sampling_rate, length).real  # e^{−στ} cos(ω_d τ), (length, n_modes)
     covariance = (shapes @ power) * lag_weight[:, None]  # (length, n_channels)
     # Σ over lags −(L−1) … L−1 of an even sequence: twice the DFT of lags 0 … L−1, less lag 0.
     two_sided = 2.0 * rfft(covariance, axis=0).real - covariance[:1]
     psd = two_sided / (np.sum(window**2) * sampling_rate)
     psd[1:-1] *= 2.0
     return np.maximum(psd[:n_freq], 0.0)
+
+
+def _pole_powers(z: np.ndarray, length: int) -> np.ndarray:
+    """exp(z τ) for τ = 0 … length−1 and each pole z, (length, n_poles): r^(bB + j) = (r^B)^b r^j.
+
+    Products of two short tables instead of length × n_poles complex
+    exponentials (the model spectrum's main cost on long records).
+    """
+    block = int(np.ceil(np.sqrt(length)))
+    inner = np.exp(np.outer(np.arange(block), z))
+    outer = np.exp(np.outer(np.arange(block) * block, z))
+    return (outer[:, None, :] * inner[None, :, :]).reshape(block * block, z.size)[:length]
 
 
 def residual_candidates(
@@ -109,16 +133,23 @@ def residual_candidates(
     if hi <= lo:
         return []
     n_cells = max(hi - lo, 1) // overview.cell
-    expected = overview.channel_floor + model_spectra(overview, sampling_rate, modes)
+    model = model_spectra(overview, sampling_rate, modes)
+    # The floor afresh, of what the modes leave: where resonances fill the band, the overview's floor holds
+    # their tails (it follows the valleys between them), and with the model on top they would count twice.
+    floor = (
+        noise_floor(np.maximum(overview.channel_spectra - model, 0.0), overview.dof, overview.cell, passes=1)
+        if modes
+        else overview.channel_floor
+    )
+    expected = floor + model
     ratio = overview.channel_spectra / expected
-    false_alarm = RESIDUAL_FALSE_ALARM_SHARE * 1e-4
-    statistics = [(ratio.mean(axis=1), detection_threshold(overview, n_cells, false_alarm=false_alarm),
-                   overview.combined_dof)]
+    false_alarm = RESIDUAL_FALSE_ALARM_SHARE * FALSE_ALARM
+    statistics = [(ratio.mean(axis=1), overview.combined_dof, False)]
     if ratio.shape[1] > 1:
-        statistics.append((ratio.max(axis=1), detection_threshold(
-            overview, n_cells, per_channel=True, false_alarm=false_alarm), overview.channel_dof))
+        statistics.append((ratio.max(axis=1), overview.channel_dof, True))
     found: list[Candidate] = []
-    for statistic, threshold, dof in statistics:
+    for statistic, dof, per_channel in statistics:
+        threshold = detection_threshold(overview, n_cells, per_channel=per_channel, false_alarm=false_alarm)
         index, _ = signal.find_peaks(statistic, distance=max(1, overview.cell))
         index = index[(index >= lo) & (index <= hi)]
         for k in index[statistic[index] >= threshold[index]]:
