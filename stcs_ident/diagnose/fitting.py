@@ -33,6 +33,7 @@ import numpy as np
 
 from ..forward import batch_frequencies
 from ..identify.lsq import _local_fit, fit_lsq
+from ..identify.parameters import fixity
 from ..identify.problem import Measurement, Problem
 from ..identify.result import IdentificationResult
 from ..model import Campaign, Test
@@ -163,8 +164,6 @@ def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None
             if v is None:
                 continue
             if p.kind == "end_stiffness":
-                from ..identify.parameters import fixity
-
                 x[j] = fixity(v, p.reference_stiffness)
             else:
                 x[j] = v / p.scale

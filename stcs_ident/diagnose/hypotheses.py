@@ -24,6 +24,7 @@ are unchanged), whose parameters carry one ``slot`` per setup.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -202,8 +203,6 @@ def build(campaign: Campaign, tests: Sequence[Test], effects: Sequence[str],
 
 def hypothesis_sets(effects: Sequence[str], max_effects: int = 2) -> list[tuple[str, ...]]:
     """The nominal model, every single effect and every pair (up to ``max_effects``)."""
-    import itertools
-
     out: list[tuple[str, ...]] = [()]
     for k in range(1, max_effects + 1):
         out += list(itertools.combinations(effects, k))
