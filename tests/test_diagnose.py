@@ -171,3 +171,14 @@ def test_cli_writes_json(tmp_path, capsys):
     assert data["campaign"] == "c" and data["hypotheses"]
     assert "hypothesis 1 of" in captured.err  # progress
     assert "Cause:" in captured.out
+
+
+def test_notes_name_values_in_si_units():
+    from stcs_ident.diagnose.fitting import in_si_units
+    from stcs_ident.identify.parameters import Parameter
+
+    params = [Parameter("position", "(unmodeled mass)", 0.3, 0.3, 0.1, 60.0, slots=(("S", 0),)),
+              Parameter("EI", None, 2e5, 2e5, 0.01, 100.0), Parameter("tension", "T1", 4e5, 4e5, 0.5, 2.0)]
+    note = "other: position_ratio[(unmodeled mass)] = 63.9977, EI_ratio = 0.5, tension_ratio[T1] = 1.02"
+    assert in_si_units(note, params) == (
+        "other: position[(unmodeled mass)] = 19.1993 m, EI = 100000 N m^2, tension_ratio[T1] = 1.02")

@@ -25,6 +25,7 @@ prediction of an unseen test.
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -145,6 +146,31 @@ def _quiet(fn, notes: list[str]):
     return out
 
 
+#: Units of the SI values of the parameter kinds a note may name.
+_UNITS = {"EI": "N m^2", "length": "m", "position": "m", "mass": "kg", "stiffness": "N/m",
+          "mass_per_length": "kg/m"}
+
+
+def in_si_units(note: str, parameters: Sequence) -> str:
+    """``note`` with every ``name = variable`` of ``parameters`` rewritten in SI units
+    (``position_ratio[W1] = 1.02`` → ``position[W1] = 10.05 m``); ratios of tension and the end
+    fixity stay as they are."""
+    by_name = {p.name: p for p in parameters if p.kind in _UNITS}
+
+    def convert(match: re.Match) -> str:
+        p = by_name.get(match.group(1))
+        if p is None:
+            return match.group(0)
+        value = float(p.to_value(float(match.group(2))))
+        label = p.kind if p.member is None else f"{p.kind}[{p.member}]"
+        return f"{label} = {value:.6g} {_UNITS[p.kind]}"
+
+    return _ASSIGNMENT.sub(convert, note)
+
+
+_ASSIGNMENT = re.compile(r"([A-Za-z_]+(?:\[[^\]]*\])?) = ([-+0-9.eE]+)")
+
+
 def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None], float]],
                  nominal: bool = True) -> np.ndarray:
     """Variable vectors of ``problem`` from SI values by (kind, member); missing ones nominal.
@@ -233,6 +259,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         if other.chi2 < result.chi2 * (1 - 1e-9):
             result = other
     notes += [n for n in result.notes if n not in notes]
+    notes = [in_si_units(note, problem.parameters) for note in notes]
     n = problem.n_data
     predicted = problem.predict(result.estimate)
     fit = HypothesisFit(hyp, result, predicted, result.chi2, aicc(result.chi2, n, len(hyp.parameters)),
