@@ -182,3 +182,16 @@ def test_notes_name_values_in_si_units():
     note = "other: position_ratio[(unmodeled mass)] = 63.9977, EI_ratio = 0.5, tension_ratio[T1] = 1.02"
     assert in_si_units(note, params) == (
         "other: position[(unmodeled mass)] = 19.1993 m, EI = 100000 N m^2, tension_ratio[T1] = 1.02")
+
+
+def test_modes_with_doubtful_numbers_are_left_out():
+    from types import SimpleNamespace
+
+    campaign, picked = synthetic(None, seed=5)
+    m = picked["T1"]
+    doubtful = (False, False, True, False, False, False)
+    picked["T1"] = SimpleNamespace(modes=tuple(m.modes), frequencies=m.frequencies, uncertainty=m.uncertainty,
+                                   doubtful=doubtful)
+    d = diagnose(campaign, picked=picked, max_effects=1)
+    assert list(d.measurements[0].modes) == [1, 2, 4, 5, 6]
+    assert any("T1: modes 3 left out" in n for n in d.notes)

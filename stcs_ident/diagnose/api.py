@@ -12,8 +12,10 @@ import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 
+import numpy as np
+
 from ..errors import InputError
-from ..identify.problem import gather_measurements
+from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
 from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
 from .hypotheses import EFFECTS, applicable, build, hypothesis_sets, parse_effects
@@ -42,7 +44,9 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         Effects of the vocabulary to consider (default all of
         :data:`~stcs_ident.diagnose.hypotheses.EFFECTS`).
     picked : mapping, optional
-        {test: spectra or Measurement} replacing a test's table.
+        {test: spectra or Measurement} replacing a test's table. Modes of
+        spectra whose number is flagged doubtful are left out (and said so
+        in the notes): a wrong number would pass for a model error.
     max_effects : int
         Largest number of effects combined in one hypothesis (1 or 2).
     tension_model : {"uniform", "per-segment", "none"}
@@ -74,9 +78,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     names = parse_effects(effects)
     if max_effects not in (1, 2):
         raise InputError(f"must be 1 or 2, got {max_effects!r}", field="max_effects")
+    picked, excluded = _without_doubtful(campaign, picked or {})
     measurements, skipped = gather_measurements(campaign, tests, picked)
     measured_tests = [m.test for m in measurements]
-    notes: list[str] = []
+    notes: list[str] = list(excluded)
     usable = []
     for e in names:
         why = applicable(campaign, measured_tests, e)
@@ -140,6 +145,26 @@ def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
         for point in [fit.values(), *fit.minima]:
             seeds.append({**others, **point})
     return seeds
+
+
+def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple[dict, list[str]]:
+    """Picked spectra without the modes whose number is doubtful (a wrong number would pass for a
+    model error), and a note for each test that lost some."""
+    out, notes = {}, []
+    known = {t.name for t in campaign.tests}
+    for name, spectra in picked.items():
+        doubtful = np.asarray(getattr(spectra, "doubtful", ()), bool)
+        if name not in known or not doubtful.any() or doubtful.size != len(spectra.modes):
+            out[name] = spectra
+            continue
+        keep = ~doubtful
+        test = campaign.test(name)
+        if keep.any():
+            out[name] = Measurement(test, np.asarray(spectra.modes)[keep], np.asarray(spectra.frequencies)[keep],
+                                    np.asarray(spectra.uncertainty)[keep], "spectra")
+        lost = ", ".join(str(m) for m in np.asarray(spectra.modes)[doubtful])
+        notes.append(f"{name}: modes {lost} left out (their numbers are doubtful)")
+    return out, notes
 
 
 def _fit_job(job) -> tuple[tuple[str, ...], HypothesisFit, float]:
