@@ -195,3 +195,31 @@ def test_modes_with_doubtful_numbers_are_left_out():
     d = diagnose(campaign, picked=picked, max_effects=1)
     assert list(d.measurements[0].modes) == [1, 2, 4, 5, 6]
     assert any("T1: modes 3 left out" in n for n in d.notes)
+
+
+def _fit(effects, k, chi2, n):
+    from stcs_ident.diagnose.fitting import HypothesisFit
+    from stcs_ident.diagnose.hypotheses import Hypothesis
+
+    hyp = Hypothesis(tuple(effects), None, (None,) * k, tuple(effects))
+    return HypothesisFit(hyp, None, np.zeros(n), chi2, aicc(chi2, n, k), 0.0)
+
+
+def test_selection_adds_an_effect_only_when_the_simpler_model_fails():
+    from stcs_ident.diagnose.selection import select
+
+    n = 12
+    fits = {(): _fit((), 0, 5000.0, n), ("length",): _fit(("length",), 1, 16.6, n),
+            ("attachment_mass", "length"): _fit(("attachment_mass", "length"), 2, 8.1, n),
+            ("attachment_mass",): _fit(("attachment_mass",), 1, 900.0, n)}
+    # the pair is 5.5 lower in AICc, but length alone leaves chi2 16.6 for 11 dof (p = 0.12): length is the cause
+    sel = select(fits, n)
+    assert sel.effects == ("length",) and sel.principal == "length"
+    # when length alone fails (chi2 60 for 11 dof, p ~ 1e-8), the pair is named, its principal the costlier
+    fits[("length",)] = _fit(("length",), 1, 60.0, n)
+    sel = select(fits, n)
+    assert sel.effects == ("attachment_mass", "length") and sel.principal == "length"
+    # the nominal model within the noise: empty cause whatever the others do
+    fits[()] = _fit((), 0, 14.0, n)
+    sel = select(fits, n)
+    assert sel.effects == () and sel.principal is None and sel.explained

@@ -11,7 +11,11 @@
 3. **Parsimony**: a hypothesis nested in the best one (a subset of its
    effects) that is within :data:`AMBIGUITY` of it in AICc explains the data
    as well with fewer effects and is preferred (Burnham & Anderson: an
-   added parameter that lowers χ² by less than 2 is not supported).
+   added parameter that lowers χ² by less than 2 is not supported). So is a
+   nested hypothesis that already explains the data within their
+   uncertainty (its χ² below the 1 − ALPHA quantile for n − k degrees of
+   freedom): as for the nominal model in step 1, an effect is added only
+   when the simpler model fails, never to absorb the noise.
 4. **Principal effect**: of the chosen effects, the one whose removal
    raises AICc most.
 5. **Ambiguity**: every other hypothesis within :data:`AMBIGUITY` of the
@@ -71,6 +75,12 @@ def explains(nominal: HypothesisFit, n: int) -> bool:
     return float(chi2_distribution.sf(nominal.chi2, n)) >= ALPHA
 
 
+def _within_noise(fit: HypothesisFit, n: int) -> bool:
+    """Whether a fitted hypothesis leaves a χ² the measurement uncertainty explains (n − k dof)."""
+    dof = n - fit.n_parameters
+    return dof > 0 and float(chi2_distribution.sf(fit.chi2, dof)) >= ALPHA
+
+
 def ranking(fits: dict[tuple[str, ...], HypothesisFit]) -> list[HypothesisFit]:
     """Fits sorted by AICc (ties: fewer parameters first)."""
     return sorted(fits.values(), key=lambda f: (f.aicc, f.n_parameters, len(f.effects)))
@@ -93,7 +103,7 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
     best = ranked[0]
     while True:
         nested = [f for f in ranked if f.effects and set(f.effects) < set(best.effects)
-                  and f.aicc - best.aicc < AMBIGUITY]
+                  and (f.aicc - best.aicc < AMBIGUITY or _within_noise(f, n))]
         if not nested:
             break
         best = min(nested, key=lambda f: (len(f.effects), f.aicc))
