@@ -1,4 +1,4 @@
-"""Spectral overview: per-channel spectra, noise floors, the combined spectrum and peak detection.
+"""Spectral overview: per-channel spectra, noise floors and the combined spectrum.
 
 Spectra
     Free decays: per event and channel, the periodogram of the segment
@@ -25,66 +25,31 @@ Combined spectrum
     (FDD) would weight channels better but has no simple null distribution.
 
 Detection
-    Two statistics share a nominal false-alarm probability of 1e-4 per
-    record (Bonferroni over the independent cells): the combined spectrum,
-    and the largest single channel's spectrum over its floor (a mode seen
-    by one channel of many is diluted C times in the mean). A candidate is
-    a local maximum above floor × t, t the chi-squared quantile for the
-    local degrees of freedom widened by the scatter of the floor estimate,
-    with a prominence (height over the higher neighbouring valley) of t
-    too. In ambient spectra, where the response itself scatters, the
-    prominence must also beat the F quantile of the ratio of two spectrum
-    values at 0.5 false bumps per record: ripple on skirts is kept down,
-    and what passes is rejected by the fit (:mod:`.refine`). Of candidates
-    not separated by a valley (in a running mean over half a peak width)
-    down to the floor, or by the threshold below the weaker peak (ambient:
-    or deeper than the ripple of that mean goes, F quantile at 1 %), only
-    the one exceeding its threshold most is kept: one per resonance, even
-    when ambient loading puts random ripple on it.
-
-    Free decays are looked at in several resolutions
-    (:func:`decay_overviews`, :func:`detect_multiresolution`): the
-    whole-event periodogram, the same averaged over SMOOTHING cells (weak,
-    heavily damped modes), and full-Hann windows over the first L samples
-    of each event, L = N/4, N/16, … (modes decaying in a small part of the
-    event; weak modes on the 1/f² skirts of strong ones). The false-alarm
-    probability is shared equally among them, and a coarser overview adds
-    a candidate only where the finer ones have none; the fit confirms it
-    or it is dropped.
-
-    Measured, 60 s at 256 Hz: a candidate in 0 of 400 white-noise and 0 of
-    400 low-pass-noise records with one channel, 0 and 2 of 200 with
-    three; no peak reported in 180 noise records (1, 3 and 16 channels,
-    white and low-pass) once the fit has judged the candidates.
+    Candidates are found in these overviews by :mod:`.detection`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, signal, special
+from scipy import ndimage, signal
 from scipy.fft import next_fast_len, rfft
 
 from .events import Event
-from .floor import floor_log_variance, noise_floor, ripple_dof
+from .floor import noise_floor, ripple_dof
 
 __all__ = [
     "Overview",
     "ambient_overview",
     "decay_overview",
     "decay_overviews",
-    "detect_multiresolution",
-    "detect_peaks",
     "noise_floor",
     "smoothed_overview",
 ]
 
-FALSE_ALARM = 1e-4  # nominal, per record (measured rates in the module docstring)
 DECAY_PADDING = 2
 RIPPLE_DOF_CAP = 8  # free decays: local degrees of freedom at most 8 C ν
-RIPPLE_FALSE_ALARM = 0.5  # per record: ripple bumps that pass the prominence test (the fit rejects them)
-SEPARATION_PROBABILITY = 0.01  # a valley deeper than ripple makes with this probability separates two resonances
 WELCH_SEGMENTS = 16
 DECAY_WINDOW_RATIO = 4  # successive decay-matched windows are this much shorter
 MIN_DECAY_WINDOW = 64  # samples, shortest decay-matched window
@@ -303,253 +268,3 @@ def _overview(frequency, psd, floor, dof, combined_dof, channel_dof, cell, rando
     return Overview(
         frequency, psd, floor, combined, combined_floor, float(dof), combined_dof, channel_dof, int(cell), random_ripple
     )
-
-
-def detection_threshold(
-    overview: Overview, n_cells: int, per_channel: bool = False, false_alarm: float = FALSE_ALARM
-) -> np.ndarray:
-    """Height over the floor (per bin) that pure noise exceeds somewhere with probability `false_alarm` / 2.
-
-    For the mean over channels (``combined``), or with ``per_channel`` for
-    the largest single channel (the probability shared among the channels).
-    The statistic is Y / F: Y a chi-squared variable over its degrees of
-    freedom d (``combined_dof``, or one channel's), F the estimated floor
-    over the true one. log F is taken as normal with the variance of
-    :func:`.floor.floor_log_variance`, divided by the number of channels
-    whose floors average (d / dof), and the quantile is solved for over
-    that spread (Gauss–Hermite quadrature). Tabulated on a grid of d and
-    interpolated.
-    """
-    n_channels = overview.channel_spectra.shape[1]
-    per_cell = 0.5 * false_alarm / max(n_cells, 1) / (n_channels if per_channel else 1)
-    dof = overview.channel_dof if per_channel else overview.combined_dof
-    grid = np.geomspace(dof.min(), dof.max(), 24) if dof.max() > dof.min() else dof[:1]
-    floor_dof = overview.dof if overview.floor_dof is None else overview.floor_dof
-    table = _threshold_with_floor_error(grid, overview.dof, per_cell, floor_dof)
-    return np.interp(dof, grid, table) if grid.size > 1 else np.full(dof.shape, table[0])
-
-
-def _threshold_with_floor_error(
-    dof: np.ndarray, channel_dof: float, probability: float, floor_dof: float | None = None
-) -> np.ndarray:
-    """t with E_F[P(χ²_d / d > t F)] = probability for each d in `dof`, log F normal (see detection_threshold)."""
-    floor_dof = channel_dof if floor_dof is None else floor_dof
-    log_floor_var = floor_log_variance(floor_dof) / np.maximum(dof / channel_dof, 1.0)
-    nodes, weights = np.polynomial.hermite_e.hermegauss(16)
-    weights = weights / weights.sum()
-    shifts = np.exp(np.sqrt(log_floor_var)[:, None] * nodes[None, :])  # (grid, nodes)
-
-    def exceed(t):
-        return np.sum(weights * special.chdtrc(dof[:, None], (t[:, None] * dof[:, None]) / shifts), axis=1)
-
-    lo, hi = np.ones(dof.shape), np.ones(dof.shape)
-    while np.any(low := exceed(hi) > probability):
-        hi = np.where(low, 2.0 * hi, hi)
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        above = exceed(mid) > probability
-        lo, hi = np.where(above, mid, lo), np.where(above, hi, mid)
-    return hi
-
-
-@dataclass(frozen=True, eq=False)
-class Candidate:
-    """A detected peak.
-
-    Parameters
-    ----------
-    index : int
-        Bin of the maximum.
-    frequency : float
-        Interpolated frequency, Hz.
-    snr_db : float
-        Height above the floor in the statistic that found it, dB.
-    half_power_width : float
-        -3 dB width above the floor, Hz.
-    threshold : float
-        That statistic's detection threshold at the peak (linear).
-    dof : float
-        That statistic's degrees of freedom at the peak.
-    spectrum : ndarray (n_freq,)
-        That statistic (spectrum / floor), shared, not copied.
-    proposal : bool
-        True for a candidate carried over from a coarser overview
-        (:func:`detect_multiresolution`): those overviews are liberal, so
-        it is reported only if its fit confirms a mode, never from the
-        overview.
-    """
-
-    index: int
-    frequency: float
-    snr_db: float
-    half_power_width: float
-    threshold: float
-    dof: float
-    spectrum: np.ndarray = field(repr=False)
-    proposal: bool = False
-
-    @property
-    def exceedance(self) -> float:
-        """Height over the threshold, dB."""
-        return self.snr_db - 10 * np.log10(self.threshold)
-
-
-def detect_peaks(
-    overview: Overview, f_min: float, f_max: float, min_snr_db: float | None = None, share: float = 1.0
-) -> tuple[list[Candidate], np.ndarray]:
-    """Peaks within [f_min, f_max] (see the module docstring).
-
-    Two statistics share the false-alarm probability: the mean over
-    channels of spectrum / floor (sensitive when all channels see a mode)
-    and the largest single channel's (sensitive when only one does, where
-    the mean would dilute it C times). `share` is the fraction of the
-    record's false-alarm budgets (FALSE_ALARM, RIPPLE_FALSE_ALARM) given to
-    this overview (:func:`detect_multiresolution` splits them).
-
-    Returns
-    -------
-    candidates : list of Candidate
-        In frequency order.
-    threshold : ndarray (n_freq,)
-        The height over the combined floor a peak of the mean had to reach.
-    """
-    f = overview.frequency
-    df = f[1] - f[0]
-    lo = max(int(np.ceil(f_min / df)), 3 * overview.cell)
-    hi = min(int(np.floor(f_max / df)), f.size - 2)
-    n_cells = max(hi - lo, 1) // overview.cell
-    false_alarm = share * FALSE_ALARM
-    statistics = [
-        (
-            overview.combined / overview.combined_floor,
-            detection_threshold(overview, n_cells, false_alarm=false_alarm),
-            overview.combined_dof,
-        )
-    ]
-    if overview.channel_spectra.shape[1] > 1:
-        largest = np.max(overview.channel_spectra / overview.channel_floor, axis=1)
-        per_channel = detection_threshold(overview, n_cells, per_channel=True, false_alarm=false_alarm)
-        statistics.append((largest, per_channel, overview.channel_dof))
-    if min_snr_db is not None:
-        statistics = [(r, np.maximum(t, 10 ** (min_snr_db / 10)), d) for r, t, d in statistics]
-    if hi <= lo:
-        return [], statistics[0][1]
-    candidates = []
-    for ratio, t, dof in statistics:
-        index = _exceedances(overview, ratio, t, dof, lo, hi, n_cells / share)
-        candidates += [_candidate(overview, ratio, int(k), t[k], dof[k]) for k in index]
-    return _suppress_shoulders(overview, candidates), statistics[0][1]
-
-
-def detect_multiresolution(
-    overviews: list[Overview], f_min: float, f_max: float, min_snr_db: float | None = None
-) -> tuple[list[Candidate], np.ndarray]:
-    """Peaks of several overviews of one record (finest first), on the first one's frequency grid.
-
-    Each overview gets an equal share of the false-alarm budgets
-    (Bonferroni). A candidate of a coarser overview is added only where
-    no candidate already kept lies within the half-power width of either
-    (it is a resonance the finer overviews did not see), carried over to
-    the first overview's nearest bin with its own frequency, height and
-    width (its ``spectrum`` becomes the first overview's combined one).
-
-    Returns
-    -------
-    candidates : list of Candidate
-        In frequency order.
-    threshold : ndarray (n_freq,)
-        The first overview's threshold on the combined spectrum.
-    """
-    share = 1.0 / len(overviews)
-    candidates, threshold = detect_peaks(overviews[0], f_min, f_max, min_snr_db, share)
-    frequency = overviews[0].frequency
-    combined = overviews[0].combined / overviews[0].combined_floor
-    for overview in overviews[1:]:
-        extra, _ = detect_peaks(overview, f_min, f_max, min_snr_db, share)
-        for c in extra:
-            if all(abs(c.frequency - k.frequency) > max(c.half_power_width, k.half_power_width) for k in candidates):
-                index = int(np.argmin(np.abs(frequency - c.frequency)))
-                candidates.append(replace(c, index=index, spectrum=combined, proposal=True))
-    return sorted(candidates, key=lambda c: c.frequency), threshold
-
-
-def _exceedances(overview: Overview, ratio, t, dof, lo: int, hi: int, n_cells: float) -> np.ndarray:
-    """Local maxima of `ratio` in [lo, hi] above `t`, with a prominence of `t` (and the F quantile if random)."""
-    log_ratio = np.log10(np.maximum(ratio, np.finfo(float).tiny))
-    index, _ = signal.find_peaks(log_ratio, distance=max(1, overview.cell))
-    index = index[(index >= lo) & (index <= hi)]
-    index = index[ratio[index] >= t[index]]
-    if index.size == 0:
-        return index
-    prominence = signal.peak_prominences(log_ratio, index)[0]
-    needed = t[index]
-    if overview.random_ripple:
-        needed = np.maximum(needed, _f_isf(RIPPLE_FALSE_ALARM / max(n_cells, 1), dof[index]))
-    return index[prominence >= np.log10(needed)]
-
-
-def _f_isf(probability: float, dof):
-    """Upper `probability` quantile of F(dof, dof), the ratio of two independent spectrum values.
-
-    (special.fdtri directly: scipy.stats' distribution layer costs more than
-    the quantile itself, and this is called for every pair of candidates.)
-    """
-    return special.fdtri(dof, dof, 1.0 - probability)
-
-
-def _suppress_shoulders(overview: Overview, candidates: list[Candidate]) -> list[Candidate]:
-    """Keep one candidate per resonance (see :func:`_separated`), the one that exceeds its threshold most."""
-    kept: list[Candidate] = []
-    for c in sorted(candidates, key=lambda c: c.exceedance, reverse=True):
-        if all(_separated(overview, c, k) for k in kept):
-            kept.append(c)
-    return sorted(kept, key=lambda c: c.frequency)
-
-
-def _separated(overview: Overview, weak: Candidate, strong: Candidate) -> bool:
-    """Two candidates are two resonances if, between them, the smoothed spectrum falls to the floor, or
-    below the weaker peak by the detection threshold (ambient: or by more than its ripple does, F quantile 1 %).
-
-    The smoothing (a running mean over half the stronger peak's -3 dB
-    width, at least 5 cells) keeps the random ripple on one resonance (its
-    nulls, when ambient loading continues through a decay) from splitting it.
-    """
-    df = overview.frequency[1] - overview.frequency[0]
-    if abs(weak.frequency - strong.frequency) <= 0.5 * strong.half_power_width:
-        return False
-    n = max(5 * overview.cell, round(0.5 * strong.half_power_width / df))
-    lo, hi = sorted((weak.index, strong.index))
-    a, b = max(0, lo - n), min(overview.combined.size, hi + n + 1)
-    smooth = ndimage.uniform_filter1d(weak.spectrum[a:b], n, mode="nearest")
-    valley = np.min(smooth[lo - a : hi - a + 1])
-    depth = weak.threshold
-    if overview.random_ripple:
-        # Welch spectrum, degrees of freedom known: two values of its running mean differ by this factor with
-        # probability SEPARATION_PROBABILITY. (For free decays the ripple of a random response under the decay
-        # is not known inside a resonance: the threshold itself is the depth asked for.)
-        dof = weak.dof * n / overview.cell
-        depth = min(depth, float(_f_isf(SEPARATION_PROBABILITY, dof)))
-    return bool(valley <= max(1.0, smooth[weak.index - a] / depth))
-
-
-def _candidate(overview: Overview, ratio: np.ndarray, k: int, threshold: float, dof: float) -> Candidate:
-    """Interpolated frequency (parabola through the log) and -3 dB width (above the floor, 1) of a peak of `ratio`."""
-    f = overview.frequency
-    df = f[1] - f[0]
-    y = np.log(np.maximum(ratio[k - 1 : k + 2], np.finfo(float).tiny))
-    denom = y[0] - 2 * y[1] + y[2]
-    shift = 0.5 * (y[0] - y[2]) / denom if denom < 0 else 0.0
-    # Width on a 5-cell running mean, so that ripple does not end it early.
-    n = 5 * overview.cell
-    lo, hi = max(0, k - 50 * n), min(f.size, k + 50 * n + 1)
-    smooth = ndimage.uniform_filter1d(ratio[lo:hi], n, mode="nearest")
-    centre = k - lo
-    half = 1.0 + 0.5 * (smooth[centre] - 1.0)
-    below = np.flatnonzero(smooth <= half)
-    left = below[below < centre]
-    right = below[below > centre]
-    left = left[-1] if left.size else 0
-    right = right[0] if right.size else smooth.size - 1
-    snr = 10 * np.log10(ratio[k])
-    frequency = float(f[k] + np.clip(shift, -0.5, 0.5) * df)
-    return Candidate(k, frequency, float(snr), float((right - left) * df), float(threshold), float(dof), ratio)

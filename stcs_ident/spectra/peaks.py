@@ -95,8 +95,9 @@ from scipy import fft
 from ..errors import InputError
 from .ambient_fit import AmbientFit, fit_ambient
 from .decay_fit import DecayFit, event_spectra, fit_decay
+from .detection import Candidate, detect_multiresolution
 from .events import Event, detect_events, whole_record_event
-from .overview import Candidate, Overview, ambient_overview, decay_overviews, detect_multiresolution
+from .overview import Overview, ambient_overview, decay_overviews
 from .record import Record
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates

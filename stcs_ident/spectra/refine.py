@@ -31,7 +31,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .overview import Candidate
+from .detection import Candidate
 
 __all__ = ["FALLBACK_SNR_DB", "MAX_DAMPING", "MIN_SIGNIFICANCE", "refine"]
 

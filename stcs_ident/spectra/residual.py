@@ -25,7 +25,7 @@ Detection
     The Welch spectrum over that expectation is, where the model is
     right, a chi-squared variable over its degrees of freedom: its
     combined (mean over channels) and largest-channel values are tested
-    against the overview's thresholds (:func:`.overview.detection_threshold`)
+    against the overview's thresholds (:func:`.detection.detection_threshold`)
     with their own share of the false-alarm probability, away from the
     fitted modes (a half-power width) and from the candidates already
     tried. No prominence is asked: the known resonances are in the
@@ -50,8 +50,9 @@ import numpy as np
 from scipy import signal
 from scipy.fft import irfft, rfft
 
+from .detection import FALSE_ALARM, Candidate, _candidate, detection_threshold
 from .floor import noise_floor
-from .overview import FALSE_ALARM, Candidate, Overview, _candidate, detection_threshold
+from .overview import Overview
 
 __all__ = ["model_spectra", "residual_candidates"]
 
