@@ -49,6 +49,9 @@ def plot_test_spectra(spectra, fig=None) -> dict:
                                     fontsize=8, color="tab:red" if not doubt else "tab:orange"))
     for fu, _ in spectra.unassigned:
         ax_c.axvline(fu, color="0.6", lw=0.5, ls=":")
+    if len(top):
+        low, high = ax_c.get_ylim()
+        ax_c.set_ylim(low, max(high, 3.0 * float(np.max(top))))  # headroom for the labels on a log axis
     ax_c.set_ylabel("combined spectrum")
     ax_c.set_title(f"{spectra.name}: {len(spectra.modes)} modes picked ({result.kind}); "
                    "red = mode number, orange ? = doubtful, dotted = unassigned", fontsize=9)
