@@ -10,14 +10,11 @@ from __future__ import annotations
 import json
 import math
 import os
-import shutil
-import sys
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
 from .compare import ForwardResult
+from .files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
 
 
 def _fmt(value, digits=3, width=9) -> str:
@@ -55,43 +52,6 @@ def forward_text(result: ForwardResult) -> str:
             lines.append(f"- {check.sentence()}")
         lines.append("")
     return "\n".join(lines)
-
-
-def write_atomic(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` to ``path`` whole or not at all; ``-`` is standard output."""
-    if str(path) == "-":
-        sys.stdout.write(text)
-        return
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600; give the mode a plain open() would
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def replace_directory(tmp: Path, out: Path) -> None:
-    """Rename the finished directory ``tmp`` to ``out``; an old ``out`` is replaced only as a whole
-    (moved aside, then removed once the new one is in place; put back if the rename fails)."""
-    if not out.exists():
-        os.replace(tmp, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-    os.replace(out, old / "previous")
-    try:
-        os.replace(tmp, out)
-    except BaseException:
-        os.replace(old / "previous", out)
-        raise
-    finally:
-        shutil.rmtree(old, ignore_errors=True)
 
 
 def to_json(data) -> str:

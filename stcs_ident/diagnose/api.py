@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
 from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
-from .hypotheses import EFFECTS, applicable, build, hypothesis_sets, parse_effects
+from .hypotheses import applicable, build, hypothesis_sets, parse_effects
 from .result import Diagnosis
 from .selection import BASELINE, explains, select
 
@@ -93,7 +93,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             notes.append(f"not considered: {why}")
     n = sum(m.modes.size for m in measurements)
     sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
-    smallest = min(sizes.values()) if sizes else 0
+    baseline = tuple(e for e in BASELINE if applicable(campaign, measured_tests, e) is None)
+    for e in baseline:  # fitted as the reference of the gain even when not among the effects considered
+        sizes.setdefault(e, len(build(campaign, measured_tests, (e,)).parameters))
+    smallest = min(sizes[e] for e in usable) if usable else 0
     if not usable or n < smallest + 2:
         raise InputError(f"{n} measured frequencies, but the smallest hypothesis ({smallest} parameter(s)) needs "
                          f"at least {smallest + 2} (AICc needs n > k + 1)", field="frequencies")
@@ -101,9 +104,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     dropped = len(hypothesis_sets(usable, max_effects)) - len(sets)
     if dropped:
         notes.append(f"{dropped} hypotheses not fitted: more parameters than the {n} frequencies allow")
-    baseline = tuple(e for e in BASELINE if e in EFFECTS and applicable(campaign, measured_tests, e) is None)
-    if baseline and baseline not in sets and sum(len(build(campaign, measured_tests, (e,)).parameters)
-                                                 for e in baseline) + 2 <= n:
+    if baseline and baseline not in sets and sum(sizes[e] for e in baseline) + 2 <= n:
         sets.append(baseline)
     symmetric = mirror_symmetric(campaign, measurements, tension_model)
     fits: dict[tuple[str, ...], HypothesisFit] = {}

@@ -11,14 +11,13 @@ from __future__ import annotations
 import math
 import os
 import re
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..errors import InputError
+from ..files import whole_directory
 from .tables import (
     CSV_FILES,
     cause_table,
@@ -308,12 +307,9 @@ def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform")
     forward, comparison = nominal_comparison(d, spectra, tension_model)
     tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
               "nominal_comparison": comparison, "cause": cause_table(d)}
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-    try:
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o777 & ~mask)  # mkdtemp makes 0700; give the mode a plain mkdir would
+    from ..plots import save_figure
+
+    with whole_directory(out) as tmp:
         for name, frame in tables.items():
             frame.to_csv(tmp / f"{name}.csv", index=False)
         figures: dict = {"spectra": []}
@@ -324,28 +320,13 @@ def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform")
             for ts in spectra:
                 if ts.name in used:
                     file = f"spectra_{_file_stem(ts.name)}.png"
-                    _save(plot_test_spectra(ts)["figure"], tmp / file)
+                    save_figure(plot_test_spectra(ts)["figure"], tmp / file)
                     figures["spectra"].append((ts.name, file))
-        _save(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
+        save_figure(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
         figures["residuals"] = "residuals.png"
         if diagnosis_figures.profile_scans(d):
-            _save(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
+            save_figure(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
             figures["profile"] = "profile.png"
         text = report_markdown(d, tables, figures, forward, spectra, _tension_model_note(d, forward))
         (tmp / "report.md").write_text(text, encoding="utf-8")
-        _install(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return out
-
-
-def _save(fig, path: Path) -> None:
-    fig.savefig(path, dpi=110, format="png")
-
-
-def _install(tmp: Path, out: Path) -> None:
-    """Rename the finished ``tmp`` to ``out``; an old ``out`` is replaced only as a whole."""
-    from ..report import replace_directory
-
-    replace_directory(tmp, out)

@@ -72,13 +72,18 @@ class Selection:
 
 def explains(nominal: HypothesisFit, n: int) -> bool:
     """Whether the nominal model explains ``n`` frequencies within their uncertainty (step 1)."""
-    return float(chi2_distribution.sf(nominal.chi2, n)) >= ALPHA
+    return _p_value(nominal.chi2, n) >= ALPHA
 
 
 def _within_noise(fit: HypothesisFit, n: int) -> bool:
     """Whether a fitted hypothesis leaves a χ² the measurement uncertainty explains (n − k dof)."""
     dof = n - fit.n_parameters
-    return dof > 0 and float(chi2_distribution.sf(fit.chi2, dof)) >= ALPHA
+    return dof > 0 and _p_value(fit.chi2, dof) >= ALPHA
+
+
+def _p_value(chi2: float, dof: int) -> float:
+    """Probability of a χ² at least ``chi2`` for ``dof`` degrees of freedom."""
+    return float(chi2_distribution.sf(chi2, dof))
 
 
 def ranking(fits: dict[tuple[str, ...], HypothesisFit]) -> list[HypothesisFit]:
@@ -90,7 +95,7 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
     """Name the cause from the fitted hypotheses (see the module docstring); a cause has at most
     ``max_effects`` effects (the baseline is fitted as a reference even when it has more)."""
     nominal = fits[()]
-    p_value = float(chi2_distribution.sf(nominal.chi2, n))
+    p_value = _p_value(nominal.chi2, n)
     if p_value >= ALPHA:
         return Selection((), None, (), True, p_value, {},
                          f"The nominal model explains the data within their uncertainty: chi2 = {nominal.chi2:.1f} "

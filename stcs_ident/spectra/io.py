@@ -56,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError, RecordWarning
+from ..files import umask
 from .record import STANDARD_GRAVITY, Record
 
 __all__ = ["check_duration", "check_positions", "from_sep005", "read_record", "record_from_csv", "to_sep005",
@@ -133,18 +134,12 @@ def write_record(record: Record, path: str | os.PathLike) -> None:
             h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
             h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
             h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the mode a plain open() would
+        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
         os.replace(tmp, target)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _open_hdf5(file: str) -> h5py.File:

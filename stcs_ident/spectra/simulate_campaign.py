@@ -12,8 +12,6 @@ import json
 import math
 import os
 import re
-import shutil
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -22,6 +20,7 @@ import numpy as np
 
 from ..campaign_io import CAMPAIGN_FILE, campaign_to_toml
 from ..errors import ModelError
+from ..files import whole_directory
 from ..forward.dsm import natural_frequencies
 from ..model import Cable, Campaign, Test
 from .effects import Effects, true_model
@@ -90,10 +89,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
     options = {"duration": duration, "sampling_rate": sampling_rate, "damping": damping,
                "impulses": tuple(impulses), "ambient": ambient, "snr_db": snr_db, "n_modes": n_modes,
                "channel_names": channel_names}
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-    try:
-        os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; give the mode a plain mkdir would
+    with whole_directory(out) as tmp:
         (tmp / "records").mkdir()
         nominal_tests, truth_tests = [], []
         for i, (test, stem) in enumerate(zip(selected, stems)):
@@ -109,10 +105,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
         (tmp / CAMPAIGN_FILE).write_text(campaign_to_toml(nominal, header=header), encoding="utf-8")
         truth = {"campaign": campaign.name, "options": _options_json(positions, seed, options), "tests": truth_tests}
         (tmp / TRUTH_FILE).write_text(json.dumps(truth, indent=2) + "\n", encoding="utf-8")
-        _install(tmp, out, overwrite)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        _check_target(out, overwrite)  # again: the target may have changed while the records were made
     return out
 
 
@@ -175,12 +168,6 @@ def _select_tests(campaign: Campaign, names: Sequence[str] | None) -> list[Test]
     return [campaign.test(name) for name in dict.fromkeys(names)]
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _effects_per_test(effects, tests: list[Test]) -> dict[str, Effects | None]:
     if effects is None or isinstance(effects, Effects):
         return {t.name: effects for t in tests}
@@ -210,13 +197,3 @@ def _check_target(out: Path, overwrite: bool) -> None:
         raise FileExistsError(f"{out}: exists and is not a directory")
     if out.is_dir() and any(out.iterdir()) and not overwrite:
         raise FileExistsError(f"{out}: directory exists and is not empty (pass overwrite=True to replace it)")
-
-
-def _install(tmp: Path, out: Path, overwrite: bool) -> None:
-    """Rename the finished ``tmp`` to ``out``; an old ``out`` is replaced only once the new one is complete."""
-    _check_target(out, overwrite)
-    if out.is_dir() and not any(out.iterdir()):
-        out.rmdir()
-    from ..report import replace_directory
-
-    replace_directory(tmp, out)
