@@ -143,7 +143,7 @@ def structures():
 
 
 def cases(quick: bool) -> list[Case]:
-    from stcs_ident.spectra.simulate import Ambient, Impulse
+    from stcs_ident.simulate.simulate import Ambient, Impulse
 
     hanger, stay = structures()
     n = 1 if quick else 5
@@ -226,7 +226,7 @@ def true_frequencies(structure: Structure, n: int) -> np.ndarray:
 
 
 def simulate(case: Case, seed: int, positions=None, sampling_rate=None):
-    from stcs_ident.spectra.simulate import simulate_record
+    from stcs_ident.simulate.simulate import simulate_record
 
     s = case.structure
     return simulate_record(
@@ -332,7 +332,7 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
     """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time."""
     from stcs_ident.forward import count_below
     from stcs_ident.spectra.peaks import find_peaks
-    from stcs_ident.spectra.simulate import NYQUIST_FRACTION, Ambient
+    from stcs_ident.simulate.simulate import NYQUIST_FRACTION, Ambient
 
     _, stay = structures()
     fs, duration, n_channels = 256.0, 600.0, 16

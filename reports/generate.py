@@ -21,9 +21,9 @@ sys.path.insert(0, str(ROOT))
 
 from stcs_ident.cli import main
 from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
-from stcs_ident.spectra.effects import Effects
-from stcs_ident.spectra.simulate import Impulse
-from stcs_ident.spectra.simulate_campaign import simulate_campaign
+from stcs_ident.simulate.effects import Effects
+from stcs_ident.simulate.simulate import Impulse
+from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
 HIDDEN = ROOT / "campaigns" / "hanger-hidden-mass"
 

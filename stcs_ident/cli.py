@@ -103,9 +103,9 @@ def _pair(text, option, sep):
 
 def _simulate(args) -> int:
     from .campaign_io import load_campaign
-    from .spectra.effects import Effects
-    from .spectra.simulate import Ambient, Impulse
-    from .spectra.simulate_campaign import simulate_campaign
+    from .simulate.effects import Effects
+    from .simulate.simulate import Ambient, Impulse
+    from .simulate.simulate_campaign import simulate_campaign
 
     campaign = load_campaign(args.campaign)
     try:

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
-from stcs_ident.spectra.effects import Effects
+from stcs_ident.simulate.effects import Effects
+from stcs_ident.simulate.simulate import Impulse
+from stcs_ident.simulate.simulate_campaign import simulate_campaign
 from stcs_ident.spectra.pipeline import analyse_test
-from stcs_ident.spectra.simulate import Impulse
-from stcs_ident.spectra.simulate_campaign import simulate_campaign
 
 #: Modes picked per record (the spectra pipeline's default is 30).
 MAX_MODES = 12

@@ -19,7 +19,7 @@ from stcs_ident.errors import InputError
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify.problem import Measurement
 from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
-from stcs_ident.spectra.effects import Effects, true_model
+from stcs_ident.simulate.effects import Effects, true_model
 
 CABLE = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5)
 SETUP = Setup("S", (Attachment("clamp", 2.7, 15.0),))

@@ -23,7 +23,7 @@ import pytest
 from diagnose_cases import BENCHES, simulated
 
 from stcs_ident.diagnose import diagnose
-from stcs_ident.spectra.effects import Effects
+from stcs_ident.simulate.effects import Effects
 
 
 def _effects(bench: str) -> dict[str, tuple[Effects, dict]]:

@@ -38,10 +38,10 @@ def han_diagnosis():
 def simulated(tmp_path_factory):
     """A campaign with records whose true cable carries a 15 kg mass at 6 m: (diagnosis, spectra)."""
     pytest.importorskip("h5py")
-    from stcs_ident.spectra.effects import Effects
+    from stcs_ident.simulate.effects import Effects
     from stcs_ident.spectra.pipeline import analyse_campaign
-    from stcs_ident.spectra.simulate import Impulse
-    from stcs_ident.spectra.simulate_campaign import simulate_campaign
+    from stcs_ident.simulate.simulate import Impulse
+    from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     nominal = Campaign("sim", CABLE, (Setup("bare"),),
                        (Test("T1", "bare", TENSION), Test("T2/b", "bare", 1.1 * TENSION)))

@@ -16,14 +16,14 @@ from stcs_ident.campaign_io import load_campaign
 from stcs_ident.errors import ModelError
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.model import Attachment, Boundary, Cable, Campaign, Setup, Test
-from stcs_ident.spectra.effects import Effects, true_model
-from stcs_ident.spectra.modal_response import (
+from stcs_ident.simulate.effects import Effects, true_model
+from stcs_ident.simulate.modal_response import (
     _exponential_gram,
     modal_force_covariance,
     stationary_covariance,
     zoh_transition,
 )
-from stcs_ident.spectra.simulate import (
+from stcs_ident.simulate.simulate import (
     UNCORRELATED_LENGTH,
     Ambient,
     Impulse,
@@ -346,7 +346,7 @@ def nominal_campaign():
 
 def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign):
     io = pytest.importorskip("stcs_ident.spectra.io")
-    from stcs_ident.spectra.simulate_campaign import simulate_campaign
+    from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     effects = {"T2/b": Effects(tension_ratio=0.97, extra_mass=(10.0, 13.0))}
     seen = []
@@ -378,7 +378,7 @@ def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign)
 
 def test_simulate_campaign_refuses_a_non_empty_directory(tmp_path, nominal_campaign):
     pytest.importorskip("stcs_ident.spectra.io")
-    from stcs_ident.spectra.simulate_campaign import simulate_campaign
+    from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     out = tmp_path / "sim"
     out.mkdir()

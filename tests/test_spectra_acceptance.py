@@ -32,10 +32,10 @@ from stcs_ident.errors import NumberingWarning
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.shapes import mode_shapes
 from stcs_ident.model import Attachment, Cable
+from stcs_ident.simulate.simulate import Ambient, Impulse, simulate_record
 from stcs_ident.spectra.crb import crb_frequency
 from stcs_ident.spectra.numbering import number_modes
 from stcs_ident.spectra.peaks import find_peaks
-from stcs_ident.spectra.simulate import Ambient, Impulse, simulate_record
 
 N_RECORDS = 105
 VISIBLE_DB = 10.0

@@ -1,1 +1,1 @@
-"""Spectra: acceleration records, a record simulator and modal frequency picking."""
+"""Spectra: acceleration records and modal frequency picking (the simulator is :mod:`stcs_ident.simulate`)."""

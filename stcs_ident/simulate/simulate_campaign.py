@@ -2,7 +2,7 @@
 
 :func:`simulate_campaign` turns a nominal campaign into a campaign
 directory whose records come from a true model that may differ from it
-(:class:`~stcs_ident.spectra.effects.Effects`), and writes the truth
+(:class:`~stcs_ident.simulate.effects.Effects`), and writes the truth
 beside it in ``truth.json`` for scoring identification and diagnosis.
 """
 
@@ -101,7 +101,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
             if progress is not None:
                 progress(i + 1, len(selected))
         nominal = replace(campaign, tests=tuple(nominal_tests), directory=None)
-        header = f"Simulated by stcs_ident.spectra.simulate_campaign; the true model is in {TRUTH_FILE}."
+        header = f"Simulated by stcs_ident.simulate.simulate_campaign; the true model is in {TRUTH_FILE}."
         (tmp / CAMPAIGN_FILE).write_text(campaign_to_toml(nominal, header=header), encoding="utf-8")
         truth = {"campaign": campaign.name, "options": _options_json(positions, seed, options), "tests": truth_tests}
         (tmp / TRUTH_FILE).write_text(json.dumps(truth, indent=2) + "\n", encoding="utf-8")
@@ -111,7 +111,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
 
 def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effects: Effects | None,
                    stream: np.random.SeedSequence, options: dict) -> dict:
-    from .io import write_record  # lazily: h5py only when files are written
+    from ..spectra.io import write_record  # lazily: h5py only when files are written
 
     attachments = campaign.setup(test.setup).attachments
     record = simulate_record(campaign.cable, attachments, test.tension, positions, effects=effects, seed=stream,

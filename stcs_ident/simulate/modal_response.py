@@ -1,6 +1,6 @@
 """Exact response of modal coordinates to impulses and to held random forces.
 
-The kernels behind :func:`~stcs_ident.spectra.simulate.simulate_record`.
+The kernels behind :func:`~stcs_ident.simulate.simulate.simulate_record`.
 Each mode is an SDOF q̈ + 2ζω q̇ + ω² q = f(t) with unit modal mass; the
 response is computed without time-stepping error:
 

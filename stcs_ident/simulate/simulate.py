@@ -11,12 +11,12 @@ reads Σ_k φ_k(x) q̈_k(t). Nothing is time-stepped approximately:
   (zero-order hold, white up to the Nyquist frequency), and each mode is
   advanced by its exact state-transition matrix. The record starts from a
   state drawn from the stationary distribution, so it has no start-up
-  transient (the kernels are in :mod:`~stcs_ident.spectra.modal_response`).
+  transient (the kernels are in :mod:`~stcs_ident.simulate.modal_response`).
 
 All modes below 0.45 × the sampling rate are kept (or a given number), so
 a record has the realistic content of a band-limited sensor. Hidden
-effects (:class:`~stcs_ident.spectra.effects.Effects`) act on the true
-model only. :func:`~stcs_ident.spectra.simulate_campaign.simulate_campaign`
+effects (:class:`~stcs_ident.simulate.effects.Effects`) act on the true
+model only. :func:`~stcs_ident.simulate.simulate_campaign.simulate_campaign`
 writes a whole campaign directory from them, for tests and benchmarks.
 """
 
@@ -32,9 +32,9 @@ from ..errors import ModelError
 from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
 from ..model import Attachment, Cable
+from ..spectra.record import Record
 from .effects import Effects, true_model
 from .modal_response import matrix_sqrt, modal_force_covariance, superpose
-from .record import Record
 
 __all__ = [
     "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "Effects", "Impulse", "modal_basis", "modal_damping",

@@ -1,0 +1,16 @@
+"""Simulation: acceleration records and whole campaigns from a true cable model.
+
+The simulator builds on the forward model and writes records of the type
+:mod:`stcs_ident.spectra` reads; spectra never imports it.
+"""
+
+from .effects import Effects, true_model
+from .simulate import (
+    NYQUIST_FRACTION, UNCORRELATED_LENGTH, Ambient, Impulse, modal_basis, modal_damping, simulate_record,
+)
+from .simulate_campaign import TRUTH_FILE, simulate_campaign
+
+__all__ = [
+    "NYQUIST_FRACTION", "TRUTH_FILE", "UNCORRELATED_LENGTH", "Ambient", "Effects", "Impulse", "modal_basis",
+    "modal_damping", "simulate_campaign", "simulate_record", "true_model",
+]
