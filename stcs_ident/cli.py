@@ -12,6 +12,7 @@ import os
 import sys
 import traceback
 
+from . import effects
 from .errors import ComputationError, InputError
 
 
@@ -49,9 +50,7 @@ def _parser() -> argparse.ArgumentParser:
     dia.add_argument("campaign", help="campaign directory or its campaign.toml")
     dia.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
     dia.add_argument("--effects", metavar="LIST",
-                     help="effects to consider, comma-separated (default all: tension, bending_stiffness, "
-                          "attachment_position, attachment_mass, unmodeled_mass, unmodeled_support, "
-                          "end_restraint, length)")
+                     help=f"effects to consider, comma-separated (default all: {', '.join(effects.names())})")
     dia.add_argument("--max-effects", type=int, choices=(1, 2), default=2,
                      help="largest number of effects in one hypothesis (default 2)")
     dia.add_argument("--all-hypotheses", action="store_true",
@@ -83,22 +82,12 @@ def _simulate_parser(sub) -> None:
     sim.add_argument("--seed", type=int, default=0)
     sim.add_argument("--overwrite", action="store_true", help="replace a non-empty output directory")
     eff = sim.add_argument_group("hidden effects (in the records, not in the written campaign)")
-    eff.add_argument("--tension-ratio", type=float, metavar="R")
-    eff.add_argument("--EI-ratio", type=float, metavar="R")
-    eff.add_argument("--length-ratio", type=float, metavar="R")
-    eff.add_argument("--end-stiffness", metavar="KA,KB", help="rotational end stiffness, N m/rad ('inf' clamped)")
-    eff.add_argument("--extra-mass", metavar="KG@X", help="an unmodelled point mass at X m")
-    eff.add_argument("--extra-spring", metavar="K@X", help="an unmodelled transverse spring (N/m) at X m")
-    eff.add_argument("--move", action="append", metavar="NAME@X", help="an attachment truly at X m (repeatable)")
+    for effect in effects.effects():
+        if effect.option is not None:
+            o = effect.option
+            eff.add_argument(o.flag, dest=f"effect_{effect.name}", metavar=o.metavar,
+                             action="append" if o.repeatable else "store", help=f"{effect.name}: {o.help}")
     sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
-
-
-def _pair(text, option, sep):
-    try:
-        a, b = text.split(sep)
-        return a, float(b)
-    except ValueError:
-        raise InputError(f"expected VALUE{sep}VALUE, got {text!r}", field=option) from None
 
 
 def _simulate(args) -> int:
@@ -115,27 +104,18 @@ def _simulate(args) -> int:
     if not all(0 < x < 1 for x in fractions):
         raise InputError("fractions of the length must lie in (0, 1)", field="--sensors")
     length = campaign.cable.length
-    effects = {}
-    for name in ("tension_ratio", "EI_ratio", "length_ratio"):
-        if getattr(args, name) is not None:
-            effects[name] = getattr(args, name)
-    if args.end_stiffness:
-        effects["end_stiffness"] = tuple(float(v) for v in args.end_stiffness.split(","))
-    if args.extra_mass:
-        kg, x = _pair(args.extra_mass, "--extra-mass", "@")
-        effects["extra_mass"] = (float(kg), x)
-    if args.extra_spring:
-        k, x = _pair(args.extra_spring, "--extra-spring", "@")
-        effects["extra_spring"] = (float(k), x)
-    if args.move:
-        effects["attachment_positions"] = dict(_pair(m, "--move", "@") for m in args.move)
+    hidden = {}
+    for effect in effects.effects():
+        given = getattr(args, f"effect_{effect.name}", None)
+        if effect.option is not None and given is not None:
+            hidden[effect.truth_key] = effect.parse_option(given)
     impulses = [Impulse(1.0 + i * max(args.duration / max(args.impulses, 1), 1.0), 0.17 * length, 50.0)
                 for i in range(args.impulses)]
     ambient = Ambient(args.ambient) if args.ambient else None
     if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
         raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
     try:
-        effect = Effects(**effects) if effects else None
+        effect = Effects(**hidden) if hidden else None
     except (TypeError, ValueError) as err:
         raise InputError(str(err), field="effects") from None
     out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions], duration=args.duration,

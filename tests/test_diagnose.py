@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from stcs_ident.cli import main
-from stcs_ident.diagnose import EFFECTS, diagnose
+from stcs_ident import effects
+from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.fitting import aicc
 from stcs_ident.diagnose.hypotheses import parse_effects
 from stcs_ident.errors import InputError
@@ -106,7 +107,7 @@ def test_a_mass_on_a_symmetric_cable_is_reported_in_the_first_half():
 
 
 def test_effect_names_come_from_the_vocabulary():
-    assert parse_effects(None) == EFFECTS
+    assert parse_effects(None) == effects.names()
     assert parse_effects("length, tension") == ("tension", "length")
     with pytest.raises(InputError, match="unknown effect 'sag'") as err:
         parse_effects("tension,sag")

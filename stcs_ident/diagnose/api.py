@@ -42,7 +42,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         others are skipped and listed).
     effects : str or list of str, optional
         Effects of the vocabulary to consider (default all of
-        :data:`~stcs_ident.diagnose.hypotheses.EFFECTS`).
+        :func:`stcs_ident.effects.names`).
     picked : mapping, optional
         {test: spectra or Measurement} replacing a test's table. Modes of
         spectra whose number is flagged doubtful are left out (and said so

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ..plots import _figure
-from .hypotheses import UNMODELED
+from .. import effects as registry
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {
@@ -97,9 +97,9 @@ def profile_scans(diagnosis) -> dict:
     d = diagnosis
     out = {}
     for e in d.selection.effects:
-        if e not in UNMODELED:
+        if not registry.get(e).unmodeled:
             continue
-        own = [x for x in d.corrected.effects if x in UNMODELED]
+        own = [x for x in d.corrected.effects if registry.get(x).unmodeled]
         if d.corrected.profile and own and own[0] == e:
             out[e] = d.corrected
         elif (e,) in d.fits and d.fits[(e,)].profile:
@@ -117,7 +117,8 @@ def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
     Parameters
     ----------
     diagnosis : Diagnosis
-    effect : {"unmodeled_mass", "unmodeled_support"}, optional
+    effect : str, optional
+        An unmodeled effect (mass or support) of the cause.
         Default: the first one of the cause.
     ax : matplotlib Axes, optional
 
@@ -157,7 +158,7 @@ def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
     ax.set_xlim(0.0, length / 2 if d.symmetric else length)
     ax.set_xlabel("position from end A (m)" + (", mirrored into [0, l/2]: symmetric setup" if d.symmetric else ""))
     ax.set_ylabel("χ²")
-    ax.set_title(f"{' + '.join(d.corrected.effects)}: where is the {effect.replace('unmodeled_', '')}?", fontsize=9)
+    ax.set_title(f"{' + '.join(d.corrected.effects)}: where is the {registry.get(effect).noun}?", fontsize=9)
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # never over the data
     return {"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": scan}

@@ -25,10 +25,9 @@ prediction of an unseen test.
 from __future__ import annotations
 
 import math
-import re
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -37,8 +36,9 @@ from ..identify.lsq import _local_fit, fit_lsq
 from ..identify.parameters import fixity
 from ..identify.problem import Measurement, Problem
 from ..identify.result import IdentificationResult
-from ..model import Campaign, Test
-from .hypotheses import UNMODELED, Hypothesis, build, free_positions
+from ..model import Attachment, Campaign, Test
+from ..notes import Assignment, Note
+from .hypotheses import Hypothesis, build, clear_position, free_positions, unmodeled_name
 
 #: Unmodeled attachments kept from the profile scan as starts of the full fit.
 PROFILE_STARTS = 3
@@ -68,7 +68,9 @@ class HypothesisFit:
     cv_rms_error : float or None
         Leave-one-mode-out prediction error, % (None when a fold has fewer
         data than parameters).
-    notes : list of str
+    notes : list of Note
+        Of the fit (values in SI units, :func:`in_si_units`) and the
+        warnings it raised (``kind="warning"``).
     profile : list of (position m, χ²), optional
         The profile scan of an unmodeled attachment's position.
     minima : list of dict
@@ -83,7 +85,7 @@ class HypothesisFit:
     aicc: float
     rms_error: float
     cv_rms_error: float | None = None
-    notes: list[str] = field(default_factory=list)
+    notes: list[Note] = field(default_factory=list)
     profile: list[tuple[float, float]] = field(default_factory=list)
     minima: list[dict] = field(default_factory=list)
 
@@ -134,15 +136,15 @@ def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension
     return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms)
 
 
-def _quiet(fn, notes: list[str]):
+def _quiet(fn, notes: list[Note]):
     """Run ``fn`` collecting warnings as notes (the diagnosis reports them, pytest must not fail on them)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         out = fn()
     for w in caught:
-        text = str(w.message).splitlines()[0]
-        if text not in notes:
-            notes.append(text)
+        note = Note.plain("warning", str(w.message).splitlines()[0])
+        if note not in notes:
+            notes.append(note)
     return out
 
 
@@ -151,26 +153,22 @@ _UNITS = {"EI": "N m^2", "length": "m", "position": "m", "mass": "kg", "stiffnes
           "mass_per_length": "kg/m"}
 
 
-def in_si_units(note: str, parameters: Sequence) -> str:
-    """``note`` with every ``name = variable`` of ``parameters`` rewritten in SI units
+def in_si_units(note: Note, parameters: Sequence) -> Note:
+    """``note`` with every assignment of a variable of ``parameters`` in its points given in SI units
     (``position_ratio[W1] = 1.02`` → ``position[W1] = 10.05 m``); ratios of tension and the end
     fixity stay as they are."""
     by_name = {p.name: p for p in parameters if p.kind in _UNITS}
 
-    def convert(match: re.Match) -> str:
-        p = by_name.get(match.group(1))
-        if p is None:
-            return match.group(0)
-        value = float(p.to_value(float(match.group(2))))
+    def convert(a: Assignment) -> Assignment:
+        p = by_name.get(a.parameter)
+        if p is None or a.unit:
+            return a
         label = p.kind if p.member is None else f"{p.kind}[{p.member}]"
-        return f"{label} = {value:.6g} {_UNITS[p.kind]}"
+        return Assignment(label, float(p.to_value(a.value)), _UNITS[p.kind])
 
-    return _ASSIGNMENT.sub(convert, note)
-
-
-_ASSIGNMENT = re.compile(r"([A-Za-z_]+(?:\[[^\]]*\])?) = ([-+0-9.eE]+)")
-
-
+    if not note.points:
+        return note
+    return note.with_points([convert(a) for a in pt] for pt in note.points)
 def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None], float]],
                  nominal: bool = True) -> np.ndarray:
     """Variable vectors of ``problem`` from SI values by (kind, member); missing ones nominal.
@@ -208,13 +206,13 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     single effects' profile minima).
     """
     tests = [m.test for m in measurements]
-    notes: list[str] = []
-    extra = [e for e in effects if e in UNMODELED]
+    notes: list[Note] = []
+    extra = [e for e in effects if unmodeled_name(e)]
     profile: list[tuple[float, float]] = []
     seeds = list(seeds)
     positions: dict[str, float] = {}
     for e in extra:
-        given = [s[("position", UNMODELED[e])] for s in seeds if ("position", UNMODELED[e]) in s]
+        given = [s[("position", unmodeled_name(e))] for s in seeds if ("position", unmodeled_name(e)) in s]
         if given:
             positions[e] = given[0]
     minima: list[dict] = []
@@ -232,7 +230,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             xb, c = _quiet(lambda problem=problem, starts=starts: min(
                 (_local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
-            values[("position", UNMODELED[scanned])] = float(x)
+            values[("position", unmodeled_name(scanned))] = float(x)
             previous = values
             rows.append((c, float(x), values))
             profile.append((float(x), c))
@@ -305,9 +303,12 @@ def mirror_symmetric(campaign: Campaign, measurements: Sequence[Measurement], te
     about midspan), checked numerically on the measured tests' setups."""
     tests: list[Test] = [m.test for m in measurements]
     length = campaign.cable.length
+    used = {t.setup for t in tests}
     f = []
     for x in (0.31 * length, 0.69 * length):
-        hyp = build(campaign, tests, ("unmodeled_mass",), {"unmodeled_mass": x}, fixed=("unmodeled_mass",))
-        problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
-        f.append(problem.predict(np.array([0.05 * campaign.cable.mass_per_length * length])))
+        probe = Attachment("(probe mass)", clear_position(campaign, tests, x),
+                           mass=0.05 * campaign.cable.mass_per_length * length)
+        setups = tuple(replace(s, attachments=(*s.attachments, probe)) if s.name in used else s
+                       for s in campaign.setups)
+        f.append(nominal_prediction(replace(campaign, setups=setups), measurements, tension_model))
     return bool(np.allclose(f[0], f[1], rtol=1e-9, atol=0))

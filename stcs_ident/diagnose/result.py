@@ -8,9 +8,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..identify.problem import Measurement
-from ..model import Campaign
+from .. import effects as registry
+from ..effects.base import Context
+from ..model import Cable, Campaign
 from .fitting import HypothesisFit
-from .hypotheses import UNMODELED
 from .selection import BASELINE, Selection, ranking
 
 
@@ -18,42 +19,23 @@ def _finite_or_none(v: float | None) -> float | None:
     return None if v is None or not math.isfinite(v) else float(v)
 
 
-def effect_parameters(fit: HypothesisFit, length: float, symmetric: bool) -> tuple[dict, dict]:
-    """Values and standard uncertainties by effect, in the units of ``interface.md``.
+def effect_parameters(fit: HypothesisFit, cable: Cable, symmetric: bool) -> tuple[dict, dict]:
+    """Values and standard uncertainties by effect, in the units of the diagnosis JSON.
 
-    A position on a configuration symmetric about midspan is given in
-    [0, l/2] (x and l − x cannot be told apart).
+    Each effect of the registry puts its own parameters in (:meth:`~stcs_ident.effects.base.Effect.record`);
+    a position on a configuration symmetric about midspan is given in [0, l/2] (x and l − x cannot be told
+    apart).
     """
     values: dict = {}
     sigmas: dict = {}
     if fit.result is None:
         return values, sigmas
     res = fit.result
+    context = Context(cable, symmetric)
     for p, owner, x, s, v in zip(res.parameters, fit.hypothesis.owners, res.estimate, res.uncertainty, res.values):
-        v, s_si = float(v), float(p.value_uncertainty(x, s))
         val, sig = values.setdefault(owner, {}), sigmas.setdefault(owner, {})
-        if owner == "tension":
-            val.setdefault("ratio", {})[p.member] = float(x)
-            sig.setdefault("ratio", {})[p.member] = _finite_or_none(float(s))
-        elif owner == "bending_stiffness":
-            val["EI"], sig["EI"] = v, _finite_or_none(s_si)
-        elif owner == "length":
-            val["length"], sig["length"] = v, _finite_or_none(s_si)
-        elif owner == "end_restraint":
-            key = "rotational_stiffness" if p.member == "AB" else f"rotational_stiffness_{p.member}"
-            val[key], sig[key] = (_finite_or_none(v) if math.isfinite(v) else "inf"), _finite_or_none(s_si)
-            val["fixity" if p.member == "AB" else f"fixity_{p.member}"] = float(x)
-        elif owner in UNMODELED:
-            if p.kind == "position":
-                if symmetric and v > length / 2:
-                    v = length - v
-                val["position"], sig["position"] = v, _finite_or_none(s_si)
-            else:
-                val[p.kind], sig[p.kind] = v, _finite_or_none(s_si)
-        else:
-            key = "position" if owner == "attachment_position" else "mass"
-            val.setdefault(key, {})[p.member] = v
-            sig.setdefault(key, {})[p.member] = _finite_or_none(s_si)
+        registry.get(owner).record(p, float(x), _finite_or_none(float(s)), float(v),
+                                   _finite_or_none(float(p.value_uncertainty(x, s))), val, sig, context)
     return values, sigmas
 
 
@@ -116,7 +98,7 @@ class Diagnosis:
         return ranking(self.fits)
 
     def parameters(self, fit: HypothesisFit) -> tuple[dict, dict]:
-        return effect_parameters(fit, self.campaign.cable.length, self.symmetric)
+        return effect_parameters(fit, self.campaign.cable, self.symmetric)
 
     def per_test(self, fit: HypothesisFit) -> list[np.ndarray]:
         """``fit.predicted`` split by test."""
@@ -188,7 +170,8 @@ class Diagnosis:
         if not sel.effects:
             return sel.statement
         values, sigmas = self.parameters(self.corrected)
-        parts = [_describe(e, values.get(e, {}), sigmas.get(e, {}), self.campaign.cable) for e in sel.effects]
+        parts = [registry.get(e).describe(values.get(e, {}), sigmas.get(e, {}), self.campaign.cable)
+                 for e in sel.effects]
         delta = self.nominal.aicc - self.corrected.aicc
         text = f"{'; '.join(parts)} explain{'s' if len(parts) == 1 else ''} the residual pattern"
         text = text[0].upper() + text[1:]
@@ -210,39 +193,3 @@ class Diagnosis:
         from .report import diagnosis_text
 
         return diagnosis_text(self)
-
-
-def _pm(value: float, sigma: float | None, digits: int = 3) -> str:
-    if sigma is None or not math.isfinite(sigma):
-        return f"{value:.{digits}g}"
-    return f"{value:.{digits}g} ± {sigma:.2g}"
-
-
-def _describe(effect: str, val: dict, sig: dict, cable) -> str:
-    if effect == "tension":
-        ratios = ", ".join(f"{t}: {_pm(v, sig['ratio'].get(t), 4)}" for t, v in val["ratio"].items())
-        return f"tensions differ from the measured ones (true/measured {ratios})"
-    if effect == "bending_stiffness":
-        return (f"an effective bending stiffness EI = {_pm(val['EI'] / 1e3, _div(sig.get('EI'), 1e3))} kN m² "
-                f"({val['EI'] / cable.EI:.3g} × nominal)")
-    if effect == "length":
-        return f"a vibrating length of {_pm(val['length'], sig.get('length'), 5)} m (nominal {cable.length:g} m)"
-    if effect == "end_restraint":
-        k = val.get("rotational_stiffness")
-        shown = "clamped" if k == "inf" else f"{_pm(k, sig.get('rotational_stiffness'))} N m/rad"
-        return f"anchorages restrained by a rotational stiffness {shown} (fixity {val.get('fixity', math.nan):.3f})"
-    if effect == "unmodeled_mass":
-        return (f"an unmodeled mass of {_pm(val['mass'], sig.get('mass'))} kg near "
-                f"{_pm(val['position'], sig.get('position'))} m")
-    if effect == "unmodeled_support":
-        return (f"an unmodeled support of {_pm(val['stiffness'], sig.get('stiffness'))} N/m near "
-                f"{_pm(val['position'], sig.get('position'))} m")
-    if effect == "attachment_position":
-        where = ", ".join(f"{a} at {_pm(v, sig['position'].get(a))} m" for a, v in val["position"].items())
-        return f"attachments elsewhere than recorded ({where})"
-    masses = ", ".join(f"{a}: {_pm(v, sig['mass'].get(a))} kg" for a, v in val["mass"].items())
-    return f"attachment masses differ from the recorded ones ({masses})"
-
-
-def _div(v: float | None, d: float) -> float | None:
-    return None if v is None else v / d

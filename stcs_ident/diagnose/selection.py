@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 from scipy.stats import chi2 as chi2_distribution
 
+from .. import effects
 from .fitting import HypothesisFit
 
 #: False-alarm probability of the test "the nominal model explains the data".
@@ -37,7 +38,7 @@ ALPHA = 1e-3
 #: AICc difference below which two hypotheses are not told apart.
 AMBIGUITY = 2.0
 #: The baseline hypothesis: the source paper's correction of tension and EI.
-BASELINE = ("tension", "bending_stiffness")
+BASELINE = effects.baseline()
 
 
 @dataclass(frozen=True)

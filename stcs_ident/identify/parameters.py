@@ -47,16 +47,22 @@ KINDS = {
     "end_stiffness": ("end", None),
 }
 
-#: Other names accepted for a kind (the effect vocabulary of ``interface.md``).
+#: Other names accepted for a kind (besides the names of the effects that free one kind, see
+#: :func:`aliases`).
 ALIASES = {
-    "bending_stiffness": "EI",
     "ei": "EI",
-    "attachment_position": "position",
-    "attachment_mass": "mass",
     "attachment_stiffness": "stiffness",
-    "end_restraint": "end_stiffness",
     "rotational_stiffness": "end_stiffness",
 }
+
+
+def aliases() -> dict[str, str]:
+    """Every other name of a kind: :data:`ALIASES` and the name of each registered effect that frees
+    one kind of parameter (``bending_stiffness`` → ``EI``)."""
+    from .. import effects  # the effects build on this module: imported when first needed
+
+    named = {e.name: e.parameter_kind for e in effects.effects() if e.parameter_kind and e.name != e.parameter_kind}
+    return {**named, **ALIASES}
 
 #: Default bounds of the variable (ratio unless stated in the module docstring).
 DEFAULT_BOUNDS = {
@@ -189,7 +195,7 @@ def stiffness_of_fixity(phi, reference: float):
 
 
 def _known_names() -> str:
-    return ", ".join([*KINDS, *ALIASES])
+    return ", ".join([*KINDS, *aliases()])
 
 
 def _split(spec: str | Iterable[str]) -> list[str]:
@@ -211,7 +217,8 @@ def parse_name(name: str) -> tuple[str, str | None]:
     kind = None
     if match:
         word = match.group(1)
-        kind = word if word in KINDS else ALIASES.get(word, ALIASES.get(word.lower()))
+        known = aliases()
+        kind = word if word in KINDS else known.get(word, known.get(word.lower()))
         if kind is None and word.lower() in {k.lower() for k in KINDS}:
             kind = next(k for k in KINDS if k.lower() == word.lower())
     if kind is None:

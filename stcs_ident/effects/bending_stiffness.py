@@ -1,0 +1,42 @@
+"""``bending_stiffness``: the effective EI differs from the nominal one.
+
+A strand's or a bundle's bending stiffness lies between that of its wires
+bending alone and that of a solid section, depending on interwire friction
+and hence on tension; the nominal value is often a guess within tens of per
+cent. One value for all tests. Part of the source paper's correction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from .base import Effect, Option, Quantity, Tolerance, pm, positive_ratio, scaled
+
+
+class BendingStiffness(Effect):
+    name = "bending_stiffness"
+    meaning = "the effective bending stiffness EI differs from nominal"
+    quantities = (Quantity("EI", "N m^2"),)
+    tolerance = Tolerance("EI", 0.3)
+    baseline = True
+    parameter_kind = "EI"
+    truth_key = "EI_ratio"
+    option = Option("--EI-ratio", "R", "true / nominal bending stiffness")
+
+    def applicable(self, campaign, tests):
+        if campaign.cable.EI <= 0:
+            return "bending_stiffness has no ratio: the nominal EI is 0"
+        return None
+
+    def describe(self, values, sigmas, cable):
+        return (f"an effective bending stiffness EI = {pm(values['EI'] / 1e3, scaled(sigmas.get('EI'), 1e3))} "
+                f"kN m² ({values['EI'] / cable.EI:.3g} × nominal)")
+
+    def check_truth(self, value, field):
+        return positive_ratio(value, field)
+
+    def apply_truth(self, truth, value):
+        truth.cable = replace(truth.cable, EI=truth.cable.EI * value)
+
+
+EFFECT = BendingStiffness()

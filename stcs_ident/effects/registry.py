@@ -1,0 +1,94 @@
+"""The registry of effects: the one place that knows which effects exist.
+
+The built-in effects register themselves when :mod:`stcs_ident.effects` is
+imported, in the order of the vocabulary; :func:`register` adds another
+(a user's or a test's own effect) at the end. Everything that loops over
+effects (hypotheses, simulator, report, command line) reads
+:func:`effects` or :func:`get`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+from ..errors import InputError
+from .base import Effect
+
+_REGISTRY: dict[str, Effect] = {}
+
+
+def register(effect: Effect) -> Effect:
+    """Add ``effect`` (an :class:`~stcs_ident.effects.base.Effect` instance) to the vocabulary.
+
+    Raises
+    ------
+    ValueError
+        For an effect without a name, or a name or ``truth_key`` already taken.
+    """
+    if not isinstance(effect, Effect) or not effect.name:
+        raise ValueError(f"an effect must be an Effect instance with a name, got {effect!r}")
+    if effect.name in _REGISTRY:
+        raise ValueError(f"an effect named {effect.name!r} is already registered")
+    if effect.truth_key and any(e.truth_key == effect.truth_key for e in _REGISTRY.values()):
+        raise ValueError(f"the simulator keyword {effect.truth_key!r} is already taken")
+    _REGISTRY[effect.name] = effect
+    return effect
+
+
+def unregister(name: str) -> None:
+    """Remove an effect (a test's own effect, when the test is done)."""
+    _REGISTRY.pop(name, None)
+
+
+def effects() -> tuple[Effect, ...]:
+    """Every registered effect, in vocabulary order."""
+    return tuple(_REGISTRY.values())
+
+
+def names() -> tuple[str, ...]:
+    """Every registered effect's name, in vocabulary order."""
+    return tuple(_REGISTRY)
+
+
+def get(name: str) -> Effect:
+    """The effect called ``name`` (KeyError if there is none)."""
+    return _REGISTRY[name]
+
+
+def by_truth_key(key: str) -> Effect | None:
+    """The effect hidden by the simulator keyword ``key`` (or named ``key``), or None."""
+    for e in _REGISTRY.values():
+        if key in (e.truth_key, e.name):
+            return e
+    return None
+
+
+def in_order(chosen: Iterable[str]) -> tuple[str, ...]:
+    """``chosen`` effect names in vocabulary order (unknown names dropped)."""
+    chosen = set(chosen)
+    return tuple(n for n in _REGISTRY if n in chosen)
+
+
+def baseline() -> tuple[str, ...]:
+    """The effects of the source paper's correction (tension and EI re-estimated)."""
+    return tuple(e.name for e in _REGISTRY.values() if e.baseline)
+
+
+def parse(spec: str | Sequence[str] | None) -> tuple[str, ...]:
+    """``"tension,unmodeled_mass"`` → effect names in vocabulary order; None → all.
+
+    Raises
+    ------
+    InputError
+        ``field="effects"`` for a name outside the vocabulary or none at all.
+    """
+    if spec is None:
+        return names()
+    items = [spec] if isinstance(spec, str) else list(spec)
+    chosen = [part.strip() for item in items for part in str(item).split(",") if part.strip()]
+    if not chosen:
+        raise InputError("no effect named", field="effects")
+    for name in chosen:
+        if name not in _REGISTRY:
+            raise InputError(f"unknown effect {name!r}; the vocabulary is: {', '.join(_REGISTRY)}", field="effects")
+    return in_order(chosen)
