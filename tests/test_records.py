@@ -15,16 +15,11 @@ import pandas as pd
 import pytest
 
 from stcs_ident.errors import InputError, RecordWarning
-from stcs_ident.spectra.io import (
-    check_duration,
-    check_positions,
-    from_sep005,
-    read_record,
-    record_from_csv,
-    to_sep005,
-    write_record,
-)
+from stcs_ident.spectra.io_csv import record_from_csv
+from stcs_ident.spectra.io_hdf5 import read_record, write_record
 from stcs_ident.spectra.record import STANDARD_GRAVITY, Record
+from stcs_ident.spectra.sep005 import from_sep005, to_sep005
+from stcs_ident.spectra.validation import check_duration, check_positions
 
 FS = 200.0  # Hz
 N = 2000  # samples: 10 s

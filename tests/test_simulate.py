@@ -345,7 +345,7 @@ def nominal_campaign():
 
 
 def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign):
-    io = pytest.importorskip("stcs_ident.spectra.io")
+    io = pytest.importorskip("stcs_ident.spectra.io_hdf5")
     from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     effects = {"T2/b": Effects(tension_ratio=0.97, extra_mass=(10.0, 13.0))}
@@ -377,7 +377,7 @@ def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign)
 
 
 def test_simulate_campaign_refuses_a_non_empty_directory(tmp_path, nominal_campaign):
-    pytest.importorskip("stcs_ident.spectra.io")
+    pytest.importorskip("stcs_ident.spectra.io_hdf5")
     from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     out = tmp_path / "sim"

@@ -23,6 +23,7 @@ from ..errors import ModelError
 from ..files import whole_directory
 from ..forward.dsm import natural_frequencies
 from ..model import Cable, Campaign, Test
+from ..spectra.io_hdf5 import write_record
 from .effects import Effects, true_model
 from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record
 
@@ -111,8 +112,6 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
 
 def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effects: Effects | None,
                    stream: np.random.SeedSequence, options: dict) -> dict:
-    from ..spectra.io import write_record  # lazily: h5py only when files are written
-
     attachments = campaign.setup(test.setup).attachments
     record = simulate_record(campaign.cable, attachments, test.tension, positions, effects=effects, seed=stream,
                              **options)

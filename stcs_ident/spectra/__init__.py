@@ -1,1 +1,28 @@
-"""Spectra: acceleration records and modal frequency picking (the simulator is :mod:`stcs_ident.simulate`)."""
+"""Spectra: acceleration records and modal frequency picking (the simulator is :mod:`stcs_ident.simulate`).
+
+- :class:`Record`: an acceleration record in m/s²; :func:`read_record` and
+  :func:`write_record` (HDF5), :func:`record_from_csv`, :func:`from_sep005`
+  and :func:`to_sep005` (SDyPy SEP005), all with the same checks
+  (:mod:`.validation`, dead and clipped channels dropped by :mod:`.screening`);
+- :func:`find_peaks`: modal frequencies, damping and uncertainties from a
+  record (:class:`PeakResult`, :class:`Peak`);
+- :func:`number_modes`: mode numbers from the nominal model's family
+  (:class:`Numbering`);
+- :func:`analyse_test`, :func:`analyse_campaign`: record → checks → peaks →
+  numbering for a campaign's tests (:class:`TestSpectra`).
+"""
+
+from .io_csv import record_from_csv
+from .io_hdf5 import read_record, write_record
+from .numbering import Numbering, number_modes
+from .peaks import Peak, PeakResult, find_peaks
+from .pipeline import TestSpectra, analyse_campaign, analyse_test
+from .record import Record
+from .sep005 import from_sep005, to_sep005
+from .validation import check_duration, check_positions
+
+__all__ = [
+    "Numbering", "Peak", "PeakResult", "Record", "TestSpectra", "analyse_campaign", "analyse_test", "check_duration",
+    "check_positions", "find_peaks", "from_sep005", "number_modes", "read_record", "record_from_csv", "to_sep005",
+    "write_record",
+]

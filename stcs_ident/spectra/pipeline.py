@@ -16,9 +16,10 @@ import pandas as pd
 
 from ..forward import natural_frequencies
 from ..model import Campaign, Test
-from .io import check_duration, check_positions, read_record
+from .io_hdf5 import read_record
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
+from .validation import check_duration, check_positions
 
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.

@@ -1,0 +1,135 @@
+"""Acceleration records in HDF5: the record file of a campaign.
+
+The layout is the one of the interface contract: root attributes
+``format = "stcs-record"``, ``version = 1``, ``sampling_rate`` (Hz),
+``unit`` (``"m/s^2"`` or ``"g"``) and optional ``start_time`` (ISO 8601);
+datasets ``/acceleration`` (n_samples, n_channels), ``/channel_name`` and
+``/channel_position`` (m from end A). The checks every record source shares
+(and their errors) are in :mod:`~stcs_ident.spectra.validation`; dead and
+clipped channels are dropped as :mod:`~stcs_ident.spectra.screening` says.
+A file that is missing, unreadable or not HDF5 raises an
+:class:`~stcs_ident.errors.InputError` with no field.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from typing import Any
+
+import h5py
+import numpy as np
+
+from ..errors import InputError
+from ..files import umask
+from .record import Record
+from .validation import one_line, validated_record
+
+__all__ = ["FORMAT", "VERSION", "read_record", "write_record"]
+
+FORMAT = "stcs-record"
+VERSION = 1
+
+
+def read_record(path: str | os.PathLike) -> Record:
+    """Read an acceleration record from its HDF5 file (the contract's layout).
+
+    Returns
+    -------
+    Record
+        In m/s², ``source = str(path)``, dead and clipped channels dropped.
+
+    Raises
+    ------
+    InputError
+        If the file is missing or not HDF5, or an attribute or dataset is
+        missing or invalid; ``.file`` and ``.field`` say where.
+    """
+    file = str(path)
+    with _open_hdf5(file) as h5:
+        if (fmt := _attr(h5.attrs, "format", str, file)) != FORMAT:
+            raise InputError(f"is {fmt!r}, expected {FORMAT!r}", field="format", file=file)
+        if (version := _attr(h5.attrs, "version", float, file)) != VERSION:
+            raise InputError(f"unsupported version {version:g}; this toolkit reads {VERSION}", field="version",
+                             file=file)
+        sampling_rate = _attr(h5.attrs, "sampling_rate", float, file)
+        unit = _attr(h5.attrs, "unit", str, file)
+        start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
+        acceleration = _read_dataset(h5, "acceleration", file)
+        names = _read_dataset(h5, "channel_name", file)
+        positions = _read_dataset(h5, "channel_position", file)
+    if acceleration.dtype.kind != "f":
+        raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
+    return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
+                             source=file)
+
+
+def write_record(record: Record, path: str | os.PathLike) -> None:
+    """Write ``record`` to an HDF5 file, whole or not at all.
+
+    The layout is the contract's, in float64 and m/s², version 1. The file
+    is written beside the target under a temporary name, then renamed, so a
+    failure never leaves half a record. Dropped channels are not written.
+    """
+    target = os.fspath(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", dir=os.path.dirname(target) or ".")
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w") as h5:
+            h5.attrs.update(format=FORMAT, version=VERSION, sampling_rate=record.sampling_rate, unit="m/s^2")
+            if record.start_time is not None:
+                h5.attrs["start_time"] = record.start_time
+            h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
+            h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
+            h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
+        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _open_hdf5(file: str) -> h5py.File:
+    """Open ``file`` for reading; any failure is an InputError naming it."""
+    if not os.path.exists(file):
+        raise InputError("file not found", file=file)
+    try:
+        if not h5py.is_hdf5(file):
+            raise InputError("not an HDF5 file", file=file)
+        return h5py.File(file, "r")
+    except OSError as err:
+        raise InputError(f"cannot read the file: {one_line(err)}", file=file) from err
+
+
+def _attr(attrs: h5py.AttributeManager, key: str, kind: type, file: str) -> Any:
+    """Root attribute ``key`` as a Python ``str`` or ``float`` (``kind``)."""
+    if key not in attrs:
+        raise InputError("missing root attribute", field=key, file=file)
+    value = attrs[key]
+    if isinstance(value, np.ndarray) and value.size == 1:
+        value = value.reshape(())[()]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", errors="replace")
+    if kind is str and isinstance(value, str):
+        return value
+    if kind is float and isinstance(value, int | float) and not isinstance(value, bool):
+        return float(value)
+    raise InputError(f"must be a {'string' if kind is str else 'number'}, got {value!r}", field=key, file=file)
+
+
+def _read_dataset(h5: h5py.File, name: str, file: str) -> np.ndarray:
+    """Dataset ``name`` as an array; strings are decoded from UTF-8."""
+    if name not in h5:
+        raise InputError("missing dataset", field=name, file=file)
+    node = h5[name]
+    if not isinstance(node, h5py.Dataset):
+        raise InputError("must be a dataset, found a group", field=name, file=file)
+    try:
+        if h5py.check_string_dtype(node.dtype) is not None:
+            return np.asarray(node.asstr("utf-8")[()], dtype=object)
+        return np.asarray(node[()])
+    except (OSError, ValueError) as err:  # UnicodeDecodeError is a ValueError
+        raise InputError(f"cannot read the dataset: {one_line(err)}", field=name, file=file) from err

@@ -1,0 +1,131 @@
+"""Acceleration records to and from the SDyPy SEP005 channel-dict convention.
+
+One dict per channel, with ``data``, ``fs`` (or a uniform ``time``),
+``name``, ``quantity`` and ``unit_str``; ``position`` (m from end A) is our
+extension. A record read from them passes the checks of every record source
+(:mod:`~stcs_ident.spectra.validation`); its errors name no file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .record import Record
+from .validation import (
+    UNITS,
+    Positions,
+    check_sampling_rate,
+    position_list,
+    positions_by_name,
+    rate_from_time,
+    validated_record,
+)
+
+__all__ = ["from_sep005", "to_sep005"]
+
+# SEP005 writes the unit as free text; the contract's spelling is "m/s^2".
+_SEP005_UNITS = {"m/s^2": "m/s^2", "m/s²": "m/s^2", "m/s2": "m/s^2", "g": "g"}
+
+
+def to_sep005(record: Record) -> list[dict[str, Any]]:
+    """The record as SDyPy SEP005 channel dicts, one per channel.
+
+    Each has ``data`` (1-D, m/s²), ``fs`` (Hz), ``name``, ``quantity``
+    (``"acceleration"``), ``unit_str`` (``"m/s^2"``), ``position`` (m from
+    end A, our extension) and, when known, ``start_timestamp``.
+    """
+    channels = []
+    for index, name in enumerate(record.channel_names):
+        channel = {
+            "name": name,
+            "data": record.acceleration[:, index].copy(),
+            "fs": record.sampling_rate,
+            "quantity": "acceleration",
+            "unit_str": "m/s^2",
+            "position": float(record.channel_positions[index]),
+        }
+        if record.start_time is not None:
+            channel["start_timestamp"] = record.start_time
+        channels.append(channel)
+    return channels
+
+
+def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None = None) -> Record:
+    """Build a record from SDyPy SEP005 channel dicts.
+
+    Parameters
+    ----------
+    channels : iterable of dict
+        Each with ``name``, ``data`` (1-D), ``unit_str`` (``"m/s^2"``,
+        ``"m/s²"`` or ``"g"``), ``fs`` (Hz) or a uniform ``time``, and
+        optionally ``quantity`` (acceleration), ``start_timestamp`` and
+        ``position``. All channels share one length and sampling rate.
+    positions : mapping or sequence of float, optional
+        Positions of the channels without a ``position`` key.
+
+    Raises
+    ------
+    InputError
+        As :func:`~stcs_ident.spectra.io_hdf5.read_record`, without a file; the message names the channel.
+    """
+    channels = list(channels)
+    if not channels:
+        raise InputError("no channels", field="acceleration")
+    names = [_sep005_name(channel, index) for index, channel in enumerate(channels)]
+    data = [_sep005_data(channel, name) for channel, name in zip(channels, names)]
+    lengths = {name: x.size for name, x in zip(names, data)}
+    if len(set(lengths.values())) > 1:
+        raise InputError(f"channels differ in length: {lengths}", field="acceleration")
+    rates = [_sep005_rate(channel, name, x.size) for channel, name, x in zip(channels, names, data)]
+    if not np.allclose(rates, rates[0], rtol=1e-9, atol=0):
+        raise InputError(f"channels differ in sampling rate: {dict(zip(names, rates))}", field="sampling_rate")
+    lookup = dict(positions_by_name(names, positions, None)) if positions is not None else {}
+    lookup.update({name: channel["position"] for name, channel in zip(names, channels) if "position" in channel})
+    start_time = next((c["start_timestamp"] for c in channels if c.get("start_timestamp") is not None), None)
+    return validated_record(
+        np.column_stack(data), rates[0], names, position_list(names, lookup, None),
+        unit="m/s^2", start_time=start_time, source=None,
+    )
+
+
+def _sep005_name(channel: Mapping[str, Any], index: int) -> str:
+    name = channel.get("name") if isinstance(channel, Mapping) else None
+    if not isinstance(name, str) or not name:
+        raise InputError(f"channel #{index + 1} has no 'name' (or is not a dict)", field="channel_name")
+    return name
+
+
+def _sep005_data(channel: Mapping[str, Any], name: str) -> np.ndarray:
+    """The channel's samples in m/s²."""
+    if "data" not in channel:
+        raise InputError(f"channel {name!r} has no 'data'", field="acceleration")
+    try:
+        data = np.asarray(channel["data"], dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"channel {name!r}: 'data' is not numeric", field="acceleration") from None
+    if data.ndim != 1:
+        raise InputError(f"channel {name!r}: 'data' must be 1-D, got shape {data.shape}", field="acceleration")
+    quantity = channel.get("quantity", "acceleration")
+    if str(quantity).lower() != "acceleration":
+        raise InputError(f"channel {name!r} holds {quantity!r}, not acceleration", field="acceleration")
+    unit = _SEP005_UNITS.get(str(channel.get("unit_str")).strip())
+    if unit is None:
+        raise InputError(f"channel {name!r}: unknown unit_str {channel.get('unit_str')!r}; use 'm/s^2' or 'g'",
+                         field="unit")
+    return data * UNITS[unit]
+
+
+def _sep005_rate(channel: Mapping[str, Any], name: str, n_samples: int) -> float:
+    if "fs" in channel:
+        return check_sampling_rate(channel["fs"], None)
+    if "time" in channel:
+        time = np.asarray(channel["time"], dtype=float).reshape(-1)
+        if time.size != n_samples:
+            raise InputError(f"channel {name!r}: 'time' has {time.size} values for {n_samples} samples",
+                             field="sampling_rate")
+        return rate_from_time(time, "sampling_rate", None)
+    raise InputError(f"channel {name!r} has neither 'fs' nor 'time'", field="sampling_rate")

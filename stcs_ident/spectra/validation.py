@@ -1,0 +1,226 @@
+"""Checks every acceleration record passes, whatever its source.
+
+HDF5 (:mod:`~stcs_ident.spectra.io_hdf5`), CSV
+(:mod:`~stcs_ident.spectra.io_csv`) and SEP005
+(:mod:`~stcs_ident.spectra.sep005`) each read their own input, then hand
+its parts to :func:`validated_record`, which checks them, converts to m/s²
+and drops dead and clipped channels (:mod:`~stcs_ident.spectra.screening`).
+The result is a :class:`~stcs_ident.spectra.record.Record`.
+:func:`check_positions` and :func:`check_duration` check a record against
+the cable it was measured on.
+
+Errors
+------
+Every problem raises :class:`~stcs_ident.errors.InputError` whose text is
+one line, ``"<file>: field '<field>': <what is wrong>"``. The fields are
+those of the file: ``format``, ``version``, ``sampling_rate``, ``unit``,
+``start_time``, ``acceleration``, ``channel_name``, ``channel_position``
+(and ``time`` for CSV). A file that is missing, unreadable or not HDF5 or
+CSV has no field. Non-finite samples are refused, naming the channel and
+its first bad sample (0-based index).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from datetime import datetime
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .record import STANDARD_GRAVITY, Record
+from .screening import screen_channels
+
+__all__ = [
+    "TIME_TOLERANCE", "UNITS", "Positions", "check_duration", "check_positions", "check_sampling_rate", "one_line",
+    "position_list", "positions_by_name", "rate_from_time", "validated_record",
+]
+
+#: Units a record may be in, with their factor to m/s².
+UNITS = {"m/s^2": 1.0, "g": STANDARD_GRAVITY}
+#: Largest relative spread of time steps accepted as uniform sampling.
+TIME_TOLERANCE = 1e-6
+
+Positions = Mapping[str, float] | Iterable[float]
+
+
+# Checks against the cable
+
+
+def check_positions(record: Record, length: float, file: str | None = None) -> None:
+    """Refuse a channel placed outside the span [0, ``length``] m.
+
+    ``file`` (default ``record.source``) is named in the error.
+    """
+    outside = np.flatnonzero((record.channel_positions < 0) | (record.channel_positions > length))
+    if outside.size:
+        index = int(outside[0])
+        raise InputError(
+            f"channel {record.channel_names[index]!r} at {record.channel_positions[index]:g} m "
+            f"lies outside the cable span [0, {length:g}] m",
+            field="channel_position", file=file or record.source,
+        )
+
+
+def check_duration(record: Record, f1: float, periods: float = 5, file: str | None = None) -> None:
+    """Refuse a record shorter than ``periods`` periods of mode 1 (``f1`` in Hz)."""
+    if not f1 > 0:
+        raise ValueError(f"f1 must be > 0 Hz, got {f1!r}")
+    minimum = periods / f1
+    if record.duration < minimum:
+        raise InputError(
+            f"the record lasts {record.duration:.4g} s, shorter than {periods:g} periods of mode 1 "
+            f"({f1:.4g} Hz): at least {minimum:.4g} s needed",
+            field="acceleration", file=file or record.source,
+        )
+
+
+# Validation shared by every source
+
+
+def validated_record(
+    acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
+    *, unit: str, start_time: str | None, source: str | None,
+) -> Record:
+    """Check the parts of a record, convert to m/s², drop dead and clipped channels."""
+    file = source
+    acceleration = _check_shape(np.asarray(acceleration, dtype=float), file)
+    names = _check_names(names, acceleration.shape[1], file)
+    positions = _check_position_values(positions, names, file)
+    sampling_rate = check_sampling_rate(sampling_rate, file)
+    if unit not in UNITS:
+        raise InputError(f"unknown unit {unit!r}; use 'm/s^2' or 'g'", field="unit", file=file)
+    if start_time is not None:
+        _check_start_time(start_time, file)
+    _check_finite(acceleration, names, file)
+    acceleration = acceleration * UNITS[unit]
+    keep, dropped = screen_channels(acceleration, names, file)
+    return Record(
+        acceleration=acceleration[:, keep], sampling_rate=sampling_rate,
+        channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
+        start_time=start_time, source=source, dropped=tuple(dropped),
+    )
+
+
+def _check_shape(acceleration: np.ndarray, file: str | None) -> np.ndarray:
+    if acceleration.ndim != 2:
+        raise InputError(f"must have shape (n_samples, n_channels), got {acceleration.shape}",
+                         field="acceleration", file=file)
+    if acceleration.shape[0] == 0 or acceleration.shape[1] == 0:
+        raise InputError(f"has no samples or no channels: shape {acceleration.shape}", field="acceleration", file=file)
+    return acceleration
+
+
+def _check_names(names: Any, n_channels: int, file: str | None) -> list[str]:
+    names = np.asarray(names, dtype=object)
+    if names.shape != (n_channels,):
+        raise InputError(f"must have shape ({n_channels},), one per channel, got {names.shape}",
+                         field="channel_name", file=file)
+    seen = set()
+    for index, name in enumerate(names):
+        if not isinstance(name, str) or not name.strip():
+            raise InputError(f"channel {index} needs a non-empty text name, got {name!r}", field="channel_name",
+                             file=file)
+        if name in seen:
+            raise InputError(f"duplicate channel name {name!r}", field="channel_name", file=file)
+        seen.add(name)
+    return [str(name) for name in names]
+
+
+def _check_position_values(positions: Any, names: list[str], file: str | None) -> np.ndarray:
+    try:
+        positions = np.asarray(positions, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("positions must be numbers", field="channel_position", file=file) from None
+    if positions.shape != (len(names),):
+        raise InputError(f"must have shape ({len(names)},), one per channel, got {positions.shape}",
+                         field="channel_position", file=file)
+    bad = np.flatnonzero(~np.isfinite(positions))
+    if bad.size:
+        index = int(bad[0])
+        raise InputError(f"channel {names[index]!r} has position {positions[index]}: not a finite number",
+                         field="channel_position", file=file)
+    return positions
+
+
+def check_sampling_rate(value: Any, file: str | None) -> float:
+    """``value`` as a sampling rate, Hz: a finite number > 0."""
+    try:
+        rate = float(value)
+    except (TypeError, ValueError):
+        rate = np.nan
+    if not rate > 0 or rate == np.inf:
+        raise InputError(f"must be a finite number > 0 Hz, got {value!r}", field="sampling_rate", file=file)
+    return rate
+
+
+def _check_start_time(value: Any, file: str | None) -> None:
+    try:
+        datetime.fromisoformat(value)
+    except (TypeError, ValueError):
+        raise InputError(f"is not an ISO 8601 time: {value!r}", field="start_time", file=file) from None
+
+
+def _check_finite(acceleration: np.ndarray, names: list[str], file: str | None) -> None:
+    """Refuse NaN or inf samples, naming the first bad channel and sample."""
+    bad = ~np.isfinite(acceleration)
+    bad_channels = np.flatnonzero(bad.any(axis=0))
+    if not bad_channels.size:
+        return
+    channel = int(bad_channels[0])
+    sample = int(np.argmax(bad[:, channel]))
+    value = acceleration[sample, channel]
+    what = "NaN" if np.isnan(value) else f"{value:g}"
+    others = f" ({bad_channels.size - 1} other channel(s) too)" if bad_channels.size > 1 else ""
+    raise InputError(f"channel {names[channel]!r} has {what} at sample {sample} (0-based), "
+                     f"its first non-finite sample{others}", field="acceleration", file=file)
+
+
+def positions_by_name(names: list[str], positions: Positions, file: str | None) -> dict[str, Any]:
+    """Positions given as ``{name: position}`` or in channel order, by name."""
+    if isinstance(positions, Mapping):
+        unknown = [key for key in positions if key not in names]
+        if unknown:
+            raise InputError(f"position given for unknown channel {unknown[0]!r}; channels are {', '.join(names)}",
+                             field="channel_position", file=file)
+        return dict(positions)
+    try:
+        values = list(positions)
+    except TypeError:
+        raise InputError("positions must be a mapping or a sequence", field="channel_position", file=file) from None
+    if len(values) != len(names):
+        raise InputError(f"{len(values)} positions for {len(names)} channels", field="channel_position", file=file)
+    return dict(zip(names, values))
+
+
+def position_list(names: list[str], lookup: Mapping[str, Any], file: str | None) -> list[Any]:
+    """The position of each of ``names`` from ``lookup``, in channel order; every channel needs one."""
+    missing = [name for name in names if name not in lookup]
+    if missing:
+        raise InputError(f"no position for channel {missing[0]!r}", field="channel_position", file=file)
+    return [lookup[name] for name in names]
+
+
+def rate_from_time(time: np.ndarray, field: str, file: str | None) -> float:
+    """Sampling rate, Hz, of uniformly spaced sample times."""
+    if time.size < 2:
+        raise InputError("needs at least two samples to give the sampling rate", field=field, file=file)
+    if not np.all(np.isfinite(time)):
+        index = int(np.argmin(np.isfinite(time)))
+        raise InputError(f"sample {index} has no finite time", field=field, file=file)
+    step = (time[-1] - time[0]) / (time.size - 1)
+    steps = np.diff(time)
+    worst = int(np.argmax(np.abs(steps - step)))
+    if step <= 0 or abs(steps[worst] - step) > TIME_TOLERANCE * step:
+        raise InputError(
+            f"not uniformly sampled: step {worst} ({time[worst]:.9g} s to {time[worst + 1]:.9g} s) "
+            f"is {steps[worst]:.6g} s against {step:.6g} s on average (tolerance {TIME_TOLERANCE:g} relative)",
+            field=field, file=file,
+        )
+    return float(1.0 / step)
+
+
+def one_line(err: BaseException) -> str:
+    """An exception's text on one line, for an error message that quotes it."""
+    return " ".join(str(err).split()) or type(err).__name__
