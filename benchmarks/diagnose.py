@@ -27,16 +27,15 @@ import argparse
 import os
 import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import CHECKOUT, print_header
 
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.api import _default_workers
 from stcs_ident.identify import identify
 
-CAMPAIGN = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
+CAMPAIGN = CHECKOUT / "campaigns" / "han2020"
 TARGET = 60.0
 
 
@@ -54,6 +53,7 @@ def main(argv=None) -> int:
     group.add_argument("--serial-only", action="store_true", help="only the one-process run")
     group.add_argument("--parallel-only", action="store_true", help="only the shipped (parallel) run")
     args = parser.parse_args(argv)
+    print_header()
     campaign = load_campaign(CAMPAIGN)
     print(f"han2020 diagnosis; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs; "
           f"{_default_workers()} worker(s) by default")

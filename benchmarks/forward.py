@@ -18,33 +18,19 @@ from __future__ import annotations
 
 import argparse
 import math
-import statistics
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import CHECKOUT, print_header, timed
 
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.forward import batch_frequencies, natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies
 from stcs_ident.model import Attachment, Cable
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = CHECKOUT  # campaigns/ of this checkout
 TARGET_ACCURACY = 1e-6  # relative, on mode 10
-
-
-def timed(func, repeat):
-    """Median wall time of ``repeat`` calls (after one warm-up), seconds."""
-    func()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        func()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def fe_mesh_for(cable, atts, tension, exact10):
@@ -63,8 +49,8 @@ def one_call(repeat):
     tension = 3.0e6
     exact = natural_frequencies(cable, atts, tension, 10)
     n, err = fe_mesh_for(cable, atts, tension, exact[9])
-    t_dsm = timed(lambda: natural_frequencies(cable, atts, tension, 10), repeat)
-    t_fe = timed(lambda: fe_frequencies(cable, atts, tension, 10, n_elements=n, solver="sparse"), repeat)
+    t_dsm, _ = timed(lambda: natural_frequencies(cable, atts, tension, 10), repeat)
+    t_fe, _ = timed(lambda: fe_frequencies(cable, atts, tension, 10, n_elements=n, solver="sparse"), repeat)
     return {"dsm": t_dsm, "fe": t_fe, "fe_elements": n, "fe_error": err}
 
 
@@ -108,6 +94,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a smaller batch (3,600 sets)")
     args = parser.parse_args(argv)
+    print_header()
     one = one_call(repeat=30 if args.quick else 100)
     b = batch(args.quick)
     rows = [

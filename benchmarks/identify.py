@@ -24,35 +24,22 @@ Run: ``python benchmarks/identify.py [--quick] [--figures DIR]``.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import CHECKOUT, print_header, timed
 
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies
 from stcs_ident.identify import Problem, fit_contour, fit_lsq, gather_measurements, parse_parameters
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = CHECKOUT  # campaigns/ of this checkout
 TARGET_ACCURACY = 1e-6  # relative, on mode 6 at the nominal point
 TEST = "case1-L4"
-
-
-def timed(func, repeat):
-    """Median wall time of ``repeat`` calls after one warm-up (s), and the last value."""
-    value = func()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        value = func()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), value
 
 
 def fe_mesh_for(cable, tension, exact6):
@@ -89,6 +76,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="fewer repeats and a smaller FE grid")
     parser.add_argument("--figures", metavar="DIR", help="also write the han2020 identification figures into DIR")
     args = parser.parse_args(argv)
+    print_header()
     if args.figures:
         write_figures(Path(args.figures))
     campaign = load_campaign(ROOT / "campaigns" / "han2020")

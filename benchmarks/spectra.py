@@ -1,7 +1,7 @@
 """Modal frequency estimation benchmark: stcs_ident's find_peaks against pyOMA-2 FDD and EFDD, side by side.
 
 Every method sees the SAME simulated records (seeded modal superposition of
-the exact cable model, ``stcs_ident.spectra.simulate.simulate_record``):
+the exact cable model, ``stcs_ident.simulate.simulate_record``):
 
 - a short stiff hanger (l = 8 m, m = 30 kg/m, EI = 2e5 N m², H = 400 kN,
   clamped), 3 sensors, ζ = 0.8 %, SNR 20 dB;
@@ -56,11 +56,9 @@ import statistics
 import sys
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import print_header, wall_times
 
 PYOMA_MISSING = (
     "pyOMA-2 is not installed; this benchmark compares against it.\n"
@@ -319,15 +317,6 @@ def print_case(r: dict) -> dict:
     return {"title": f"{s.name} {case.kind}", "lower": lower, "med": med}
 
 
-def timed(func, repeat: int) -> list[float]:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        func()
-        times.append(time.perf_counter() - t)
-    return times
-
-
 def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) -> dict:
     """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time."""
     from stcs_ident.forward import count_below
@@ -349,7 +338,7 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
     repeat = repeat or (1 if quick else 3)
 
     holder = {}
-    ours_default = timed(lambda: holder.update(result=find_peaks(record)), repeat)
+    ours_default = wall_times(lambda: holder.update(result=find_peaks(record)), repeat)
     ours_single = None
     try:
         from threadpoolctl import threadpool_limits
@@ -357,7 +346,7 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
         pass
     else:
         with threadpool_limits(limits=1, user_api="blas"):
-            ours_single = timed(lambda: find_peaks(record), repeat)
+            ours_single = wall_times(lambda: find_peaks(record), repeat)
     found = np.array([p.frequency for p in holder["result"].peaks])
     err = np.full(truth.size, np.nan)
     for k, ft in enumerate(truth):
@@ -383,7 +372,7 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
             setup.mpe("FDD", sel_freq=list(truth), DF=PYOMA_DF_FRACTION * gaps.min())
         holder["fdd"] = np.asarray(setup["FDD"].result.Fn, dtype=float)
 
-    result["fdd"] = timed(fdd, repeat)
+    result["fdd"] = wall_times(fdd, repeat)
     result["fdd_err"] = float(np.median(np.abs(holder["fdd"] / truth - 1)))
     return result
 
@@ -424,6 +413,7 @@ def main(argv=None) -> int:
                         help="only the find_peaks throughput case (no pyOMA-2 needed), --repeat runs")
     parser.add_argument("--repeat", type=int, default=5, help="timing runs with --throughput (default 5)")
     args = parser.parse_args(argv)
+    print_header()
     if args.throughput:
         print_throughput(throughput(quick=False, with_fdd=False, repeat=max(1, args.repeat)))
         return 0
