@@ -58,7 +58,7 @@ def test_no_effect_gives_an_empty_cause():
     s = d.summary()
     # no pair can change an empty cause: the nominal model, the 8 single effects and the baseline only
     assert max(d.fits, key=len) == ("tension", "bending_stiffness") and len(d.fits) == 10
-    assert any("pairs of effects not fitted" in n for n in d.notes)
+    assert any("pairs of effects not fitted" in str(n) for n in d.notes)
     assert s["cause"]["effects"] == [] and s["cause"]["principal"] is None
     assert s["cause"]["explained_by_nominal"] and s["cause"]["p_value_nominal"] >= 1e-3
     assert s["gain"]["rms_error_corrected"] == s["gain"]["rms_error_nominal"]
@@ -177,12 +177,17 @@ def test_cli_writes_json(tmp_path, capsys):
 def test_notes_name_values_in_si_units():
     from stcs_ident.diagnose.fitting import in_si_units
     from stcs_ident.identify.parameters import Parameter
+    from stcs_ident.notes import Note, point
 
     params = [Parameter("position", "(unmodeled mass)", 0.3, 0.3, 0.1, 60.0, slots=(("S", 0),)),
               Parameter("EI", None, 2e5, 2e5, 0.01, 100.0), Parameter("tension", "T1", 4e5, 4e5, 0.5, 2.0)]
-    note = "other: position_ratio[(unmodeled mass)] = 63.9977, EI_ratio = 0.5, tension_ratio[T1] = 1.02"
-    assert in_si_units(note, params) == (
+    note = Note.make("almost_as_well", "other: {points}",
+                     points=[point([p.name for p in params], [63.9977, 0.5, 1.02])])
+    assert str(note) == "other: position_ratio[(unmodeled mass)] = 63.9977, EI_ratio = 0.5, tension_ratio[T1] = 1.02"
+    converted = in_si_units(note, params)
+    assert str(converted) == (
         "other: position[(unmodeled mass)] = 19.1993 m, EI = 100000 N m^2, tension_ratio[T1] = 1.02")
+    assert [a.unit for a in converted.points[0]] == ["m", "N m^2", ""]  # the data, not only the sentence
 
 
 def test_modes_with_doubtful_numbers_are_left_out():
@@ -195,7 +200,7 @@ def test_modes_with_doubtful_numbers_are_left_out():
                                    doubtful=doubtful)
     d = diagnose(campaign, picked=picked, max_effects=1)
     assert list(d.measurements[0].modes) == [1, 2, 4, 5, 6]
-    assert any("T1: modes 3 left out" in n for n in d.notes)
+    assert any("T1: modes 3 left out" in str(n) for n in d.notes)
 
 
 def _fit(effects, k, chi2, n):

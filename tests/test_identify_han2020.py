@@ -71,7 +71,7 @@ def test_covariance_scaled_and_said_so(joint):
     """Rounding (0.01/√12 Hz) is far below the real misfit: the covariance is scaled."""
     assert joint.covariance_scale == pytest.approx(joint.reduced_chi2)
     assert joint.reduced_chi2 > 100
-    assert any("scaled by the reduced chi2" in n for n in joint.notes)
+    assert any(n.kind == "covariance_scaled" and "scaled by the reduced chi2" in str(n) for n in joint.notes)
     assert joint.summary()["covariance_scale"] == pytest.approx(joint.reduced_chi2)
 
 

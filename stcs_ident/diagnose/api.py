@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import InputError
 from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
+from ..notes import Note
 from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
 from .hypotheses import applicable, build, hypothesis_sets, parse_effects
 from .result import Diagnosis
@@ -81,7 +82,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     picked, excluded = _without_doubtful(campaign, picked or {})
     measurements, skipped = gather_measurements(campaign, tests, picked)
     measured_tests = [m.test for m in measurements]
-    notes: list[str] = list(excluded)
+    notes: list[Note] = list(excluded)
     usable = []
     for e in names:
         why = applicable(campaign, measured_tests, e)
@@ -90,7 +91,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         elif requested:
             raise InputError(why, field="effects")
         else:
-            notes.append(f"not considered: {why}")
+            notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
     n = sum(m.modes.size for m in measurements)
     sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
     baseline = tuple(e for e in BASELINE if applicable(campaign, measured_tests, e) is None)
@@ -103,7 +104,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     sets = [s for s in hypothesis_sets(usable, max_effects) if sum(sizes[e] for e in s) + 2 <= n]
     dropped = len(hypothesis_sets(usable, max_effects)) - len(sets)
     if dropped:
-        notes.append(f"{dropped} hypotheses not fitted: more parameters than the {n} frequencies allow")
+        notes.append(Note.make("too_many_parameters", "{value} hypotheses not fitted: more parameters than the "
+                               "{n} frequencies allow", value=dropped, n=n))
     if baseline and baseline not in sets and sum(sizes[e] for e in baseline) + 2 <= n:
         sets.append(baseline)
     symmetric = mirror_symmetric(campaign, measurements, tension_model)
@@ -117,8 +119,9 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         if i == 1 and not all_hypotheses and explains(fits[()], n):
             # No pair can change an empty cause: fit only the baseline, which the gain needs.
             kept = [s for s in stage if s == baseline]
-            notes.append(f"the nominal model explains the data: {len(stage) - len(kept)} pairs of effects not "
-                         f"fitted (they cannot change an empty cause; all_hypotheses fits them)")
+            notes.append(Note.make("pairs_not_fitted", "the nominal model explains the data: {value} pairs of "
+                                   "effects not fitted (they cannot change an empty cause; all_hypotheses fits them)",
+                                   value=len(stage) - len(kept)))
             total -= len(stage) - len(kept)
             stage = kept
         jobs = [(campaign, measurements, s, tension_model, symmetric, _pair_seeds(fits, s) if len(s) > 1 else [])
@@ -148,7 +151,7 @@ def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
     return seeds
 
 
-def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple[dict, list[str]]:
+def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple[dict, list[Note]]:
     """Picked spectra without the modes whose number is doubtful (a wrong number would pass for a
     model error), and a note for each test that lost some."""
     out, notes = {}, []
@@ -164,7 +167,8 @@ def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple
             out[name] = Measurement(test, np.asarray(spectra.modes)[keep], np.asarray(spectra.frequencies)[keep],
                                     np.asarray(spectra.uncertainty)[keep], "spectra")
         lost = ", ".join(str(m) for m in np.asarray(spectra.modes)[doubtful])
-        notes.append(f"{name}: modes {lost} left out (their numbers are doubtful)")
+        notes.append(Note.make("doubtful_modes", "{test}: modes {modes} left out (their numbers are doubtful)",
+                               test=name, modes=lost))
     return out, notes
 
 

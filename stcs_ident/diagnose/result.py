@@ -52,7 +52,8 @@ class Diagnosis:
     selection : Selection
     symmetric : bool
         Whether the measured setups are symmetric about midspan.
-    skipped, notes : tuple
+    skipped : tuple of (test, reason)
+    notes : tuple of Note
     timings : dict
         Seconds per hypothesis (fit and cross-validation).
     elapsed : float
@@ -133,7 +134,7 @@ class Diagnosis:
                                "n_parameters": f.n_parameters, "chi2": f.chi2, "rms_error": f.rms_error,
                                "aicc": _finite_or_none(f.aicc), "delta_aicc": _finite_or_none(f.aicc - best),
                                "cv_rms_error": _finite_or_none(f.cv_rms_error), "cv_rank": cv_rank.get(f.effects),
-                               "notes": list(f.notes)})
+                               "notes": [str(n) for n in f.notes]})
         sel = self.selection
         values, sigmas = self.parameters(corrected)
         gain = {"rms_error_nominal": nominal.rms_error, "rms_error_corrected": corrected.rms_error,
@@ -154,7 +155,7 @@ class Diagnosis:
             "gain": gain,
             "symmetric": self.symmetric,
             "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
-            "notes": list(self.notes),
+            "notes": [str(n) for n in self.notes],
             "seconds": self.elapsed,
         }
 

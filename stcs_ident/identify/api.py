@@ -6,6 +6,7 @@ from collections.abc import Iterable, Mapping, Sequence
 
 from ..errors import InputError
 from ..model import Campaign
+from ..notes import Note
 from .parameters import parse_parameters
 from .problem import Problem, gather_measurements
 from .result import IdentificationResult
@@ -81,6 +82,7 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if skipped:
         from dataclasses import replace
 
-        note = f"skipped (nothing to identify from): {', '.join(f'{n} ({r})' for n, r in skipped)}"
+        note = Note.make("skipped", "skipped (nothing to identify from): {tests}",
+                         tests=", ".join(f"{n} ({r})" for n, r in skipped))
         result = replace(result, skipped=tuple(skipped), notes=result.notes + (note,))
     return result

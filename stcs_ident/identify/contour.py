@@ -25,17 +25,22 @@ a region only a few cells across to measure it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import ndimage
 from scipy.optimize import minimize
 
 from ..errors import InputError
+from ..notes import Note, point
 from .lsq import _local_fit, finish, mirror_images, nearest_nominal
 from .problem import Problem
 from .result import IdentificationResult
 from .uncertainty import covariance_scale
+
+#: Sentence of the ``covariance_scaled`` note here: the bands are widened, and the covariance with them.
+SCALED_BANDS = ("the misfit is {misfit:.3g} times the stated frequency uncertainties (reduced chi2 {value:.3g}, "
+                "{dof} degrees of freedom): the contour bands are widened by its square root")
 
 #: Grid ranges by kind (variable units), clipped to the bounds.
 DEFAULT_RANGES = {
@@ -147,35 +152,39 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
     _, chi2_min = _local_fit(problem, np.array([axes[0][i0[0]], axes[1][i0[1]]]), 100)
     scale, scale_note = covariance_scale(chi2_min, problem.n_data - 2, scale_rule)
     if scale_note:
-        notes.append(scale_note.replace("the covariance is scaled by the reduced chi2",
-                                        "the contour bands are widened by its square root"))
+        notes.append(replace(scale_note, template=SCALED_BANDS) if scale_note.kind == "covariance_scaled"
+                     else scale_note)
     sigma = problem.sigma * np.sqrt(scale)
     centre, tau = _minimax(problem, F, axes, sigma)
     centre, alternatives = _mirror_choice(problem, centre, tau, sigma)
     if alternatives:
-        shown = "; ".join(", ".join(f"{n} = {v:.6g}" for n, v in zip(problem.names, a)) for a in alternatives)
-        notes.append(f"the mirror image explains the data equally well (the one nearest the nominal values is "
-                     f"reported): {shown}")
+        notes.append(Note.make("mirror_image", "the mirror image explains the data equally well (the one nearest "
+                               "the nominal values is reported): {points}",
+                               points=[point(problem.names, a) for a in alternatives]))
     sweep = _sweep(problem, axes, F, sigma, centre, tau)
     for _ in range(max_widen):
         grow = _widened(problem, axes, sweep)
         if grow is None:
             break
-        notes.append(f"the intersection region reached the edge of the grid: grid widened to "
-                     f"{grow[0][0]:.4g}-{grow[0][-1]:.4g} x {grow[1][0]:.4g}-{grow[1][-1]:.4g}")
+        notes.append(Note.make("grid_widened", "the intersection region reached the edge of the grid: grid "
+                               "widened to {low_1:.4g}-{high_1:.4g} x {low_2:.4g}-{high_2:.4g}",
+                               parameters=problem.names, low_1=float(grow[0][0]), high_1=float(grow[0][-1]),
+                               low_2=float(grow[1][0]), high_2=float(grow[1][-1])))
         axes, F = grow, _surfaces(problem, grow)
         sweep = _sweep(problem, axes, F, sigma, centre, tau)
     if _widened(problem, axes, sweep) is not None:
-        notes.append("the intersection region still reaches the edge of the grid: its extent is a lower bound")
+        notes.append(Note.make("region_at_edge", "the intersection region still reaches the edge of the grid: its "
+                               "extent is a lower bound"))
     zoom = _zoom(problem, sweep)
     if zoom is not None:
         sweep = _replace_zoom(sweep, zoom)
     extent = sweep.extent
     parts = ndimage.label(sweep.misfit <= sweep.level)[1]
     if parts > 1:
-        notes.append(f"the contours nearly meet in {parts} separate regions; the one around the estimate is "
-                     "reported")
-    notes.append(f"contour centre: every mode within {tau:.3g} band widths; region: within {tau + 1:.3g}")
+        notes.append(Note.make("separate_regions", "the contours nearly meet in {value} separate regions; the one "
+                               "around the estimate is reported", value=int(parts)))
+    notes.append(Note.make("contour_centre", "contour centre: every mode within {value:.3g} band widths; region: "
+                           "within {level:.3g}", value=float(tau), level=float(tau + 1)))
     chi2 = float(problem.chi2(centre[None, :])[0])
     return finish(problem, centre, chi2, "contour", notes=notes, uncertainty=extent, sweep=sweep, scale=scale,
                   alternatives=alternatives)
@@ -325,6 +334,4 @@ def _zoom(problem: Problem, sweep: ContourSweep) -> ContourSweep | None:
 
 
 def _replace_zoom(sweep: ContourSweep, zoom: ContourSweep) -> ContourSweep:
-    from dataclasses import replace
-
     return replace(sweep, zoom=zoom, extent=zoom.extent, centroid=zoom.centroid)

@@ -19,6 +19,7 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..notes import Note, point
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability
@@ -97,7 +98,8 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
                 if min(v - lo, hi - v) <= 1e-9 * w]
     if at_bound:
-        notes.append(f"at a bound (the standard deviation there is only indicative): {', '.join(at_bound)}")
+        notes.append(Note.make("at_bound", "at a bound (the standard deviation there is only indicative): "
+                               "{parameters}", parameters=at_bound))
     notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper),
                                   stacklevel=4)
     before = problem.predict(problem.start)
@@ -209,7 +211,8 @@ def nearest_nominal(problem: Problem, candidates: list[np.ndarray]) -> list[np.n
 def _choose(problem: Problem, solutions: list[tuple[np.ndarray, float]]):
     """Best minimum; among minima that fit equally well, the one nearest the nominal values.
 
-    Returns (x, χ², alternatives, notes).
+    Returns (x, χ², alternatives, notes); the notes (``equally_well``, ``almost_as_well``) quote the
+    other minima as points.
     """
     distinct: list[tuple[np.ndarray, float]] = []
     for x, c in sorted(solutions, key=lambda s: s[1]):
@@ -226,13 +229,14 @@ def _choose(problem: Problem, solutions: list[tuple[np.ndarray, float]]):
     notes = []
     names = problem.names
     if alternatives:
-        shown = "; ".join(", ".join(f"{n} = {v:.6g}" for n, v in zip(names, a)) for a in alternatives)
-        notes.append(f"{len(alternatives)} other estimate(s) explain the data equally well (the one nearest the "
-                     f"nominal values is reported): {shown}")
+        notes.append(Note.make("equally_well", "{value} other estimate(s) explain the data equally well (the one "
+                               "nearest the nominal values is reported): {points}", value=len(alternatives),
+                               points=[point(names, a) for a in alternatives]))
     # "almost as well": within one unit of χ² (scaled like the covariance when the misfit is large)
     unit = max(1.0, best_chi2 / max(problem.n_data - len(names), 1))
     close = [(y, c) for y, c in distinct if tol < c - best_chi2 < unit]
     for y, c in close:
-        shown = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, y))
-        notes.append(f"another minimum fits almost as well (chi2 {c:.4g} against {best_chi2:.4g}): {shown}")
+        notes.append(Note.make("almost_as_well", "another minimum fits almost as well (chi2 {value:.4g} against "
+                               "{best:.4g}): {points}", value=float(c), best=float(best_chi2),
+                               points=[point(names, y)]))
     return x, chi2, alternatives, notes

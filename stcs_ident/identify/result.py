@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..notes import Note
 from .parameters import Parameter
 
 
@@ -102,9 +103,9 @@ class IdentificationResult:
     covariance_scale : float
         Factor applied to the covariance: the reduced χ² when the misfit is
         larger than the stated uncertainties explain, else 1.
-    notes : tuple of str
-        Plain-language remarks (scaling, parameters at a bound, ambiguity,
-        not identifiable, ...).
+    notes : tuple of Note
+        Remarks as records (scaling, parameters at a bound, ambiguity, not
+        identifiable, ...); ``str(note)`` says one in words.
     skipped : tuple of (test, reason)
     alternatives : tuple of ndarray
         Other estimates that explain the data equally well (mirror images,
@@ -123,7 +124,7 @@ class IdentificationResult:
     chi2: float
     dof: int
     covariance_scale: float = 1.0
-    notes: tuple[str, ...] = ()
+    notes: tuple[Note, ...] = ()
     skipped: tuple[tuple[str, str], ...] = ()
     alternatives: tuple[np.ndarray, ...] = ()
     sweep: object | None = field(default=None, repr=False)
@@ -172,7 +173,7 @@ class IdentificationResult:
         Extra keys: ``values`` and ``value_uncertainty`` (SI units),
         ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
         ``reduced_chi2``, ``covariance_scale``, ``rms_error_before``,
-        ``rms_error_after`` (%), ``notes``, ``skipped``, ``alternatives``,
+        ``rms_error_after`` (%), ``notes`` (as sentences), ``skipped``, ``alternatives``,
         and per test ``uncertainty``, ``uncertainty_source`` and ``reference``
         (frequencies computed by others, e.g. the paper's corrected values).
         """
@@ -200,7 +201,7 @@ class IdentificationResult:
             "covariance_scale": _float(self.covariance_scale),
             "rms_error_before": _float(self.rms_before),
             "rms_error_after": _float(self.rms_after),
-            "notes": list(self.notes),
+            "notes": [str(n) for n in self.notes],
             "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
             "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
         }

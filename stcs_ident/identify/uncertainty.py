@@ -16,11 +16,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy import stats
 
 from ..errors import StcsWarning
+from ..notes import Note
 
 #: |correlation| above which two parameters are reported as not separately identifiable.
 CORRELATION_LIMIT = 0.995
@@ -33,6 +35,9 @@ CONDITION_LIMIT = 1e3
 NO_EFFECT = 1e-6
 
 SCALE_RULES = ("auto", "birge", "never")
+#: Sentence of the ``covariance_scaled`` note (the contour method says what it widens instead).
+SCALED = ("the misfit is {misfit:.3g} times the stated frequency uncertainties (reduced chi2 {value:.3g}, {dof} "
+          "degrees of freedom): the covariance is scaled by the reduced chi2")
 
 
 class IdentifiabilityWarning(StcsWarning):
@@ -43,8 +48,11 @@ class IdentifiabilityWarning(StcsWarning):
         self.parameters = tuple(parameters)
 
 
-def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, str | None]:
+def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, Note | None]:
     """Factor for the covariance and a note saying why it is applied.
+
+    The note is ``no_degrees_of_freedom`` or ``covariance_scaled`` (its
+    ``value`` the reduced χ², its data ``misfit`` = √value and ``dof``).
 
     Parameters
     ----------
@@ -57,14 +65,14 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, 
     if rule not in SCALE_RULES:
         raise ValueError(f"scale rule must be one of {SCALE_RULES}, got {rule!r}")
     if dof <= 0:
-        return 1.0, "no degrees of freedom left: the uncertainties rest on the stated frequency uncertainties alone"
+        return 1.0, Note.make("no_degrees_of_freedom", "no degrees of freedom left: the uncertainties rest on the "
+                                                       "stated frequency uncertainties alone")
     reduced = chi2 / dof
     significant = chi2 > stats.chi2.ppf(0.95, dof)
     if rule == "never" or reduced <= 1 or (rule == "auto" and not significant):
         return 1.0, None
-    return reduced, (f"the misfit is {np.sqrt(reduced):.3g} times the stated frequency uncertainties "
-                     f"(reduced chi2 {reduced:.3g}, {dof} degrees of freedom): the covariance is scaled by "
-                     "the reduced chi2")
+    return reduced, Note.make("covariance_scaled", SCALED, value=float(reduced), misfit=float(np.sqrt(reduced)),
+                              dof=int(dof))
 
 
 def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -91,50 +99,59 @@ def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarra
 
 
 def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma: np.ndarray,
-                    lower: np.ndarray, upper: np.ndarray) -> list[tuple[str, tuple[str, ...]]]:
-    """Problems that make parameters not identifiable: (sentence, names) pairs.
+                    lower: np.ndarray, upper: np.ndarray) -> list[Note]:
+    """Problems that make parameters not identifiable, as notes naming the parameters.
 
-    - a parameter that does not change any measured frequency;
-    - two parameters correlated beyond :data:`CORRELATION_LIMIT`;
-    - an ill-conditioned Jacobian (condition number of its column-normalised
-      form above :data:`CONDITION_LIMIT`): the parameters of the weakest
-      direction are named;
-    - a standard deviation wider than half the bounds: the data do not
-      locate the parameter within them.
+    - ``no_effect``: a parameter that does not change any measured frequency;
+    - ``correlated``: two parameters correlated beyond
+      :data:`CORRELATION_LIMIT` (``value``: the correlation);
+    - ``ill_conditioned``: the Jacobian's column-normalised form has a
+      condition number (``value``) above :data:`CONDITION_LIMIT`; the
+      parameters of the weakest direction are named;
+    - ``not_located``: a standard deviation (``value``) wider than half the
+      bounds: the data do not locate the parameter within them.
     """
     names = list(names)
     problems = []
     norms = np.linalg.norm(J, axis=0)
     dead = norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)
     for i in np.flatnonzero(dead):
-        problems.append((f"{names[i]} does not change any measured frequency", (names[i],)))
+        problems.append(Note.make("no_effect", "{parameter} does not change any measured frequency",
+                                  parameters=(names[i],)))
     live = np.flatnonzero(~dead)
     for a, i in enumerate(live):
         for j in live[a + 1:]:
             if abs(corr[i, j]) > CORRELATION_LIMIT:
-                problems.append(((f"{names[i]} and {names[j]} are correlated at {corr[i, j]:+.4f}: the data "
-                                 "determine only a combination of them"), (names[i], names[j])))
+                problems.append(Note.make("correlated", "{names[0]} and {names[1]} are correlated at {value:+.4f}: "
+                                          "the data determine only a combination of them",
+                                          parameters=(names[i], names[j]), value=float(corr[i, j])))
     if live.size > 1:
         Jn = J[:, live] / norms[live]
         _, s, Vt = np.linalg.svd(Jn, full_matrices=False)
         cond = s[0] / s[-1] if s[-1] > 0 else np.inf
         if cond > CONDITION_LIMIT:
             weak = tuple(names[live[k]] for k in np.flatnonzero(np.abs(Vt[-1]) > 0.25))
-            problems.append(((f"the Jacobian is ill-conditioned (condition number {cond:.3g}); weakest direction: "
-                             f"{', '.join(weak)}"), weak))
+            problems.append(Note.make("ill_conditioned", "the Jacobian is ill-conditioned (condition number "
+                                      "{value:.3g}); weakest direction: {parameters}", parameters=weak,
+                                      value=float(cond)))
     for i in live:
         if np.isfinite(sigma[i]) and sigma[i] > 0.5 * (upper[i] - lower[i]):
-            problems.append(((f"{names[i]} is not located within its bounds [{lower[i]:g}, {upper[i]:g}] "
-                             f"(standard deviation {sigma[i]:.3g})"), (names[i],)))
+            problems.append(Note.make("not_located", "{parameter} is not located within its bounds [{lower:g}, "
+                                      "{upper:g}] (standard deviation {value:.3g})", parameters=(names[i],),
+                                      value=float(sigma[i]), lower=float(lower[i]), upper=float(upper[i])))
     return problems
 
 
-def warn_identifiability(problems: list[tuple[str, tuple[str, ...]]], stacklevel: int = 3) -> list[str]:
-    """Issue one :class:`IdentifiabilityWarning` naming every affected parameter; return the notes."""
+#: What the notes of :func:`warn_identifiability` say before each problem.
+NOT_IDENTIFIABLE = "not identifiable from the data: "
+
+
+def warn_identifiability(problems: list[Note], stacklevel: int = 3) -> list[Note]:
+    """Issue one :class:`IdentifiabilityWarning` naming every affected parameter; return the notes
+    (the problems, each said as ``not identifiable from the data: ...``)."""
     if not problems:
         return []
-    affected = tuple(dict.fromkeys(n for _, names in problems for n in names))
-    notes = [f"not identifiable from the data: {sentence}" for sentence, _ in problems]
-    message = f"parameters not identifiable from the data: {', '.join(affected)} ({'; '.join(s for s, _ in problems)})"
+    affected = tuple(dict.fromkeys(n for p in problems for n in p.parameters))
+    message = f"parameters not identifiable from the data: {', '.join(affected)} ({'; '.join(map(str, problems))})"
     warnings.warn(IdentifiabilityWarning(message, affected), stacklevel=stacklevel)
-    return notes
+    return [replace(p, template=NOT_IDENTIFIABLE + p.template) for p in problems]
