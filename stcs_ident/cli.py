@@ -228,7 +228,9 @@ def _identify(args) -> int:
 
         save_identify_figures(result, args.plot)
     if args.json != "-":
-        sys.stdout.write(result.text())
+        from .identify.tables import result_text
+
+        sys.stdout.write(result_text(result))
         for item in summary["published"]:
             sys.stdout.write(f"\nPublished beside ours: {item['statement']}\n")
     return 0
@@ -256,7 +258,9 @@ def _diagnose(args) -> int:
 
         write_report(result, args.out, spectra=spectra, tension_model=args.tension_model)
     if args.json != "-":
-        sys.stdout.write(result.text())
+        from .diagnose.report import diagnosis_text
+
+        sys.stdout.write(diagnosis_text(result))
         if args.out is not None:
             sys.stdout.write(f"report: {os.path.join(args.out, 'report.md')}\n")
     return 0

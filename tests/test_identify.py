@@ -202,6 +202,8 @@ def test_summary_is_the_interface_json():
 
 
 def test_tables_in_the_papers_form(tmp_path):
+    from stcs_ident.identify.tables import parameters_table, result_markdown, result_text, write_csv
+
     campaign, picked = synthetic("bare", 1.02, 0.9, tensions=(1.0e6, 1.2e6), n_modes=6)
     result = identify(campaign, None, "tension,EI", picked=picked)
     df = result.to_dataframe()
@@ -209,15 +211,15 @@ def test_tables_in_the_papers_form(tmp_path):
                                     "corrected_Hz", "corrected_error_abs_%"]
     assert len(df) == 12 and (df["before_error_abs_%"] >= 0).all()
     np.testing.assert_allclose(df["corrected_error_abs_%"], 0, atol=1e-8)
-    md = result.to_markdown()
+    md = result_markdown(result)
     assert "| mode | measured (Hz) | before (Hz) | \\|δ\\| (%) |" in md  # pipes escaped inside cells
     assert "#### T2" in md
-    text = result.text()
+    text = result_text(result)
     assert "tension_ratio[T1]" in text and "|δ*| (%)" in text
     path = tmp_path / "table.csv"
-    result.to_csv(path)
+    write_csv(result, path)
     assert path.read_text().splitlines()[0].startswith("test,mode,measured_Hz")
-    assert list(result.parameters_dataframe()["parameter"]) == result.names
+    assert list(parameters_table(result)["parameter"]) == result.names
 
 
 def test_corrected_campaign_carries_the_estimates():

@@ -1,4 +1,8 @@
-"""The diagnosis result: the ``diagnose`` JSON of ``interface.md`` and a text summary."""
+"""The diagnosis result: the data of the ``diagnose`` step and its JSON (``.summary()``).
+
+The terminal summary and the report are made from it by
+:mod:`stcs_ident.diagnose.report`, which this module does not import.
+"""
 
 from __future__ import annotations
 
@@ -110,7 +114,7 @@ class Diagnosis:
         return out
 
     def summary(self) -> dict:
-        """The ``diagnose`` JSON of ``interface.md`` (plus optional keys)."""
+        """The ``diagnose`` JSON (plain data, notes as sentences)."""
         nominal, corrected, baseline = self.nominal, self.corrected, self.baseline
         tests = []
         parts = {"nominal": self.per_test(nominal), "corrected": self.per_test(corrected)}
@@ -188,9 +192,3 @@ class Diagnosis:
             text += (" Not told apart from: " + "; ".join(" + ".join(a) for a in sel.ambiguous_with)
                      + " (ΔAICc < 2).")
         return text
-
-    def text(self) -> str:
-        """Human-readable summary for the terminal."""
-        from .report import diagnosis_text
-
-        return diagnosis_text(self)

@@ -8,8 +8,8 @@
   evaluated in batches;
 - :func:`fit_lsq`, :func:`fit_contour`: the two methods on a built problem;
 - :class:`IdentificationResult`, :class:`TestFit`: results, with
-  ``.summary()`` (JSON), ``.to_dataframe()`` (the paper's Table 9/10 form),
-  ``.to_markdown()`` and ``.text()``;
+  ``.summary()`` (JSON) and ``.to_dataframe()`` (the paper's Table 9/10
+  form); :mod:`.tables` lays them out as text, Markdown and CSV;
 - :func:`corrected_campaign`: the campaign with the estimates in place of the
   nominal values (to chain identifications, as the paper does);
 - :class:`IdentifiabilityWarning`.

@@ -4,9 +4,11 @@
 returns for either method: the estimates in the dimensionless variables of
 the parameters (ratios to nominal, mostly) and in SI units, their
 uncertainties, and per test the measured frequencies before and after the
-correction (:class:`TestFit`). ``.summary()`` is the ``identify`` JSON of
-``interface.md`` plus optional keys; ``.to_dataframe()`` is the paper's
-Table 9/10 form.
+correction (:class:`TestFit`). ``.summary()`` is the ``identify`` JSON
+plus optional keys; ``.to_dataframe()`` is the paper's Table 9/10 form.
+The tables in words (text and Markdown) and the CSV file are made by
+:mod:`stcs_ident.identify.tables`, which reads these objects; nothing here
+imports it.
 """
 
 from __future__ import annotations
@@ -19,6 +21,9 @@ import pandas as pd
 
 from ..notes import Note
 from .parameters import Parameter
+
+#: Reference columns shown beside the correction: labels containing this word.
+SHOWN_REFERENCE = "corrected"
 
 
 @dataclass(frozen=True)
@@ -168,7 +173,7 @@ class IdentificationResult:
         return float(np.sqrt(np.mean(np.concatenate([t.after_error for t in self.tests]) ** 2)))
 
     def summary(self) -> dict:
-        """Plain data for JSON: the ``identify`` object of ``interface.md``, with extra keys.
+        """Plain data for JSON: the ``identify`` object, with extra keys.
 
         Extra keys: ``values`` and ``value_uncertainty`` (SI units),
         ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
@@ -207,35 +212,34 @@ class IdentificationResult:
         }
         return out
 
+    @property
+    def shown_references(self) -> list[str]:
+        """Labels of the tests' reference columns shown beside the correction (those containing
+        :data:`SHOWN_REFERENCE`, e.g. the paper's own corrected frequencies)."""
+        return list(dict.fromkeys(label for t in self.tests for label in t.reference if SHOWN_REFERENCE in label))
+
     def to_dataframe(self) -> pd.DataFrame:
-        """Before/after table in the paper's Table 9/10 form (one row per test and mode)."""
-        from .tables import before_after_table
+        """Before/after table in the paper's Table 9/10 form: one row per test and mode.
 
-        return before_after_table(self)
-
-    def to_csv(self, path) -> None:
-        """Write :meth:`to_dataframe` as CSV."""
-        from .tables import write_csv
-
-        write_csv(self, path)
-
-    def parameters_dataframe(self) -> pd.DataFrame:
-        """One row per parameter: nominal, estimate and uncertainty, as variable and in SI units."""
-        from .tables import parameters_table
-
-        return parameters_table(self)
-
-    def to_markdown(self) -> str:
-        """Parameters and before/after tables as Markdown."""
-        from .tables import result_markdown
-
-        return result_markdown(self)
-
-    def text(self) -> str:
-        """Parameters and before/after tables as plain text (the CLI's standard output)."""
-        from .tables import result_text
-
-        return result_text(self)
+        Columns ``test``, ``mode``, ``measured_Hz``, ``before_Hz``,
+        ``before_error_abs_%``, ``corrected_Hz``, ``corrected_error_abs_%``
+        (errors |computed − measured| / measured × 100), and for each of
+        :attr:`shown_references` ``<label>_Hz`` and ``<label>_error_abs_%``.
+        """
+        frames = []
+        labels = self.shown_references
+        for t in self.tests:
+            data = {
+                "test": t.name, "mode": list(t.modes), "measured_Hz": t.measured,
+                "before_Hz": t.before, "before_error_abs_%": np.abs(t.before_error),
+                "corrected_Hz": t.after, "corrected_error_abs_%": np.abs(t.after_error),
+            }
+            for label in labels:
+                values = t.reference.get(label, np.full(len(t.modes), np.nan))
+                data[f"{label}_Hz"] = values
+                data[f"{label}_error_abs_%"] = np.abs((values - t.measured) / t.measured * 100.0)
+            frames.append(pd.DataFrame(data))
+        return pd.concat(frames, ignore_index=True)
 
 
 def _float(x) -> float | None:

@@ -1,10 +1,12 @@
-"""Before/after tables in the source paper's Table 9/10 form, as DataFrame, Markdown, CSV and text.
+"""Before/after tables in the source paper's Table 9/10 form, as Markdown, text and CSV.
 
 Per test and mode: the measured frequency, the nominal model's ("before")
 and its error |δ|, the corrected model's and its error |δ*| (errors in %,
 |computed − measured| / measured × 100). Reference columns whose label
 says ``corrected`` (the paper's own corrected frequencies) are shown beside
-ours with their errors, so the two corrections can be compared.
+ours with their errors, so the two corrections can be compared. The
+numbers come from the result (``IdentificationResult.to_dataframe()`` and
+its fields); this module only lays them out.
 """
 
 from __future__ import annotations
@@ -16,40 +18,6 @@ import numpy as np
 import pandas as pd
 
 from .problem import printed_step
-
-#: Reference columns shown beside the correction: labels containing this word.
-SHOWN_REFERENCE = "corrected"
-
-
-def before_after_table(result) -> pd.DataFrame:
-    """One row per test and mode: test, mode, measured, before, |δ| %, corrected, |δ*| % (and references).
-
-    Parameters
-    ----------
-    result : IdentificationResult
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``test``, ``mode``, ``measured_Hz``, ``before_Hz``,
-        ``before_error_abs_%``, ``corrected_Hz``, ``corrected_error_abs_%``,
-        and for each shown reference ``<label>_Hz`` and
-        ``<label>_error_abs_%``.
-    """
-    frames = []
-    labels = _references(result)
-    for t in result.tests:
-        data = {
-            "test": t.name, "mode": list(t.modes), "measured_Hz": t.measured,
-            "before_Hz": t.before, "before_error_abs_%": np.abs(t.before_error),
-            "corrected_Hz": t.after, "corrected_error_abs_%": np.abs(t.after_error),
-        }
-        for label in labels:
-            values = t.reference.get(label, np.full(len(t.modes), np.nan))
-            data[f"{label}_Hz"] = values
-            data[f"{label}_error_abs_%"] = np.abs((values - t.measured) / t.measured * 100.0)
-        frames.append(pd.DataFrame(data))
-    return pd.concat(frames, ignore_index=True)
 
 
 def parameters_table(result) -> pd.DataFrame:
@@ -68,16 +36,12 @@ _UNITS = {"tension": "N", "EI": "N m^2", "length": "m", "mass_per_length": "kg/m
 _HEAD = ("mode", "measured (Hz)", "before (Hz)", "|δ| (%)", "corrected (Hz)", "|δ*| (%)")
 
 
-def _references(result) -> list[str]:
-    return list(dict.fromkeys(label for t in result.tests for label in t.reference if SHOWN_REFERENCE in label))
-
-
 def _fmt(x, digits: int) -> str:
     return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
 
 
 def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
-    labels = [k for k in _references(result) if k in t.reference]
+    labels = [k for k in result.shown_references if k in t.reference]
     head = list(_HEAD) + [h for k in labels for h in (f"{k} (Hz)", f"|δ| {k} (%)")]
     rows = []
     digits = min(4, max(2, round(-math.log10(printed_step(t.measured)))))
@@ -148,8 +112,8 @@ def result_text(result) -> str:
 
 
 def write_csv(result, path: str | os.PathLike) -> None:
-    """The before/after table (:func:`before_after_table`) as CSV."""
-    before_after_table(result).to_csv(path, index=False, float_format="%.6g")
+    """The before/after table (``result.to_dataframe()``) as CSV."""
+    result.to_dataframe().to_csv(path, index=False, float_format="%.6g")
 
 
 def _md_table(head, rows) -> list[str]:
