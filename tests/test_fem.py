@@ -358,7 +358,7 @@ def test_sag_term_leaves_antisymmetric_modes_alone():
     # Exactly the same matrices on the antisymmetric subspace: rounding only.
     assert uniform[0] == pytest.approx(none[1], rel=1e-10)
     assert uniform[3] == pytest.approx(none[3], rel=1e-10)
-    # physics.md, "no sag-extensibility" row: 1.362, 3.016, 5.077 Hz,
+    # docs/model.md, tension model "none" row: 1.362, 3.016, 5.077 Hz,
     # printed to 3 decimals (half a unit of the last digit).
     np.testing.assert_allclose(none[:3], [1.362, 3.016, 5.077], atol=5e-4)
 

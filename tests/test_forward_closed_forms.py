@@ -1,4 +1,4 @@
-"""The exact solver against every closed form of physics.md.
+"""The exact solver against every closed form of docs/model.md.
 
 Tolerance 1e-9 relative throughout (the issue's acceptance); the solver
 refines to ~2e-13 and the references are computed to ~1e-15, so a failure

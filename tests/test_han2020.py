@@ -1,4 +1,4 @@
-"""Facts checked on the full-scale test data (physics.md, 'Facts already checked')."""
+"""Facts checked on the full-scale test data (docs/model.md, 'Known differences from the source paper')."""
 
 import math
 from dataclasses import replace
@@ -90,7 +90,7 @@ def test_table12_is_reproduced_without_sag_extensibility(campaign, e):
 
 def test_table12_with_uniform_additional_tension(campaign):
     """With sag-extensibility the first symmetric mode leaves 1.36 Hz and
-    rises past the first antisymmetric one (λ² ≈ 138 ≫ 4π²). physics.md's
+    rises past the first antisymmetric one (λ² ≈ 138 ≫ 4π²). The design notes'
     check table (3.016, 3.429, 5.332 Hz) is reproduced to 1e-3 when the
     attachments' weights are left out of the static profile and of Eq. (2);
     with their weights, as Eq. (2) states, the symmetric mode is at 3.67 Hz
@@ -106,7 +106,7 @@ def test_table12_with_uniform_additional_tension(campaign):
 
     weightless = _batch_without_attachment_weights(cable, atts, H)
     f = solve_modes(weightless, np.zeros(3, dtype=int), np.arange(1, 4)) / (2 * math.pi)
-    np.testing.assert_allclose(f, [3.016, 3.429, 5.332], rtol=1e-3)  # physics.md prints 4 digits
+    np.testing.assert_allclose(f, [3.016, 3.429, 5.332], rtol=1e-3)  # the check table prints 4 digits
     per_seg = _batch_without_attachment_weights(cable, atts, H, "per-segment")
     f = solve_modes(per_seg, np.zeros(3, dtype=int), np.arange(1, 4)) / (2 * math.pi)
     np.testing.assert_allclose(f, [3.431, 5.844, 8.942], rtol=1e-3)  # FE model of the doc: ~1e-3

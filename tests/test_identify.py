@@ -104,7 +104,7 @@ def test_mirror_image_reported_as_alternative():
 
 def test_mirror_tie_goes_to_end_As_half():
     """Recorded at midspan, truly at 10.5 m: 10.5 and l − 10.5 are equally near the
-    record; the one in [0, l/2] is reported (interface.md)."""
+    record; the one in [0, l/2] is reported (docs/formats.md, identify's alternatives)."""
     campaign, picked = synthetic("mid", positions=[10.5])
     result = identify(campaign, ["T1"], "position", picked=picked)
     assert result.values[0] == pytest.approx(CABLE.length - 10.5, rel=1e-6)

@@ -174,7 +174,7 @@ def natural_frequencies(cable: Cable, attachments: Sequence[Attachment], tension
                         tension_model: str = "uniform") -> np.ndarray:
     """The first ``n_modes`` natural frequencies (Hz) of one configuration.
 
-    Exact for the model of ``physics.md`` (segments between attachments solved
+    Exact for the model of ``docs/model.md`` (segments between attachments solved
     in closed form); found by the Wittrick–Williams count, so none is missed,
     and refined to 1e-12 relative.
     """

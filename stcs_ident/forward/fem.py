@@ -3,7 +3,7 @@
 Hermite cubic beam elements with geometric stiffness H, consistent mass,
 point masses and transverse springs at nodes, rotational end springs and
 the rank-one sag-extensibility term (EA/L_e) g gᵀ of Irvine's uniform
-additional tension (see ``docs/physics.md``). It is deliberately
+additional tension (see ``docs/model.md``). It is deliberately
 independent of the exact dynamic-stiffness solver (``dsm.py``), so that
 each can check the other, and it serves as the finite-element baseline of
 the benchmarks.

@@ -2,7 +2,7 @@
 
 At a natural frequency ω_k the global matrix K(ω_k) is singular; its null
 vector gives the nodal displacements, rotations and the additional tension
-ĥ, and Eq. (3) of ``physics.md`` gives φ(x) on every segment. Shapes are
+ĥ, and Eq. (3) of ``docs/model.md`` gives φ(x) on every segment. Shapes are
 mass-normalised, ∫ m φ² dx + Σ M_k φ(x_k)² = 1, the integral by composite
 Gauss–Legendre on sub-intervals that resolve both the wavelength and the
 boundary layers of width 1/p at the segment ends.

@@ -20,7 +20,7 @@ in the source paper, except
 :func:`parse_parameters` turns names such as ``"tension,EI"``,
 ``"position[W1]"`` or ``"end_stiffness[A]"`` into parameters for the
 selected tests; the diagnosis step reuses it with the effect vocabulary of
-``interface.md`` (``bending_stiffness``, ``attachment_position``, ...).
+``docs/effects.md`` (``bending_stiffness``, ``attachment_position``, ...).
 """
 
 from __future__ import annotations
