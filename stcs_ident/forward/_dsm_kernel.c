@@ -62,10 +62,11 @@ static int beam_segment(double L, double EI, double H, double m, double omega,
     double pl = p * half, ql = q * half;
     double T = tanh(pl), s = sin(ql), c = cos(ql);
     double ppqq = p2 + q2, pq = p * q;
-    double n_sym = q * s + p * T * c, n_anti = T * q * c - s * p;
+    /* n_anti = T q c - s p without the cancellation of its leading terms on a short segment */
+    double n_sym = q * s + p * T * c, n_anti = p * x_cos_minus_sin(ql) - q * c * x_minus_tanh(pl);
     double k1 = EI / n_sym, k2 = EI / n_anti;
-    double a = -k1 * pq * T * s * ppqq, b = k1 * pq * (p * s - q * T * c), d = k1 * c * ppqq;
-    double e = -k2 * pq * c * ppqq, f = k2 * pq * (p * T * c + q * s), h = -k2 * T * s * ppqq;
+    double a = -k1 * pq * T * s * ppqq, b = -k1 * pq * n_anti, d = k1 * c * ppqq;
+    double e = -k2 * pq * c * ppqq, f = k2 * pq * n_sym, h = -k2 * T * s * ppqq;
     Ke[0] = Ke[10] = 0.5 * (a + e);
     Ke[5] = Ke[15] = 0.5 * (d + h);
     Ke[2] = Ke[8] = 0.5 * (a - e);

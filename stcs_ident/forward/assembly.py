@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ComputationError
 from .elements import BeamSegment, StringSegment
 from .statics import end_slopes, stretched_lengths
 
@@ -254,7 +255,16 @@ def negative_pivots(K):
     eigenvalues). An exactly zero pivot (a matrix evaluated exactly at a
     root) is replaced by a relative 1e-14, which keeps the count and
     leaves the determinant at round-off size.
+
+    Raises
+    ------
+    ComputationError
+        If a matrix is not finite (LAPACK would fail on it, and elimination
+        would count nonsense).
     """
+    if not np.all(np.isfinite(K)):
+        raise ComputationError("the dynamic stiffness matrix is not finite (attachments nearly coincident, or an "
+                               "extreme parameter value)")
     if K.shape[0] <= SMALL_BATCH:
         lam = np.linalg.eigvalsh(K)
         return np.count_nonzero(lam < 0, axis=-1), np.prod(lam, axis=-1)

@@ -80,12 +80,14 @@ class BeamSegment:
         ppqq = p * p + q * q
         pq = p * q
         n_sym = q * s + p * T * c
-        n_anti = T * q * c - s * p
+        # T q c − s p, whose leading terms (p q L/2 each) cancel on a short segment: written as
+        # p (ql cos ql − sin ql) − q cos ql (pl − tanh pl), each part computed without cancellation.
+        n_anti = p * _x_cos_minus_sin(ql) - q * c * _x_minus_tanh(pl)
         self.n_sym, self.n_anti = n_sym, n_anti
         k = EI / n_sym
-        self.sym = (-k * pq * T * s * ppqq, k * pq * (p * s - q * T * c), k * c * ppqq)
+        self.sym = (-k * pq * T * s * ppqq, -k * pq * n_anti, k * c * ppqq)
         k = EI / n_anti
-        self.anti = (-k * pq * c * ppqq, k * pq * (p * T * c + q * s), -k * T * s * ppqq)
+        self.anti = (-k * pq * c * ppqq, k * pq * n_sym, -k * T * s * ppqq)
         num = p * p * T * _x_cos_minus_sin(ql) + q * q * s * _x_minus_tanh(pl)
         self.translation_residual = 2.0 * EI * pq * num / n_sym
 
