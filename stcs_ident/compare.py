@@ -20,6 +20,7 @@ from scipy.optimize import minimize_scalar
 from .forward import batch_frequencies
 from .forward import reference as closed_form
 from .model import Campaign, Test
+from .settings import Settings
 
 
 @dataclass(frozen=True)
@@ -103,15 +104,20 @@ class ReferenceCheck:
 @dataclass(frozen=True)
 class ForwardResult:
     """Result of :func:`compare_forward`: one :class:`TestComparison` per test
-    and one :class:`ReferenceCheck` per (reference column, setup)."""
+    and one :class:`ReferenceCheck` per (reference column, setup), with the
+    :class:`~stcs_ident.settings.Settings` they were computed with."""
 
     campaign: str
-    tension_model: str
+    settings: Settings
     tests: list[TestComparison]
     reference_checks: list[ReferenceCheck]
 
+    @property
+    def tension_model(self) -> str:
+        return self.settings.tension_model
+
     def summary(self) -> dict:
-        """Plain data for JSON, per ``interface.md`` (plus ``reference`` keys)."""
+        """Plain data for JSON (the ``forward`` object, with ``reference`` and ``settings`` keys)."""
         def floats(a):
             return None if a is None else [None if math.isnan(x) else float(x) for x in a]
 
@@ -134,6 +140,7 @@ class ForwardResult:
                  "EI_best": c.EI_best, "rms_best_Hz": c.rms_best, "statement": c.sentence()}
                 for c in self.reference_checks
             ],
+            "settings": self.settings.summary(),
         }
 
 
@@ -162,6 +169,7 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
         the table as ``measured`` (the table is then shown as a reference
         column, ``table``).
     """
+    settings = Settings(tension_model=tension_model)
     picked = picked or {}
     cable = campaign.cable
     selected = campaign.tests if not tests else [campaign.test(n) for n in tests]
@@ -199,7 +207,7 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
         ))
     checks = _reference_checks(campaign, [campaign.test(t.name) for t in out if t.name not in picked],
                                tension_model)
-    return ForwardResult(campaign.name, tension_model, out, checks)
+    return ForwardResult(campaign.name, settings, out, checks)
 
 
 def _printed_step(values) -> float:

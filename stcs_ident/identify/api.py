@@ -7,6 +7,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from ..errors import InputError
 from ..model import Campaign
 from ..notes import Note
+from ..settings import Settings
 from .parameters import parse_parameters
 from .problem import Problem, gather_measurements
 from .result import IdentificationResult
@@ -56,7 +57,7 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     Raises
     ------
     InputError
-        Naming the field: ``method``, ``test``,
+        Naming the field: ``method``, ``tension_model``, ``scale_rule``, ``test``,
         ``test[<name>].frequencies`` (a selected test with neither
         frequencies nor a record), ``params`` (unknown name, fewer measured
         frequencies than free parameters), ``bounds.<parameter>``.
@@ -70,15 +71,16 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
     measurements, skipped = gather_measurements(campaign, tests, picked)
     parameters = parse_parameters(campaign, [m.test for m in measurements], params, bounds)
-    problem = Problem(campaign, measurements, parameters, tension_model)
+    settings = Settings(tension_model=tension_model, scale_rule=scale_rule)
+    problem = Problem(campaign, measurements, parameters, settings.tension_model)
     if method == "lsq":
         from .lsq import fit_lsq
 
-        result = fit_lsq(problem, scale_rule=scale_rule, **options)
+        result = fit_lsq(problem, settings=settings, **options)
     else:
         from .contour import fit_contour
 
-        result = fit_contour(problem, scale_rule=scale_rule, **options)
+        result = fit_contour(problem, settings=settings, **options)
     if skipped:
         from dataclasses import replace
 

@@ -33,6 +33,7 @@ from scipy.optimize import minimize
 
 from ..errors import InputError
 from ..notes import Note, point
+from ..settings import Settings
 from .lsq import _local_fit, finish, mirror_images, nearest_nominal
 from .problem import Problem
 from .result import IdentificationResult
@@ -113,7 +114,7 @@ class ContourSweep:
 
 
 def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=None, scale_rule: str = "auto",
-                max_widen: int = 3) -> IdentificationResult:
+                max_widen: int = 3, settings: Settings | None = None) -> IdentificationResult:
     """The paper's contour-intersection estimate of two parameters.
 
     Parameters
@@ -130,6 +131,9 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
     max_widen : int
         How many times the grid may be widened when the region reaches its
         edge.
+    settings : Settings, optional
+        Recorded in the result (default: the problem's tension model and
+        ``scale_rule``); its ``scale_rule`` then replaces ``scale_rule``.
 
     Returns
     -------
@@ -143,6 +147,9 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
     n1, n2 = (int(g) for g in grid)
     if min(n1, n2) < 11:
         raise InputError(f"needs at least 11 points per side, got {grid}", field="grid")
+    if settings is None:
+        settings = Settings(tension_model=problem.tension_model, scale_rule=scale_rule)
+    scale_rule = settings.scale_rule
     lo, hi = _ranges(problem, ranges)
     notes = []
     axes = (np.linspace(lo[0], hi[0], n1), np.linspace(lo[1], hi[1], n2))
@@ -187,7 +194,7 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
                            "within {level:.3g}", value=float(tau), level=float(tau + 1)))
     chi2 = float(problem.chi2(centre[None, :])[0])
     return finish(problem, centre, chi2, "contour", notes=notes, uncertainty=extent, sweep=sweep, scale=scale,
-                  alternatives=alternatives)
+                  alternatives=alternatives, settings=settings)
 
 
 def _ranges(problem: Problem, ranges) -> tuple[np.ndarray, np.ndarray]:

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..notes import Note, point
+from ..settings import Settings
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability
@@ -34,7 +35,8 @@ SAME_CHI2 = 1e-6
 
 
 def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str = "auto",
-            max_nfev: int = 200, seed: int = 0, tol: float = 1e-14) -> IdentificationResult:
+            max_nfev: int = 200, seed: int = 0, tol: float = 1e-14,
+            settings: Settings | None = None) -> IdentificationResult:
     """Least-squares estimate of the problem's parameters with their covariance.
 
     Parameters
@@ -56,6 +58,9 @@ def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str
     tol : float
         ``xtol``, ``ftol`` and ``gtol`` of each local fit (the diagnosis,
         which fits many hypotheses, uses 1e-10).
+    settings : Settings, optional
+        Recorded in the result (default: the problem's tension model and
+        ``scale_rule``); its ``scale_rule`` then replaces ``scale_rule``.
 
     Returns
     -------
@@ -73,17 +78,24 @@ def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str
     best = min(solutions, key=lambda s: s[1])[0]
     solutions += [_local_fit(problem, m, max_nfev, tol) for m in mirror_images(problem, best)]
     x, chi2, alternatives, notes = _choose(problem, solutions)
-    return finish(problem, x, chi2, "lsq", scale_rule=scale_rule, alternatives=alternatives, notes=notes)
+    return finish(problem, x, chi2, "lsq", scale_rule=scale_rule, alternatives=alternatives, notes=notes,
+                  settings=settings)
 
 
 def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_rule: str = "auto",
-           alternatives=(), notes=(), uncertainty=None, sweep=None, scale=None) -> IdentificationResult:
+           alternatives=(), notes=(), uncertainty=None, sweep=None, scale=None,
+           settings: Settings | None = None) -> IdentificationResult:
     """Covariance, identifiability and the before/after fits at the estimate ``x``.
 
     ``uncertainty`` replaces the standard deviations and ``scale`` the
     covariance scale (the contour method passes its region's extent and the
-    scale it used); the covariance is still computed.
+    scale it used); the covariance is still computed. ``settings`` is
+    recorded in the result (default: the problem's tension model and
+    ``scale_rule``; given, its ``scale_rule`` is the one applied).
     """
+    if settings is None:
+        settings = Settings(tension_model=problem.tension_model, scale_rule=scale_rule)
+    scale_rule = settings.scale_rule
     n, p = problem.n_data, len(problem.parameters)
     dof = n - p
     notes = list(notes)
@@ -117,6 +129,7 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
         uncertainty=sigma if uncertainty is None else np.asarray(uncertainty, float),
         covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
         covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
+        settings=settings,
     )
 
 

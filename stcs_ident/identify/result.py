@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..notes import Note
+from ..settings import Settings
 from .parameters import Parameter
 
 #: Reference columns shown beside the correction: labels containing this word.
@@ -117,6 +118,8 @@ class IdentificationResult:
         interchangeable attachments).
     sweep : ContourSweep or None
         The contour method's grids, surfaces and region (for figures).
+    settings : Settings
+        How the identification was run (tension model, scale rule).
     """
 
     method: str
@@ -133,6 +136,7 @@ class IdentificationResult:
     skipped: tuple[tuple[str, str], ...] = ()
     alternatives: tuple[np.ndarray, ...] = ()
     sweep: object | None = field(default=None, repr=False)
+    settings: Settings = field(default_factory=Settings)
 
     @property
     def names(self) -> list[str]:
@@ -178,7 +182,7 @@ class IdentificationResult:
         Extra keys: ``values`` and ``value_uncertainty`` (SI units),
         ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
         ``reduced_chi2``, ``covariance_scale``, ``rms_error_before``,
-        ``rms_error_after`` (%), ``notes`` (as sentences), ``skipped``, ``alternatives``,
+        ``rms_error_after`` (%), ``notes`` (as sentences), ``skipped``, ``alternatives``, ``settings``,
         and per test ``uncertainty``, ``uncertainty_source`` and ``reference``
         (frequencies computed by others, e.g. the paper's corrected values).
         """
@@ -209,6 +213,7 @@ class IdentificationResult:
             "notes": [str(n) for n in self.notes],
             "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
             "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
+            "settings": self.settings.summary(),
         }
         return out
 
