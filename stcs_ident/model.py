@@ -17,25 +17,28 @@ from dataclasses import dataclass, field
 from .errors import ModelError
 
 
-def _finite(value, name: str) -> float:
+def finite_number(value, name: str) -> float:
+    """``value`` as a finite float (a bool is not a number); ModelError naming ``name`` otherwise."""
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise ModelError(f"must be a number, got {value!r}", field=name) from None
+    except OverflowError:  # an integer too large for a float
+        raise ModelError(f"must be a finite number, got an integer of {len(str(value))} digits", field=name) from None
     if isinstance(value, bool) or not math.isfinite(v):
         raise ModelError(f"must be a finite number, got {value!r}", field=name)
     return v
 
 
 def _positive(value, name: str) -> float:
-    v = _finite(value, name)
+    v = finite_number(value, name)
     if v <= 0:
         raise ModelError(f"must be > 0, got {value!r}", field=name)
     return v
 
 
 def _non_negative(value, name: str) -> float:
-    v = _finite(value, name)
+    v = finite_number(value, name)
     if v < 0:
         raise ModelError(f"must be >= 0, got {value!r}", field=name)
     return v
@@ -128,7 +131,7 @@ class Cable:
         set_(self, "EI", _non_negative(self.EI, "cable.EI"))
         if self.EA is not None:
             set_(self, "EA", _positive(self.EA, "cable.EA"))
-        theta = _finite(self.inclination, "cable.inclination")
+        theta = finite_number(self.inclination, "cable.inclination")
         if abs(theta) >= math.pi / 2:
             raise ModelError("must satisfy |inclination| < 90 degrees", field="cable.inclination")
         set_(self, "inclination", theta)
@@ -304,8 +307,8 @@ class Published:
         where = f"published[{self.parameter}]"
         if not isinstance(self.parameter, str) or not self.parameter:
             raise ModelError("must be a non-empty string", field="published.parameter")
-        low = _finite(self.low, f"{where}.low")
-        high = _finite(self.high, f"{where}.high")
+        low = finite_number(self.low, f"{where}.low")
+        high = finite_number(self.high, f"{where}.high")
         if high < low:
             raise ModelError(f"must be >= low ({low}), got {high}", field=f"{where}.high")
         object.__setattr__(self, "low", low)

@@ -20,7 +20,7 @@ from ..errors import ModelError
 from ..model import (
     Attachment,
     Cable,
-    _finite,  # the model's check of a finite number, naming the field
+    finite_number,  # the model's check of a finite number, naming the field
 )
 
 __all__ = ["TENSION_MODELS", "Dofs", "check_inputs", "element_density", "merge_attachments", "mesh_nodes",
@@ -36,7 +36,7 @@ def check_inputs(cable: Cable, tension: float, n_elements: int, tension_model: s
     """Check the arguments of ``fe_matrices``; the tension as a float. A bad one raises ModelError naming it."""
     if not isinstance(cable, Cable):
         raise ModelError("must be a Cable", field="cable")
-    tension = _finite(tension, "tension")
+    tension = finite_number(tension, "tension")
     if tension < 0:
         raise ModelError(f"must be >= 0, got {tension!r}", field="tension")
     if tension == 0 and cable.EI == 0:
@@ -47,7 +47,7 @@ def check_inputs(cable: Cable, tension: float, n_elements: int, tension_model: s
         raise ModelError("must be > 0 for the sag term (or use tension_model='none')", field="tension")
     if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) or n_elements < 2:
         raise ModelError(f"must be an integer >= 2, got {n_elements!r}", field="n_elements")
-    if _finite(grading, "grading") < 0:
+    if finite_number(grading, "grading") < 0:
         raise ModelError(f"must be >= 0, got {grading!r}", field="grading")
     return tension
 
