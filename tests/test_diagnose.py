@@ -11,8 +11,8 @@ import json
 import numpy as np
 import pytest
 
-from stcs_ident.cli import main
 from stcs_ident import effects
+from stcs_ident.cli import main
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.fitting import aicc
 from stcs_ident.diagnose.hypotheses import parse_effects

@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from ..plots import _figure
 from .. import effects as registry
+from ..plots import _figure
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {

@@ -7,7 +7,7 @@ frequency measurement, each good to a few per cent; it is one ratio
 
 from __future__ import annotations
 
-from .base import Effect, Option, Quantity, Tolerance, positive_ratio, pm
+from .base import Effect, Option, Quantity, Tolerance, pm, positive_ratio
 
 
 class Tension(Effect):
