@@ -23,6 +23,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from . import effects
 from .campaign_toml import campaign_to_toml
 from .errors import CampaignError, ModelError
 from .model import Attachment, Boundary, Cable, Campaign, Published, Setup, Test
@@ -32,7 +33,7 @@ __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 #: Name of the campaign file inside a campaign directory.
 CAMPAIGN_FILE = "campaign.toml"
 
-_TOP_KEYS = ("campaign", "cable", "setup", "test", "published")
+_TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance")
 _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
@@ -122,7 +123,20 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     setups = [_parse_setup(t, i, cable.length) for i, t in enumerate(found, 1)]
     tests = [_parse_test(t, i) for i, t in enumerate(_tables(data.get("test", []), "test"), 1)]
     published = [_parse_published(t, i) for i, t in enumerate(_tables(data.get("published", []), "published"), 1)]
-    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published))
+    tolerance = _parse_tolerance(_table(data.get("tolerance", {}), "tolerance"))
+    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance)
+
+
+def _parse_tolerance(table: dict[str, Any]) -> tuple[tuple[str, float], ...]:
+    """``[tolerance]``: how well the nominal values are known, by the keys the effects declare."""
+    _check_keys(table, effects.tolerance_keys(), "tolerance")
+    out = []
+    for key, value in table.items():
+        v = _number(value, f"tolerance.{key}")
+        if not math.isfinite(v) or v < 0:
+            raise CampaignError(f"must be a finite number >= 0, got {_show(value)}", field=f"tolerance.{key}")
+        out.append((key, float(v)))
+    return tuple(out)
 
 
 def _parse_published(table: dict[str, Any], index: int) -> Published:

@@ -47,6 +47,8 @@ def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
         lines += ["", *_test_lines(test)]
     for item in campaign.published:
         lines += ["", *_published_lines(item)]
+    if campaign.tolerance:
+        lines += ["", "[tolerance]", *(f"{key} = {_toml_float(value)}" for key, value in campaign.tolerance)]
     return "\n".join(lines) + "\n"
 
 

@@ -328,11 +328,23 @@ class Campaign:
     description: str = ""
     directory: str | None = None
     published: tuple[Published, ...] = ()
+    #: Tolerances the campaign gives (``[tolerance]``): (key, value) pairs, sorted by key; a key not
+    #: given takes its effect's default (:func:`stcs_ident.effects.tolerance`).
+    tolerance: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="campaign.name")
         object.__setattr__(self, "published", tuple(self.published))
+        given = dict(self.tolerance)
+        if len(given) != len(tuple(self.tolerance)):
+            raise ModelError("a key is given twice", field="tolerance")
+        for key, value in given.items():
+            v = finite_number(value, f"tolerance.{key}")
+            if v < 0:
+                raise ModelError(f"must be >= 0, got {value!r}", field=f"tolerance.{key}")
+            given[key] = v
+        object.__setattr__(self, "tolerance", tuple(sorted(given.items())))
         object.__setattr__(self, "setups", tuple(self.setups))
         object.__setattr__(self, "tests", tuple(self.tests))
         _unique((s.name for s in self.setups), "setup")

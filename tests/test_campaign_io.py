@@ -402,3 +402,46 @@ def test_input_file_is_not_written(tmp_path):
     before = (file.read_bytes(), file.stat().st_mtime_ns)
     load_campaign(file)
     assert (file.read_bytes(), file.stat().st_mtime_ns) == before
+
+
+# --------------------------------------------------------------------------
+# [tolerance]
+# --------------------------------------------------------------------------
+
+TOLERANCE_CAMPAIGN = """
+[campaign]
+name = "t"
+
+[cable]
+length = 10.0
+mass_per_length = 5.0
+EI = 100.0
+
+[tolerance]
+{body}
+"""
+
+
+def test_tolerances_default_to_the_effects_and_a_campaign_overrides_them(tmp_path):
+    from stcs_ident import effects
+
+    campaign = load_campaign(write_campaign(tmp_path, TOLERANCE_CAMPAIGN.format(body="tension = 0.005\nposition = 0.1")))
+    assert dict(campaign.tolerance) == {"position": 0.1, "tension": 0.005}
+    assert effects.tolerance(campaign, "tension") == 0.005
+    assert effects.tolerance(campaign, "attachment_position") == 0.1
+    assert effects.tolerance(campaign, "bending_stiffness") == effects.get("bending_stiffness").tolerance.default == 0.3
+    assert effects.tolerance(campaign, "unmodeled_mass") is None
+    assert reload(tmp_path, campaign).tolerance == campaign.tolerance
+
+
+@pytest.mark.parametrize("body,field", [
+    ("tension = -0.01", "tolerance.tension"),
+    ("EI = nan", "tolerance.EI"),
+    ("EI = \"a lot\"", "tolerance.EI"),
+    ("coefficient_of_wind = 0.1", "tolerance.coefficient_of_wind"),
+])
+def test_bad_tolerances_are_refused_naming_the_key(tmp_path, body, field):
+    file = write_campaign(tmp_path, TOLERANCE_CAMPAIGN.format(body=body))
+    with pytest.raises(CampaignError) as info:
+        load_campaign(file)
+    assert_one_line_naming(info.value, file, field)

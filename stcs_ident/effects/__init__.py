@@ -27,7 +27,19 @@ from . import (
     unmodeled_support,
 )
 from .base import Context, Effect, Option, Quantity, Tolerance, Truth, UnmodeledAttachment
-from .registry import baseline, by_truth_key, effects, get, in_order, names, parse, register, unregister
+from .registry import (
+    baseline,
+    by_truth_key,
+    effects,
+    get,
+    in_order,
+    names,
+    parse,
+    register,
+    tolerance,
+    tolerance_keys,
+    unregister,
+)
 
 for _module in (tension, bending_stiffness, attachment_position, attachment_mass, unmodeled_mass, unmodeled_support,
                 end_restraint, length):
@@ -35,5 +47,6 @@ for _module in (tension, bending_stiffness, attachment_position, attachment_mass
 
 __all__ = [
     "Context", "Effect", "Option", "Quantity", "Tolerance", "Truth", "UnmodeledAttachment", "baseline",
-    "by_truth_key", "effects", "get", "in_order", "names", "parse", "register", "unregister",
+    "by_truth_key", "effects", "get", "in_order", "names", "parse", "register", "tolerance", "tolerance_keys",
+    "unregister",
 ]

@@ -74,6 +74,20 @@ def baseline() -> tuple[str, ...]:
     return tuple(e.name for e in _REGISTRY.values() if e.baseline)
 
 
+def tolerance_keys() -> tuple[str, ...]:
+    """The keys of a campaign's ``[tolerance]`` table: those the registered effects declare."""
+    return tuple(dict.fromkeys(e.tolerance.key for e in _REGISTRY.values() if e.tolerance is not None))
+
+
+def tolerance(campaign, effect: str) -> float | None:
+    """The tolerance of the nominal value ``effect`` changes: the campaign's ``[tolerance]`` value for
+    its key, else the effect's default (None when the effect changes no nominal value)."""
+    declared = get(effect).tolerance
+    if declared is None:
+        return None
+    return dict(campaign.tolerance).get(declared.key, declared.default)
+
+
 def parse(spec: str | Sequence[str] | None) -> tuple[str, ...]:
     """``"tension,unmodeled_mass"`` → effect names in vocabulary order; None → all.
 
