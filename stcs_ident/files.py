@@ -1,8 +1,10 @@
 """Outputs written whole or not at all: a file renamed into place, a directory swapped in whole.
 
-Every writer of the package goes through here, so that a failure (or an
-interrupted run) never leaves half a file or half a report, and what is
-written gets the permissions a plain ``open()`` or ``mkdir`` would give.
+Every writer of the package goes through here (JSON and Markdown text,
+CSV tables, PNG figures), so that a failure (or an interrupted run) never
+leaves half a file or half a report, what is written is on disk before it
+is renamed into place, and it gets the permissions a plain ``open()`` or
+``mkdir`` would give.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import IO
 
 
 def umask() -> int:
@@ -23,22 +26,66 @@ def umask() -> int:
     return mask
 
 
+def _fsync(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
+    """A temporary file beside ``path`` for a writer that wants a file name; when the block ends it is
+    flushed to disk, given the mode a plain ``open()`` would give (from the umask) and renamed to
+    ``path``; when the block fails it is removed and ``path`` is untouched.
+
+    The one way the package puts a file in place: :func:`atomic_file`, :func:`write_atomic`,
+    :func:`write_csv` and :func:`write_figure` go through it.
+    """
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=directory)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        _fsync(tmp)
+        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
+        os.replace(tmp, target)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+@contextmanager
+def atomic_file(path: str | os.PathLike, mode: str = "w") -> Iterator[IO]:
+    """An open stream (``"w"``: UTF-8 text, ``"wb"``: bytes) whose file replaces ``path`` whole when the
+    block ends (:func:`atomic_path`)."""
+    if mode not in ("w", "wb"):
+        raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+    with atomic_path(path) as tmp, open(tmp, mode, encoding="utf-8" if mode == "w" else None) as stream:
+        yield stream
+
+
 def write_atomic(path: str | os.PathLike, text: str) -> None:
     """Write ``text`` to ``path`` whole or not at all; ``-`` is standard output."""
     if str(path) == "-":
         sys.stdout.write(text)
         return
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as stream:
+        stream.write(text)
+
+
+def write_csv(frame, path: str | os.PathLike, **options) -> None:
+    """A DataFrame as CSV (``options`` as for :meth:`pandas.DataFrame.to_csv`), whole or not at all."""
+    write_atomic(path, frame.to_csv(**options))
+
+
+def write_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
+    """A matplotlib figure as PNG, whole or not at all."""
+    with atomic_file(path, "wb") as stream:
+        fig.savefig(stream, dpi=dpi, format="png")
 
 
 def replace_directory(tmp: Path, out: Path) -> None:

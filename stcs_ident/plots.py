@@ -4,11 +4,9 @@ that tests can inspect it. matplotlib is imported only here."""
 
 from __future__ import annotations
 
-import os
-import tempfile
-from pathlib import Path
-
 import numpy as np
+
+from .files import write_figure
 
 
 def _figure(**kwargs):
@@ -62,13 +60,6 @@ def plot_test_spectra(spectra, fig=None) -> dict:
 
 
 def save_figure(fig, path) -> None:
-    """Save a PNG whole or not at all (temporary file, then rename)."""
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".png", dir=target.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=110, format="png")
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Save a PNG whole or not at all, with the permissions of any other output
+    (:func:`stcs_ident.files.write_figure`)."""
+    write_figure(fig, path)
