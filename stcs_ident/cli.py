@@ -145,7 +145,7 @@ def _check_output(path) -> None:
 
 
 def _write(path, text) -> None:
-    from .report import write_atomic
+    from .files import write_atomic
 
     try:
         write_atomic(path, text)
@@ -228,9 +228,9 @@ def _identify(args) -> int:
 
         save_identify_figures(result, args.plot)
     if args.json != "-":
-        from .identify.tables import result_text
+        from .identify.tables import format_result
 
-        sys.stdout.write(result_text(result))
+        sys.stdout.write(format_result(result, "text"))
         for item in summary["published"]:
             sys.stdout.write(f"\nPublished beside ours: {item['statement']}\n")
     return 0
@@ -256,7 +256,7 @@ def _diagnose(args) -> int:
     if args.out is not None:
         from .diagnose.report import write_report
 
-        write_report(result, args.out, spectra=spectra, tension_model=args.tension_model)
+        write_report(result, args.out, spectra=spectra)
     if args.json != "-":
         from .diagnose.report import diagnosis_text
 

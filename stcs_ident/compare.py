@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import minimize_scalar
 
+from .formatting import percent_error
 from .forward import batch_frequencies
 from .forward import reference as closed_form
 from .model import Campaign, Test
@@ -43,7 +44,7 @@ class TestComparison:
         """(computed − measured) / measured × 100 for one model column."""
         if self.measured is None:
             return None
-        return (getattr(self, column) - self.measured) / self.measured * 100.0
+        return percent_error(getattr(self, column), self.measured)
 
     def to_dataframe(self) -> pd.DataFrame:
         data = {"mode": list(self.modes)}

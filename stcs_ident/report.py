@@ -8,19 +8,15 @@ directory, then an atomic rename).
 from __future__ import annotations
 
 import json
-import math
 import os
-
-import numpy as np
 
 from .compare import ForwardResult
 from .files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
+from .formatting import number, rms
 
 
 def _fmt(value, digits=3, width=9) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-".rjust(width)
-    return f"{value:{width}.{digits}f}"
+    return number(value, f"{{:{width}.{digits}f}}", width=width)
 
 
 def forward_text(result: ForwardResult) -> str:
@@ -42,9 +38,9 @@ def forward_text(result: ForwardResult) -> str:
             row += "".join(f" {_fmt(float(t.reference[label][i]), 3, widths[label])}" for label in refs)
             lines.append(row)
         if t.measured is not None:
-            rms = {c: math.sqrt(float((errors[c][~np.isnan(errors[c])] ** 2).mean())) for c in errors}
-            lines.append(f"     rms error %: string {rms['taut_string']:.2f}, beam {rms['beam_pinned']:.2f}, "
-                         f"DSM {rms['dsm']:.2f}")
+            errs = {c: rms(errors[c]) for c in errors}
+            lines.append(f"     rms error %: string {errs['taut_string']:.2f}, beam {errs['beam_pinned']:.2f}, "
+                         f"DSM {errs['dsm']:.2f}")
         lines.append("")
     if result.reference_checks:
         lines.append("Reference columns:")
@@ -74,7 +70,7 @@ def spectra_text(campaign: str, results, skipped) -> str:
         lines.append(f"{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9}  channels")
         for k, f, u, z, ch, doubt in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels, r.doubtful):
             flag = "?" if doubt else " "
-            zeta = "-" if np.isnan(z) else f"{100 * z:.2f}"
+            zeta = number(100 * z, "{:.2f}")
             lines.append(f"{k:>3}{flag} {f:11.4f} {u:11.5f} {zeta:>9}  {' '.join(ch)}")
         if any(r.doubtful):
             lines.append("  ? = doubtful mode number: another family of modes fits almost as well")

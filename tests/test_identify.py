@@ -202,7 +202,7 @@ def test_summary_is_the_interface_json():
 
 
 def test_tables_in_the_papers_form(tmp_path):
-    from stcs_ident.identify.tables import parameters_table, result_markdown, result_text, write_csv
+    from stcs_ident.identify.tables import format_result, parameters_table, write_csv
 
     campaign, picked = synthetic("bare", 1.02, 0.9, tensions=(1.0e6, 1.2e6), n_modes=6)
     result = identify(campaign, None, "tension,EI", picked=picked)
@@ -211,10 +211,10 @@ def test_tables_in_the_papers_form(tmp_path):
                                     "corrected_Hz", "corrected_error_abs_%"]
     assert len(df) == 12 and (df["before_error_abs_%"] >= 0).all()
     np.testing.assert_allclose(df["corrected_error_abs_%"], 0, atol=1e-8)
-    md = result_markdown(result)
+    md = format_result(result, "markdown")
     assert "| mode | measured (Hz) | before (Hz) | \\|δ\\| (%) |" in md  # pipes escaped inside cells
     assert "#### T2" in md
-    text = result_text(result)
+    text = format_result(result, "text")
     assert "tension_ratio[T1]" in text and "|δ*| (%)" in text
     path = tmp_path / "table.csv"
     write_csv(result, path)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..formatting import percent_error
 from ..notes import Note
 from ..settings import Settings
 from .parameters import Parameter
@@ -62,17 +63,17 @@ class TestFit:
 
     def reference_error(self, label: str) -> np.ndarray:
         """(reference − measured) / measured × 100 for one reference column."""
-        return (self.reference[label] - self.measured) / self.measured * 100.0
+        return percent_error(self.reference[label], self.measured)
 
     @property
     def before_error(self) -> np.ndarray:
         """(before − measured) / measured × 100."""
-        return (self.before - self.measured) / self.measured * 100.0
+        return percent_error(self.before, self.measured)
 
     @property
     def after_error(self) -> np.ndarray:
         """(after − measured) / measured × 100."""
-        return (self.after - self.measured) / self.measured * 100.0
+        return percent_error(self.after, self.measured)
 
     @property
     def rms_before(self) -> float:
@@ -242,7 +243,7 @@ class IdentificationResult:
             for label in labels:
                 values = t.reference.get(label, np.full(len(t.modes), np.nan))
                 data[f"{label}_Hz"] = values
-                data[f"{label}_error_abs_%"] = np.abs((values - t.measured) / t.measured * 100.0)
+                data[f"{label}_error_abs_%"] = np.abs(percent_error(values, t.measured))
             frames.append(pd.DataFrame(data))
         return pd.concat(frames, ignore_index=True)
 

@@ -14,9 +14,10 @@ from __future__ import annotations
 import math
 import os
 
-import numpy as np
 import pandas as pd
 
+from .. import files
+from ..formatting import PARAMETER_UNITS, STYLES, number, rms, table_lines
 from .problem import printed_step
 
 
@@ -26,18 +27,11 @@ def parameters_table(result) -> pd.DataFrame:
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
                               result.value_uncertainty):
         rows.append({"parameter": p.name, "estimate": float(x), "uncertainty": float(s), "nominal_SI": p.nominal,
-                     "value_SI": float(v), "uncertainty_SI": float(vs), "unit": _UNITS[p.kind]})
+                     "value_SI": float(v), "uncertainty_SI": float(vs), "unit": PARAMETER_UNITS[p.kind]})
     return pd.DataFrame(rows)
 
 
-_UNITS = {"tension": "N", "EI": "N m^2", "length": "m", "mass_per_length": "kg/m", "position": "m", "mass": "kg",
-          "stiffness": "N/m", "end_stiffness": "N m/rad"}
-
 _HEAD = ("mode", "measured (Hz)", "before (Hz)", "|δ| (%)", "corrected (Hz)", "|δ*| (%)")
-
-
-def _fmt(x, digits: int) -> str:
-    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
 
 
 def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
@@ -45,18 +39,17 @@ def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
     head = list(_HEAD) + [h for k in labels for h in (f"{k} (Hz)", f"|δ| {k} (%)")]
     rows = []
     digits = min(4, max(2, round(-math.log10(printed_step(t.measured)))))
+    measured = f"{{:.{digits}f}}"
     for i, k in enumerate(t.modes):
-        row = [str(k), _fmt(float(t.measured[i]), digits),
-               _fmt(float(t.before[i]), 3), _fmt(abs(float(t.before_error[i])), 2),
-               _fmt(float(t.after[i]), 3), _fmt(abs(float(t.after_error[i])), 2)]
+        row = [str(k), number(t.measured[i], measured), number(t.before[i]), number(abs(t.before_error[i]), "{:.2f}"),
+               number(t.after[i]), number(abs(t.after_error[i]), "{:.2f}")]
         for label in labels:
-            row += [_fmt(float(t.reference[label][i]), 2), _fmt(abs(float(t.reference_error(label)[i])), 2)]
+            row += [number(t.reference[label][i], "{:.2f}"), number(abs(t.reference_error(label)[i]), "{:.2f}")]
         rows.append(row)
-    rms = ["rms", "", "", _fmt(t.rms_before, 2), "", _fmt(t.rms_after, 2)]
+    last = ["rms", "", "", number(t.rms_before, "{:.2f}"), "", number(t.rms_after, "{:.2f}")]
     for label in labels:
-        e = t.reference_error(label)
-        rms += ["", _fmt(float(np.sqrt(np.nanmean(e**2))), 2)]
-    rows.append(rms)
+        last += ["", number(rms(t.reference_error(label)), "{:.2f}")]
+    rows.append(last)
     return head, rows, labels
 
 
@@ -64,71 +57,49 @@ def _parameter_lines(result) -> list[list[str]]:
     out = []
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
                               result.value_uncertainty):
-        unit = _UNITS[p.kind]
-        out.append([p.name, f"{x:.5g}", f"{s:.2g}", f"{_si(p.nominal)} {unit}", f"{_si(v)} ± {_si(vs)} {unit}"])
+        unit = PARAMETER_UNITS[p.kind]
+        out.append([p.name, f"{x:.5g}", f"{s:.2g}", f"{number(p.nominal, '{:.5g}')} {unit}",
+                    f"{number(v, '{:.5g}')} ± {number(vs, '{:.5g}')} {unit}"])
     return out
-
-
-def _si(x: float) -> str:
-    return "inf" if math.isinf(x) else f"{x:.5g}"
 
 
 def _uncertainty_word(result) -> str:
     return "± 1 sd" if result.method == "lsq" else "± half region"
 
 
-def result_markdown(result) -> str:
-    """Parameters, then one before/after table per test, then the notes, as Markdown."""
-    lines = [f"### Identified parameters ({result.method})", ""]
+def format_result(result, style: str = "text") -> str:
+    """Parameters, one before/after table per test and the notes, as aligned text or Markdown.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    style : {"text", "markdown"}
+        ``text``: the CLI's standard output; ``markdown``: headings and pipe
+        tables for a report.
+    """
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {STYLES}, got {style!r}")
+    md = style == "markdown"
+    lines = [f"### Identified parameters ({result.method})" if md
+             else f"Identification ({result.method}): {', '.join(result.names)}", ""]
     head = ["parameter", "estimate", _uncertainty_word(result), "nominal", "value"]
-    lines += _md_table(head, _parameter_lines(result))
-    lines += ["", (f"chi2 = {result.chi2:.4g}, {result.dof} degrees of freedom; rms error "
-                  f"{result.rms_before:.2f} % before, {result.rms_after:.2f} % after."), ""]
+    lines += table_lines(head, _parameter_lines(result), style)
+    chi2 = f"chi2 = {result.chi2:.4g}" if md else f"chi2 {result.chi2:.4g}"
+    lines += ["", (f"{chi2}, {result.dof} degrees of freedom; rms error {result.rms_before:.2f} % before, "
+                   f"{result.rms_after:.2f} % after{'.' if md else ''}"), ""]
     for t in result.tests:
         head, rows, _ = _rows(result, t)
-        lines += [f"#### {t.name} (setup {t.setup}; frequency uncertainty: {t.source})", ""]
-        lines += _md_table(head, rows)
+        title = f"{t.name} (setup {t.setup}; frequency uncertainty: {t.source})"
+        lines += [f"#### {title}", ""] if md else [f"Test {title}"]
+        lines += table_lines(head, rows, style)
         lines.append("")
-    if result.notes:
+    if md and result.notes:
         lines += ["Notes:", ""] + [f"- {n}" for n in result.notes] + [""]
-    return "\n".join(lines)
-
-
-def result_text(result) -> str:
-    """Parameters, before/after tables and notes as aligned plain text."""
-    lines = [f"Identification ({result.method}): {', '.join(result.names)}", ""]
-    head = ["parameter", "estimate", _uncertainty_word(result), "nominal", "value"]
-    lines += _text_table(head, _parameter_lines(result))
-    lines += ["", (f"chi2 {result.chi2:.4g}, {result.dof} degrees of freedom; rms error "
-                  f"{result.rms_before:.2f} % before, {result.rms_after:.2f} % after"), ""]
-    for t in result.tests:
-        head, rows, _ = _rows(result, t)
-        lines.append(f"Test {t.name} (setup {t.setup}; frequency uncertainty: {t.source})")
-        lines += _text_table(head, rows)
-        lines.append("")
-    for n in result.notes:
-        lines.append(f"note: {n}")
-    return "\n".join(lines) + "\n"
+    elif not md:
+        lines += [f"note: {n}" for n in result.notes]
+    return "\n".join(lines) + ("" if md else "\n")
 
 
 def write_csv(result, path: str | os.PathLike) -> None:
-    """The before/after table (``result.to_dataframe()``) as CSV."""
-    result.to_dataframe().to_csv(path, index=False, float_format="%.6g")
-
-
-def _md_table(head, rows) -> list[str]:
-    head = [_md_cell(c) for c in head]
-    rows = [[_md_cell(c) for c in r] for r in rows]
-    out = ["| " + " | ".join(head) + " |", "|" + "|".join("---" if i == 0 else "--:" for i in range(len(head))) + "|"]
-    out += ["| " + " | ".join(r) + " |" for r in rows]
-    return out
-
-
-def _md_cell(text) -> str:
-    return str(text).replace("|", "\\|")
-
-
-def _text_table(head, rows) -> list[str]:
-    widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
-    return ["  ".join(str(c).ljust(w) if i == 0 else str(c).rjust(w) for i, (c, w) in enumerate(zip(r, widths)))
-            for r in [head, *rows]]
+    """The before/after table (``result.to_dataframe()``) as CSV, whole or not at all."""
+    files.write_csv(result.to_dataframe(), path, index=False, float_format="%.6g")
