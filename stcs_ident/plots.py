@@ -9,7 +9,9 @@ import numpy as np
 from .files import write_figure
 
 
-def _figure(**kwargs):
+def new_figure(**kwargs):
+    """A :class:`matplotlib.figure.Figure` (``kwargs`` as its constructor's), never pyplot's: the one
+    place the figure modules get a figure from, so matplotlib is imported only when one is drawn."""
     from matplotlib.figure import Figure
 
     return Figure(**kwargs)
@@ -28,7 +30,7 @@ def plot_test_spectra(spectra, fig=None) -> dict:
     dict with the figure, both axes, the spectrum lines and the peak labels
     (``labels``: list of matplotlib Text, one per picked peak).
     """
-    fig = fig or _figure(figsize=(10, 6.5), layout="constrained")
+    fig = fig or new_figure(figsize=(10, 6.5), layout="constrained")
     ax_c, ax_ch = fig.subplots(2, 1, sharex=True)
     result = spectra.peaks
     f = result.frequency_axis

@@ -20,7 +20,7 @@ import os
 
 import numpy as np
 
-from .plots import _figure, save_figure
+from .plots import new_figure, save_figure
 
 _SYMBOL = {"tension": "H", "EI": "EI", "length": "l", "mass_per_length": "m", "position": "x", "mass": "M",
            "stiffness": "s"}
@@ -79,7 +79,7 @@ def plot_surfaces(result, modes=(1, 6), test: str | None = None, fig=None) -> di
     """
     sweep = _sweep_of(result)
     idx = _mode_indices(sweep, modes, test)
-    fig = fig or _figure(figsize=(11, 4.8), layout="constrained")
+    fig = fig or new_figure(figsize=(11, 4.8), layout="constrained")
     X, Y = np.meshgrid(sweep.axes[0], sweep.axes[1], indexing="ij")
     step = max(1, X.shape[0] // 50)
     axes, surfaces, contours, floors = [], [], [], []
@@ -135,7 +135,7 @@ def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
         None).
     """
     sweep = _sweep_of(result)
-    fig = fig or _figure(figsize=(12, 5.4) if zoom else (6.5, 5.4), layout="constrained")
+    fig = fig or new_figure(figsize=(12, 5.4) if zoom else (6.5, 5.4), layout="constrained")
     axes = fig.subplots(1, 2 if zoom else 1)
     axes = list(np.atleast_1d(axes))
     panels = [sweep, sweep.zoom if sweep.zoom is not None else sweep][: len(axes)]
@@ -188,7 +188,7 @@ def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
 
 def plot_errors(result, fig=None) -> dict:
     """Errors |δ| before and |δ*| after the correction, per test and mode (bars, %)."""
-    fig = fig or _figure(figsize=(max(6.0, 1.2 * sum(len(t.modes) for t in result.tests) / 2), 4),
+    fig = fig or new_figure(figsize=(max(6.0, 1.2 * sum(len(t.modes) for t in result.tests) / 2), 4),
                          layout="constrained")
     ax = fig.subplots()
     labels, before, after = [], [], []

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .. import effects as registry
-from ..plots import _figure
+from ..plots import new_figure
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {
@@ -53,7 +53,7 @@ def plot_residuals(diagnosis, fig=None) -> dict:
     n = len(d.measurements)
     ncols = 1 if n == 1 else 2
     nrows = math.ceil(n / ncols)
-    fig = fig or _figure(figsize=(5.2 * ncols, 2.7 * nrows + 0.9), layout="constrained")
+    fig = fig or new_figure(figsize=(5.2 * ncols, 2.7 * nrows + 0.9), layout="constrained")
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     models = _models(d)
     if models["corrected"] is models["nominal"]:
@@ -139,7 +139,7 @@ def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
         raise ValueError(f"no profile scan of {effect!r} in the named cause {d.selection.effects}")
     scan = scans[effect]
     if ax is None:
-        fig = _figure(figsize=(9.5, 3.8), layout="constrained")
+        fig = new_figure(figsize=(9.5, 3.8), layout="constrained")
         ax = fig.subplots()
     fig = ax.figure
     x, chi2 = np.array(sorted(scan.profile)).T
@@ -174,7 +174,7 @@ def plot_profiles(diagnosis, fig=None) -> dict:
     effects = list(profile_scans(diagnosis))
     if not effects:
         raise ValueError("the named cause has no unmodeled attachment with a profile scan")
-    fig = fig or _figure(figsize=(9.5, 3.6 * len(effects)), layout="constrained")
+    fig = fig or new_figure(figsize=(9.5, 3.6 * len(effects)), layout="constrained")
     axes = np.atleast_1d(fig.subplots(len(effects), 1))
     panels = {e: plot_profile(diagnosis, e, ax) for e, ax in zip(effects, axes)}
     return {"figure": fig, "panels": panels}

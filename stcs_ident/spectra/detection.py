@@ -44,7 +44,7 @@ from scipy import ndimage, signal, special
 from .floor import floor_log_variance
 from .overview import Overview
 
-__all__ = ["Candidate", "detect_multiresolution", "detect_peaks", "detection_threshold"]
+__all__ = ["Candidate", "detect_multiresolution", "detect_peaks", "detection_threshold", "peak_candidate"]
 
 FALSE_ALARM = 1e-4  # nominal, per record (measured rates in the module docstring)
 RIPPLE_FALSE_ALARM = 0.5  # per record: ripple bumps that pass the prominence test (the fit rejects them)
@@ -183,7 +183,7 @@ def detect_peaks(
     candidates = []
     for ratio, t, dof in statistics:
         index = _exceedances(overview, ratio, t, dof, lo, hi, n_cells / share)
-        candidates += [_candidate(overview, ratio, int(k), t[k], dof[k]) for k in index]
+        candidates += [peak_candidate(overview, ratio, int(k), t[k], dof[k]) for k in index]
     return _suppress_shoulders(overview, candidates), statistics[0][1]
 
 
@@ -278,8 +278,10 @@ def _separated(overview: Overview, weak: Candidate, strong: Candidate) -> bool:
     return bool(valley <= max(1.0, smooth[weak.index - a] / depth))
 
 
-def _candidate(overview: Overview, ratio: np.ndarray, k: int, threshold: float, dof: float) -> Candidate:
-    """Interpolated frequency (parabola through the log) and -3 dB width (above the floor, 1) of a peak of `ratio`."""
+def peak_candidate(overview: Overview, ratio: np.ndarray, k: int, threshold: float, dof: float) -> Candidate:
+    """The :class:`Candidate` at index ``k`` of ``ratio`` (spectrum over floor): interpolated frequency
+    (parabola through the log) and -3 dB width (above the floor, 1); shared with the residual pass
+    (:mod:`.residual`), which finds peaks the same way."""
     f = overview.frequency
     df = f[1] - f[0]
     y = np.log(np.maximum(ratio[k - 1 : k + 2], np.finfo(float).tiny))

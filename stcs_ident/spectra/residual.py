@@ -50,7 +50,7 @@ import numpy as np
 from scipy import signal
 from scipy.fft import irfft, rfft
 
-from .detection import FALSE_ALARM, Candidate, _candidate, detection_threshold
+from .detection import FALSE_ALARM, Candidate, detection_threshold, peak_candidate
 from .floor import noise_floor
 from .overview import Overview
 
@@ -154,7 +154,7 @@ def residual_candidates(
         index, _ = signal.find_peaks(statistic, distance=max(1, overview.cell))
         index = index[(index >= lo) & (index <= hi)]
         for k in index[statistic[index] >= threshold[index]]:
-            c = _candidate(overview, statistic, int(k), threshold[k], dof[k])
+            c = peak_candidate(overview, statistic, int(k), threshold[k], dof[k])
             if _clear(c, modes, tried + found):
                 found.append(replace(c, spectrum=overview.combined / overview.combined_floor, proposal=True))
     return sorted(found, key=lambda c: c.frequency)
