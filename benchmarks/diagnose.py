@@ -32,7 +32,7 @@ from common import CHECKOUT, print_header
 
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.diagnose import diagnose
-from stcs_ident.diagnose.api import _default_workers
+from stcs_ident.diagnose.api import default_workers
 from stcs_ident.identify import identify
 
 CAMPAIGN = CHECKOUT / "campaigns" / "han2020"
@@ -56,7 +56,7 @@ def main(argv=None) -> int:
     print_header()
     campaign = load_campaign(CAMPAIGN)
     print(f"han2020 diagnosis; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs; "
-          f"{_default_workers()} worker(s) by default")
+          f"{default_workers()} worker(s) by default")
     runs = {}
     if not args.serial_only:
         runs["shipped (parallel)"] = _run(campaign, None)

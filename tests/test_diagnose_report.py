@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose import figures as diagnosis_figures
 from stcs_ident.diagnose.report import CSV_FILES, write_report
 from stcs_ident.errors import InputError
+from stcs_ident.files import umask
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.model import Cable, Campaign, Setup, Test
 
@@ -39,9 +41,9 @@ def simulated(tmp_path_factory):
     """A campaign with records whose true cable carries a 15 kg mass at 6 m: (diagnosis, spectra)."""
     pytest.importorskip("h5py")
     from stcs_ident.simulate.effects import Effects
-    from stcs_ident.spectra.pipeline import analyse_campaign
     from stcs_ident.simulate.simulate import Impulse
     from stcs_ident.simulate.simulate_campaign import simulate_campaign
+    from stcs_ident.spectra.pipeline import analyse_campaign
 
     nominal = Campaign("sim", CABLE, (Setup("bare"),),
                        (Test("T1", "bare", TENSION), Test("T2/b", "bare", 1.1 * TENSION)))
@@ -70,9 +72,12 @@ def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary left behind
     files = {p.name for p in out.iterdir()}
     assert files == {"report.md", "residuals.png", "profile.png", *CSV_FILES}
+    mode = 0o666 & ~umask()  # every file, figures included, as a plain open() would make it
+    assert {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()} == dict.fromkeys(files, mode)
 
     text = (out / "report.md").read_text(encoding="utf-8")
     assert d.cause_text() in text and d.selection.statement in text
+    assert d.settings.max_effects == 1 and d.summary()["settings"]["tension_model"] == "uniform"
     g = d.summary()["gain"]
     for key in ("rms_error_nominal", "rms_error_baseline", "rms_error_corrected", "cv_rms_error_corrected"):
         assert f"{g[key]:.3f} %" in text

@@ -14,11 +14,13 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from ..compare import ForwardResult, compare_forward
 from ..errors import InputError
 from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
 from ..notes import Note
-from .fitting import HypothesisFit, cross_validate, fit_hypothesis, fit_nominal, mirror_symmetric
+from ..settings import Settings
+from .fitting import HypothesisFit, cross_validate, failed_fit, fit_hypothesis, fit_nominal, mirror_symmetric
 from .hypotheses import applicable, build, hypothesis_sets, parse_effects
 from .result import Diagnosis
 from .selection import BASELINE, explains, select
@@ -64,11 +66,14 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     Returns
     -------
     Diagnosis
+        With the nominal comparison (taut string, pinned beam, DSM against
+        the measured frequencies) computed once here, for the report.
 
     Raises
     ------
     InputError
-        ``field="effects"`` for an unknown effect or one that has nothing
+        ``field="max_effects"`` or ``"tension_model"`` for a setting out of
+        its range; ``field="effects"`` for an unknown effect or one that has nothing
         to act on in the measured tests (an attachment effect when no
         measured test's setup has an attachment); ``field="frequencies"``
         when there are fewer measured frequencies than the smallest
@@ -77,9 +82,9 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     started = time.perf_counter()
     requested = effects is not None
     names = parse_effects(effects)
-    if max_effects not in (1, 2):
-        raise InputError(f"must be 1 or 2, got {max_effects!r}", field="max_effects")
-    picked, excluded = _without_doubtful(campaign, picked or {})
+    settings = Settings(tension_model=tension_model, max_effects=max_effects, all_hypotheses=all_hypotheses)
+    given = dict(picked or {})
+    picked, excluded = _without_doubtful(campaign, given)
     measurements, skipped = gather_measurements(campaign, tests, picked)
     measured_tests = [m.test for m in measurements]
     notes: list[Note] = list(excluded)
@@ -101,14 +106,14 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     if not usable or n < smallest + 2:
         raise InputError(f"{n} measured frequencies, but the smallest hypothesis ({smallest} parameter(s)) needs "
                          f"at least {smallest + 2} (AICc needs n > k + 1)", field="frequencies")
-    sets = [s for s in hypothesis_sets(usable, max_effects) if sum(sizes[e] for e in s) + 2 <= n]
-    dropped = len(hypothesis_sets(usable, max_effects)) - len(sets)
+    sets = [s for s in hypothesis_sets(usable, settings.max_effects) if sum(sizes[e] for e in s) + 2 <= n]
+    dropped = len(hypothesis_sets(usable, settings.max_effects)) - len(sets)
     if dropped:
         notes.append(Note.make("too_many_parameters", "{value} hypotheses not fitted: more parameters than the "
                                "{n} frequencies allow", value=dropped, n=n))
     if baseline and baseline not in sets and sum(sizes[e] for e in baseline) + 2 <= n:
         sets.append(baseline)
-    symmetric = mirror_symmetric(campaign, measurements, tension_model)
+    symmetric = mirror_symmetric(campaign, measurements, settings.tension_model)
     fits: dict[tuple[str, ...], HypothesisFit] = {}
     timings: dict[tuple[str, ...], float] = {}
     done = 0
@@ -116,7 +121,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     stages = [[s for s in sets if len(s) <= 1], [s for s in sets if len(s) > 1]]
     total = len(sets)
     for i, stage in enumerate(stages):
-        if i == 1 and not all_hypotheses and explains(fits[()], n):
+        if i == 1 and not settings.all_hypotheses and explains(fits[()], n):
             # No pair can change an empty cause: fit only the baseline, which the gain needs.
             kept = [s for s in stage if s == baseline]
             notes.append(Note.make("pairs_not_fitted", "the nominal model explains the data: {value} pairs of "
@@ -124,17 +129,39 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
                                    value=len(stage) - len(kept)))
             total -= len(stage) - len(kept)
             stage = kept
-        jobs = [(campaign, measurements, s, tension_model, symmetric, _pair_seeds(fits, s) if len(s) > 1 else [])
+        jobs = [(campaign, measurements, s, settings.tension_model, symmetric,
+                 _pair_seeds(fits, s) if len(s) > 1 else [])
                 for s in stage]
         for s, fit, seconds in _map(_fit_job, jobs, workers):
             fits[s], timings[s] = fit, seconds
             done += 1
             if progress is not None:
                 progress(done, total, " + ".join(s) if s else "nominal")
-    selection = select(fits, n, max_effects)
+    selection = select(fits, n, settings.max_effects)
+    comparison = nominal_comparison(campaign, measurements, given, settings)
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
-                     elapsed=time.perf_counter() - started, considered=tuple(usable))
+                     elapsed=time.perf_counter() - started, considered=tuple(usable), settings=settings,
+                     comparison=comparison)
+
+
+def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], picked: Mapping[str, object],
+                       settings: Settings) -> ForwardResult:
+    """The ``forward`` comparison (taut string, pinned beam, DSM) of the measured tests with the nominal model.
+
+    The measured frequencies are the picked ones where a test has them
+    (doubtful modes included: the comparison shows what was picked), else
+    those the diagnosis used when they are not the campaign's table, else
+    the table (its reference columns then checked as well).
+    """
+    names = [m.name for m in measurements]
+    given = {name: (p.modes, p.frequencies) for name, p in picked.items() if name in names}
+    for m in measurements:
+        test = campaign.test(m.name)
+        table = dict(zip(test.modes or (), test.frequencies or ()))
+        if m.name not in given and any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies)):
+            given[m.name] = (m.modes, m.frequencies)
+    return compare_forward(campaign, names, None, settings.tension_model, picked=given)
 
 
 def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
@@ -178,14 +205,25 @@ def _fit_job(job) -> tuple[tuple[str, ...], HypothesisFit, float]:
     t0 = time.perf_counter()
     if not effects:
         fit = fit_nominal(campaign, measurements, tension_model)
-    else:
+        return effects, fit, time.perf_counter() - t0
+    try:
         fit = fit_hypothesis(campaign, measurements, effects, tension_model=tension_model, seeds=seeds,
                              symmetric=symmetric, scan=len(effects) == 1)
+    except Exception as err:  # noqa: BLE001 (one hypothesis failing must not abort the diagnosis: it is reported)
+        reason = " ".join(str(err).split()) or type(err).__name__
+        fit = failed_fit(campaign, measurements, effects, f"{type(err).__name__}: {reason}", tension_model)
+        return effects, fit, time.perf_counter() - t0
+    try:
         fit.cv_rms_error = cross_validate(fit, measurements, tension_model)
+    except Exception as err:  # noqa: BLE001 (as above: reported, the diagnosis goes on)
+        fit.notes.append(Note.plain("cv_failed", f"cross-validation failed ({type(err).__name__}: "
+                                                 f"{' '.join(str(err).split())})"))
+        fit.cv_rms_error = None
     return effects, fit, time.perf_counter() - t0
 
 
-def _default_workers() -> int:
+def default_workers() -> int:
+    """Worker processes used by default: the CPUs this process may use, at most :data:`MAX_WORKERS`."""
     try:
         n = len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
@@ -195,7 +233,7 @@ def _default_workers() -> int:
 
 def _map(fn, jobs: list, workers: int | None):
     """``fn`` over ``jobs``, results as they finish; in worker processes when more than one is useful."""
-    workers = _default_workers() if workers is None else max(1, int(workers))
+    workers = default_workers() if workers is None else max(1, int(workers))
     if workers == 1 or len(jobs) < 2:
         yield from map(fn, jobs)
         return

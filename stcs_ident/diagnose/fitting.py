@@ -31,8 +31,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..formatting import PARAMETER_UNITS
 from ..forward import batch_frequencies
-from ..identify.lsq import _local_fit, fit_lsq
+from ..identify.lsq import fit_lsq, local_fit
 from ..identify.parameters import fixity
 from ..identify.problem import Measurement, Problem
 from ..identify.result import IdentificationResult
@@ -73,6 +74,8 @@ class HypothesisFit:
         warnings it raised (``kind="warning"``).
     profile : list of (position m, χ²), optional
         The profile scan of an unmodeled attachment's position.
+    failure : str or None
+        Why the fit failed (it then ranks last: χ² and AICc infinite).
     minima : list of dict
         The best distinct points of the profile scan (SI values by (kind,
         member)): the starts of pairs that contain this effect.
@@ -88,6 +91,7 @@ class HypothesisFit:
     notes: list[Note] = field(default_factory=list)
     profile: list[tuple[float, float]] = field(default_factory=list)
     minima: list[dict] = field(default_factory=list)
+    failure: str | None = None
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -102,6 +106,15 @@ class HypothesisFit:
         if self.result is None:
             return {}
         return {(p.kind, p.member): float(v) for p, v in zip(self.result.parameters, self.result.values)}
+
+
+def failed_fit(campaign: Campaign, measurements: Sequence[Measurement], effects: Sequence[str], reason: str,
+               tension_model: str) -> HypothesisFit:
+    """A hypothesis whose fit failed: no estimate, infinite χ² and AICc, ``failure`` the reason."""
+    tests = [m.test for m in measurements]
+    hyp = build(campaign, tests, effects)
+    n = sum(m.modes.size for m in measurements)
+    return HypothesisFit(hyp, None, np.full(n, np.nan), math.inf, math.inf, math.nan, failure=reason)
 
 
 def aicc(chi2: float, n: int, k: int) -> float:
@@ -148,9 +161,8 @@ def _quiet(fn, notes: list[Note]):
     return out
 
 
-#: Units of the SI values of the parameter kinds a note may name.
-_UNITS = {"EI": "N m^2", "length": "m", "position": "m", "mass": "kg", "stiffness": "N/m",
-          "mass_per_length": "kg/m"}
+#: Units of the SI values of the parameter kinds a note may name (tension and end fixity stay ratios).
+_UNITS = {kind: unit for kind, unit in PARAMETER_UNITS.items() if kind not in ("tension", "end_stiffness")}
 
 
 def in_si_units(note: Note, parameters: Sequence) -> Note:
@@ -228,7 +240,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
             starts = _starts_from(problem, [previous] if previous else seeds, nominal=not previous)
             xb, c = _quiet(lambda problem=problem, starts=starts: min(
-                (_local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
+                (local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
             values[("position", unmodeled_name(scanned))] = float(x)
             previous = values
@@ -289,7 +301,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
         if not used or n_kept <= len(used):
             return None
         sub = Problem(hyp.campaign, kept, [hyp.parameters[j] for j in used], tension_model)
-        x_sub, _ = _quiet(lambda sub=sub, used=used: _local_fit(sub, x_full[used], max_nfev, TOL), [])
+        x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
         x[used] = x_sub
         left = modes == mode
         predicted[left] = full.predict(x)[left]

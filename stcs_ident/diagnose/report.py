@@ -13,25 +13,20 @@ import os
 import re
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from ..errors import InputError
-from ..files import whole_directory
+from ..files import whole_directory, write_atomic, write_csv, write_figure
+from ..formatting import markdown_table, number, percent, rms
 from .tables import (
     CSV_FILES,
     cause_table,
     effects_label,
     frequency_table,
     gain_table,
-    markdown_table,
     nominal_comparison,
     ranking_table,
 )
-
-
-def _num(v, fmt="{:.3f}") -> str:
-    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt.format(v)
 
 
 def diagnosis_text(diagnosis) -> str:
@@ -43,14 +38,16 @@ def diagnosis_text(diagnosis) -> str:
     best = d.ranked[0].aicc
     for f in d.ranked:
         label = " + ".join(f.effects) if f.effects else "nominal"
-        lines.append(f"{label:<44} {f.n_parameters:>3} {f.chi2:>12.4g} {_num(f.aicc - best, '{:.1f}'):>10} "
-                     f"{f.rms_error:>8.3f} {_num(f.cv_rms_error):>9}")
+        delta = number(f.aicc - best, "{:.1f}", width=10, finite_only=True)
+        lines.append(f"{label:<44} {f.n_parameters:>3} {f.chi2:>12.4g} {delta} {f.rms_error:>8.3f} "
+                     f"{number(f.cv_rms_error, width=9, finite_only=True)}")
     lines += ["", "Cause: " + d.cause_text()]
     s = d.summary()["gain"]
-    lines.append(f"Gain: rms error nominal {s['rms_error_nominal']:.3f} %, baseline (tension, EI) "
-                 f"{_num(s.get('rms_error_baseline'))} %, corrected {s['rms_error_corrected']:.3f} %; "
-                 f"cross-validated baseline {_num(s.get('cv_rms_error_baseline'))} %, corrected "
-                 f"{_num(s['cv_rms_error_corrected'])} %.")
+    baseline, cv_baseline, cv_corrected = (number(s.get(k), finite_only=True) for k in (
+        "rms_error_baseline", "cv_rms_error_baseline", "cv_rms_error_corrected"))
+    lines.append(f"Gain: rms error nominal {s['rms_error_nominal']:.3f} %, baseline (tension, EI) {baseline} %, "
+                 f"corrected {s['rms_error_corrected']:.3f} %; cross-validated baseline {cv_baseline} %, corrected "
+                 f"{cv_corrected} %.")
     for note in d.notes:
         lines.append(f"Note: {note}")
     for name, reason in d.skipped:
@@ -60,10 +57,6 @@ def diagnosis_text(diagnosis) -> str:
 
 def _file_stem(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".") or "test"
-
-
-def _pct(v) -> str:
-    return "-" if v is None or not math.isfinite(v) else f"{v:.3f} %"
 
 
 def _data_section(d, spectra) -> list[str]:
@@ -102,15 +95,15 @@ def _forward_section(forward, table: pd.DataFrame) -> list[str]:
     columns = {c: h for c, h in columns.items() if c in table.columns}
     fmt = {c: ("{:.2f}" if c.endswith("%") else "{:.3f}") for c in columns if c not in ("test", "mode")}
     out.append(markdown_table(table, fmt, columns))
-    rms = []
+    errors = []
     for t in forward.tests:
         if t.measured is None:
             continue
-        errs = {c: t.error(c) for c in ("taut_string", "beam_pinned", "dsm")}
-        rms.append(f"{t.name}: string {np.sqrt(np.nanmean(errs['taut_string'] ** 2)):.2f} %, beam "
-                   f"{np.sqrt(np.nanmean(errs['beam_pinned'] ** 2)):.2f} %, DSM {np.sqrt(np.nanmean(errs['dsm'] ** 2)):.2f} %")
-    if rms:
-        out.append("rms errors — " + "; ".join(rms) + ".\n")
+        errs = {c: rms(t.error(c)) for c in ("taut_string", "beam_pinned", "dsm")}
+        errors.append(f"{t.name}: string {errs['taut_string']:.2f} %, beam {errs['beam_pinned']:.2f} %, "
+                      f"DSM {errs['dsm']:.2f} %")
+    if errors:
+        out.append("rms errors — " + "; ".join(errors) + ".\n")
     for check in forward.reference_checks:
         out.append(f"- {check.sentence()}")
     if forward.reference_checks:
@@ -155,7 +148,8 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
     out = ["## Named cause", "", d.cause_text(), "", sel.statement, ""]
     if sel.effects:
         out.append(f"Principal effect: {sel.principal}. Removal cost (AICc rise when an effect is dropped): "
-                   + "; ".join(f"{e} {_num(v, '{:.1f}')}" for e, v in sel.removal_cost.items()) + ".")
+                   + "; ".join(f"{e} {number(v, '{:.1f}', finite_only=True)}" for e, v in sel.removal_cost.items())
+                   + ".")
         out.append("Ambiguous alternatives (ΔAICc < 2): "
                    + ("; ".join(effects_label(a) for a in sel.ambiguous_with) if sel.ambiguous_with else "none") + ".")
         out += ["", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
@@ -201,28 +195,28 @@ def _before_after_section(d, freq: pd.DataFrame, figures: dict) -> list[str]:
 
 def _gain_section(d, gain: pd.DataFrame) -> list[str]:
     g = d.summary()["gain"]
-    sentence = (f"The rms error against the measured frequencies is {_pct(g['rms_error_nominal'])} with the nominal "
+    sentence = (f"The rms error against the measured frequencies is {percent(g['rms_error_nominal'])} with the nominal "
                 f"model")
     if "rms_error_baseline" in g:
-        sentence += f", {_pct(g['rms_error_baseline'])} with tension and EI re-estimated (baseline)"
-    sentence += (f" and {_pct(g['rms_error_corrected'])} with the named cause ({effects_label(d.corrected.effects)}); "
-                 f"cross-validated, nominal {_pct(g['cv_rms_error_nominal'])}")
+        sentence += f", {percent(g['rms_error_baseline'])} with tension and EI re-estimated (baseline)"
+    sentence += (f" and {percent(g['rms_error_corrected'])} with the named cause ({effects_label(d.corrected.effects)}); "
+                 f"cross-validated, nominal {percent(g['cv_rms_error_nominal'])}")
     if "rms_error_baseline" in g:
-        sentence += f", baseline {_pct(g.get('cv_rms_error_baseline'))}"
-    sentence += f", corrected {_pct(g['cv_rms_error_corrected'])}."
+        sentence += f", baseline {percent(g.get('cv_rms_error_baseline'))}"
+    sentence += f", corrected {percent(g['cv_rms_error_corrected'])}."
     out = ["## Gain", "", sentence, ""]
     if d.selection.effects and d.corrected.rms_error > d.nominal.rms_error:
         out += [(f"The corrected model lowers χ² (errors in Hz weighted by the uncertainties) but its relative "
-                f"rms error ({_pct(d.corrected.rms_error)}) is larger than the nominal model's "
-                f"({_pct(d.nominal.rms_error)})."), ""]
+                f"rms error ({percent(d.corrected.rms_error)}) is larger than the nominal model's "
+                f"({percent(d.nominal.rms_error)})."), ""]
     columns = {"model": "model", "effects": "effects", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
                "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %"}
     fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
     return out + [markdown_table(gain, fmt, columns)]
 
 
-def _notes_section(d, extra: list[str]) -> list[str]:
-    notes = list(d.notes) + [f"{effects_label(d.corrected.effects)}: {note}" for note in d.corrected.notes] + extra
+def _notes_section(d) -> list[str]:
+    notes = list(d.notes) + [f"{effects_label(d.corrected.effects)}: {note}" for note in d.corrected.notes]
     if d.baseline is not None and d.baseline is not d.corrected:
         notes += [f"baseline ({effects_label(d.baseline.effects)}): {note}" for note in d.baseline.notes]
     notes += [f"skipped {name}: {reason}" for name, reason in d.skipped]
@@ -230,40 +224,30 @@ def _notes_section(d, extra: list[str]) -> list[str]:
     return out + ([""] if notes else [])
 
 
-def report_markdown(diagnosis, tables: dict, figures: dict, forward, spectra=(), notes=()) -> str:
+def report_markdown(diagnosis, tables: dict, figures: dict, spectra=()) -> str:
     """``report.md`` from the tables (``report_tables``) and the figure file names."""
     d = diagnosis
     lines = [f"# Diagnosis of {d.campaign.name}", "",
              (f"{len(d.measurements)} tests, {d.measured.size} measured frequencies, {len(d.fits)} hypotheses "
              f"fitted in {d.elapsed:.1f} s."), "", "**Cause:** " + d.cause_text(), "",
-             "**Gain:** rms error nominal " + _pct(d.nominal.rms_error) + ", corrected "
-             + _pct(d.corrected.rms_error) + " (cross-validated " + _pct(d.corrected.cv_rms_error) + ").", ""]
+             "**Gain:** rms error nominal " + percent(d.nominal.rms_error) + ", corrected "
+             + percent(d.corrected.rms_error) + " (cross-validated " + percent(d.corrected.cv_rms_error) + ").", ""]
     lines += _data_section(d, spectra)
     if figures.get("spectra"):
         lines += ["## Spectra", ""]
         for name, file in figures["spectra"]:
             lines += [f"### {name}", "", f"![Spectra of {name}]({file})", ""]
-    lines += _forward_section(forward, tables["nominal_comparison"])
+    lines += _forward_section(d.comparison, tables["nominal_comparison"])
     lines += _ranking_section(d, tables["ranking"])
     lines += _cause_section(d, tables["cause"], figures)
     lines += _before_after_section(d, tables["frequencies"], figures)
     lines += _gain_section(d, tables["gain"])
-    lines += _notes_section(d, list(notes))
+    lines += _notes_section(d)
     lines += ["## Files", "", "Tables as CSV: " + ", ".join(f"[{f}]({f})" for f in CSV_FILES) + ".", ""]
     return "\n".join(lines)
 
 
-def _tension_model_note(d, forward) -> list[str]:
-    dsm = np.concatenate([t.dsm[[t.modes.index(int(k)) for k in m.modes]]
-                          for t, m in zip(forward.tests, d.measurements)])
-    if np.allclose(dsm, d.nominal.predicted, rtol=1e-9, atol=0.0):
-        return []
-    return [(f"the nominal comparison (tension model '{forward.tension_model}') differs from the diagnosis's nominal "
-            f"model by up to {np.max(np.abs(dsm / d.nominal.predicted - 1)) * 100:.2g} %: pass the tension model "
-            "the diagnosis used")]
-
-
-def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform") -> Path:
+def write_report(diagnosis, out_dir, spectra=()) -> Path:
     """Write the diagnosis report into ``out_dir``, whole or not at all.
 
     ``out_dir`` gets ``report.md`` (tables, figures and the named cause in
@@ -280,8 +264,6 @@ def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform")
     out_dir : path-like
     spectra : sequence of TestSpectra, optional
         The spectra the frequencies were picked from (one figure each).
-    tension_model : {"uniform", "per-segment", "none"}
-        The tension model the diagnosis used (for the nominal comparison).
 
     Returns
     -------
@@ -304,14 +286,11 @@ def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform")
         raise InputError("is a non-empty directory without report.md: not a report, not replaced", field="out_dir",
                          file=str(out))
     d = diagnosis
-    forward, comparison = nominal_comparison(d, spectra, tension_model)
     tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
-              "nominal_comparison": comparison, "cause": cause_table(d)}
-    from ..plots import save_figure
-
+              "nominal_comparison": nominal_comparison(d), "cause": cause_table(d)}
     with whole_directory(out) as tmp:
         for name, frame in tables.items():
-            frame.to_csv(tmp / f"{name}.csv", index=False)
+            write_csv(frame, tmp / f"{name}.csv", index=False)
         figures: dict = {"spectra": []}
         if spectra:
             from ..plots import plot_test_spectra
@@ -320,13 +299,13 @@ def write_report(diagnosis, out_dir, spectra=(), tension_model: str = "uniform")
             for ts in spectra:
                 if ts.name in used:
                     file = f"spectra_{_file_stem(ts.name)}.png"
-                    save_figure(plot_test_spectra(ts)["figure"], tmp / file)
+                    write_figure(plot_test_spectra(ts)["figure"], tmp / file)
                     figures["spectra"].append((ts.name, file))
-        save_figure(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
+        write_figure(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
         figures["residuals"] = "residuals.png"
         if diagnosis_figures.profile_scans(d):
-            save_figure(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
+            write_figure(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
             figures["profile"] = "profile.png"
-        text = report_markdown(d, tables, figures, forward, spectra, _tension_model_note(d, forward))
-        (tmp / "report.md").write_text(text, encoding="utf-8")
+        text = report_markdown(d, tables, figures, spectra)
+        write_atomic(tmp / "report.md", text)
     return out

@@ -11,10 +11,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..compare import ForwardResult
+from ..formatting import percent_error
 from ..identify.problem import Measurement
 from .. import effects as registry
 from ..effects.base import Context
 from ..model import Cable, Campaign
+from ..settings import Settings
 from .fitting import HypothesisFit
 from .selection import BASELINE, Selection, ranking
 
@@ -64,6 +67,13 @@ class Diagnosis:
         Seconds in all.
     considered : tuple of str
         The effects that made hypotheses.
+    settings : Settings
+        How the diagnosis was run (tension model, largest number of effects
+        per hypothesis, whether every pair was fitted).
+    comparison : ForwardResult or None
+        The nominal model against the measured frequencies (taut string,
+        pinned beam, DSM), computed by :func:`~stcs_ident.diagnose.diagnose`
+        with the same settings.
     """
 
     campaign: Campaign
@@ -76,6 +86,8 @@ class Diagnosis:
     timings: dict = field(default_factory=dict)
     elapsed: float = 0.0
     considered: tuple = ()
+    settings: Settings = field(default_factory=Settings)
+    comparison: ForwardResult | None = None
 
     @property
     def measured(self) -> np.ndarray:
@@ -94,7 +106,7 @@ class Diagnosis:
     def baseline(self) -> HypothesisFit | None:
         """Tension and EI re-estimated (the paper's correction), or what of it applies."""
         for key in (BASELINE, ("tension",)):
-            if key in self.fits:
+            if key in self.fits and self.fits[key].failure is None:
                 return self.fits[key]
         return None
 
@@ -126,7 +138,7 @@ class Diagnosis:
             for label, values in parts.items():
                 entry[label] = values[i].tolist()
             for label, values in parts.items():
-                entry[f"{label}_error"] = ((values[i] - m.frequencies) / m.frequencies * 100.0).tolist()
+                entry[f"{label}_error"] = percent_error(values[i], m.frequencies).tolist()
             tests.append(entry)
         ranked = self.ranked
         best = ranked[0].aicc
@@ -135,7 +147,8 @@ class Diagnosis:
         for f in ranked:
             values, sigmas = self.parameters(f)
             hypotheses.append({"effects": list(f.effects), "parameters": values, "uncertainty": sigmas,
-                               "n_parameters": f.n_parameters, "chi2": f.chi2, "rms_error": f.rms_error,
+                               "n_parameters": f.n_parameters, "chi2": _finite_or_none(f.chi2),
+                               "rms_error": _finite_or_none(f.rms_error), "failed": f.failure,
                                "aicc": _finite_or_none(f.aicc), "delta_aicc": _finite_or_none(f.aicc - best),
                                "cv_rms_error": _finite_or_none(f.cv_rms_error), "cv_rank": cv_rank.get(f.effects),
                                "notes": [str(n) for n in f.notes]})
@@ -161,6 +174,7 @@ class Diagnosis:
             "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
             "notes": [str(n) for n in self.notes],
             "seconds": self.elapsed,
+            "settings": self.settings.summary(),
         }
 
     def cv_ranks(self) -> dict[tuple[str, ...], int]:

@@ -12,7 +12,9 @@ import math
 import numpy as np
 import pandas as pd
 
-#: Units of the effect parameters of ``interface.md`` (the keys of ``Diagnosis.parameters``).
+from ..formatting import percent_error
+
+#: Units of the effect parameters (the keys of ``Diagnosis.parameters``).
 UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",
          "mass": "kg", "position": "m", "stiffness": "N/m"}
 #: Files of the report, besides the figures.
@@ -74,7 +76,8 @@ def ranking_table(diagnosis) -> pd.DataFrame:
                      "reduced_chi2": _reduced_chi2(f, n), "aicc": f.aicc, "delta_aicc": f.aicc - best,
                      "rms_error_%": f.rms_error,
                      "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
-                     "cause": f.effects == d.selection.effects, "parameters": _short(parameter_rows(*d.parameters(f))),
+                     "cause": f.effects == d.selection.effects,
+                     "parameters": f"failed: {f.failure}" if f.failure else _short(parameter_rows(*d.parameters(f))),
                      "seconds": d.timings.get(f.effects, math.nan)})
     return pd.DataFrame(rows)
 
@@ -91,7 +94,7 @@ def frequency_table(diagnosis) -> pd.DataFrame:
         for key, values in split.items():
             data[f"{key}_Hz"] = values[i] if values is not None else np.full(m.modes.size, np.nan)
         for key in models:
-            data[f"{key}_error_%"] = (data[f"{key}_Hz"] - m.frequencies) / m.frequencies * 100.0
+            data[f"{key}_error_%"] = percent_error(data[f"{key}_Hz"], m.frequencies)
         data["source"] = m.source
         frames.append(pd.DataFrame(data))
     return pd.concat(frames, ignore_index=True)
@@ -118,52 +121,21 @@ def cause_table(diagnosis) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["effect", "parameter", "value", "uncertainty", "unit"])
 
 
-def nominal_comparison(diagnosis, spectra=(), tension_model: str = "uniform"):
-    """The ``forward`` comparison (taut string, pinned beam, DSM against measured) of the diagnosed tests.
+def nominal_comparison(diagnosis) -> pd.DataFrame:
+    """The diagnosis's nominal comparison (``diagnosis.comparison``: taut string, pinned beam, DSM against
+    measured), one row per test and mode.
 
-    Returns
-    -------
-    (ForwardResult, DataFrame)
-        The table has one row per test and mode.
+    Raises
+    ------
+    ValueError
+        When the diagnosis carries no comparison (one not made by
+        :func:`~stcs_ident.diagnose.diagnose`).
     """
-    from ..compare import compare_forward
-
-    d = diagnosis
-    names = [m.name for m in d.measurements]
-    picked = {ts.name: (ts.modes, ts.frequencies) for ts in spectra if ts.name in names}
-    for m in d.measurements:  # frequencies the diagnosis used that are not the campaign's table
-        test = d.campaign.test(m.name)
-        table = dict(zip(test.modes or (), test.frequencies or ()))
-        if m.name not in picked and any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies)):
-            picked[m.name] = (m.modes, m.frequencies)
-    result = compare_forward(d.campaign, names, None, tension_model, picked=picked)
+    if diagnosis.comparison is None:
+        raise ValueError("the diagnosis carries no nominal comparison (made by diagnose())")
     frames = []
-    for t in result.tests:
+    for t in diagnosis.comparison.tests:
         frame = t.to_dataframe()
         frame.insert(0, "test", t.name)
         frames.append(frame)
-    return result, pd.concat(frames, ignore_index=True)
-
-
-def _cell(value, fmt: str) -> str:
-    if isinstance(value, str):
-        return value.replace("|", "\\|")
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else ""
-    return fmt.format(value)
-
-
-def markdown_table(frame: pd.DataFrame, formats: dict | None = None, columns: dict | None = None) -> str:
-    """A pipe table of ``frame``: ``formats`` {column: "{:.3f}"}, ``columns`` {column: header} (and order)."""
-    formats = formats or {}
-    columns = columns or {c: c for c in frame.columns}
-    numeric = {c: pd.api.types.is_numeric_dtype(frame[c]) and not pd.api.types.is_bool_dtype(frame[c])
-               for c in columns}
-    lines = ["| " + " | ".join(columns.values()) + " |",
-             "|" + "|".join("---:" if numeric[c] else ":---" for c in columns) + "|"]
-    for row in frame.itertuples(index=False):
-        record = dict(zip(frame.columns, row))
-        lines.append("| " + " | ".join(_cell(record[c], formats.get(c, "{}")) for c in columns) + " |")
-    return "\n".join(lines) + "\n"
+    return pd.concat(frames, ignore_index=True)

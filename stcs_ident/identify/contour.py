@@ -34,7 +34,7 @@ from scipy.optimize import minimize
 from ..errors import InputError
 from ..notes import Note, point
 from ..settings import Settings
-from .lsq import _local_fit, finish, mirror_images, nearest_nominal
+from .lsq import finish, local_fit, mirror_images, nearest_nominal
 from .problem import Problem
 from .result import IdentificationResult
 from .uncertainty import covariance_scale
@@ -156,7 +156,7 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
     F = _surfaces(problem, axes)
     chi2_grid = np.sum(((F - problem.measured) / problem.sigma) ** 2, axis=-1)
     i0 = np.unravel_index(np.nanargmin(np.where(np.isfinite(chi2_grid), chi2_grid, np.inf)), chi2_grid.shape)
-    _, chi2_min = _local_fit(problem, np.array([axes[0][i0[0]], axes[1][i0[1]]]), 100)
+    _, chi2_min = local_fit(problem, np.array([axes[0][i0[0]], axes[1][i0[1]]]), 100)
     scale, scale_note = covariance_scale(chi2_min, problem.n_data - 2, scale_rule)
     if scale_note:
         notes.append(replace(scale_note, template=SCALED_BANDS) if scale_note.kind == "covariance_scaled"

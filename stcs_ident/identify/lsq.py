@@ -74,9 +74,9 @@ def fit_lsq(problem: Problem, *, starts=None, n_starts: int = 6, scale_rule: str
     """
     starts = _starts(problem, n_starts, seed) if starts is None else np.atleast_2d(np.asarray(starts, float))
     starts = np.clip(starts, problem.lower, problem.upper)
-    solutions = [_local_fit(problem, x0, max_nfev, tol) for x0 in starts]
+    solutions = [local_fit(problem, x0, max_nfev, tol) for x0 in starts]
     best = min(solutions, key=lambda s: s[1])[0]
-    solutions += [_local_fit(problem, m, max_nfev, tol) for m in mirror_images(problem, best)]
+    solutions += [local_fit(problem, m, max_nfev, tol) for m in mirror_images(problem, best)]
     x, chi2, alternatives, notes = _choose(problem, solutions)
     return finish(problem, x, chi2, "lsq", scale_rule=scale_rule, alternatives=alternatives, notes=notes,
                   settings=settings)
@@ -133,8 +133,17 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     )
 
 
-def _local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:
-    """One bounded trust-region fit from ``x0``: (x, χ²)."""
+def local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:
+    """One bounded trust-region fit from ``x0``: (x, χ²).
+
+    The building block of :func:`fit_lsq`'s multi-start (and of the contour
+    method's χ² minimum and the diagnosis's profile scans and
+    cross-validation folds): ``max_nfev`` function evaluations at most,
+    ``tol`` as ``xtol``, ``ftol`` and ``gtol``; non-finite residuals count as
+    a large misfit so that the fit steps back from where the model fails.
+    No covariance, notes or warnings.
+    """
+
     def residuals(x):
         r = problem.residuals(x)
         return np.where(np.isfinite(r), r, 1e8)

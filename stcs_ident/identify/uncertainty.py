@@ -23,6 +23,7 @@ from scipy import stats
 
 from ..errors import StcsWarning
 from ..notes import Note
+from ..settings import SCALE_RULES
 
 #: |correlation| above which two parameters are reported as not separately identifiable.
 CORRELATION_LIMIT = 0.995
@@ -34,7 +35,6 @@ CONDITION_LIMIT = 1e3
 #: (observed 8e-9 for a massless attachment's position).
 NO_EFFECT = 1e-6
 
-SCALE_RULES = ("auto", "birge", "never")
 #: Sentence of the ``covariance_scaled`` note (the contour method says what it widens instead).
 SCALED = ("the misfit is {misfit:.3g} times the stated frequency uncertainties (reduced chi2 {value:.3g}, {dof} "
           "degrees of freedom): the covariance is scaled by the reduced chi2")
@@ -77,7 +77,24 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, 
 
 def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Covariance (JᵀJ)⁻¹ × scale and the correlation matrix (pseudo-inverse: a
-    direction the data do not see gets infinite variance)."""
+    direction the data do not see gets infinite variance).
+
+    A column that is not finite (the model could not be evaluated on either
+    side of the estimate) gets infinite variance and NaN covariances; the
+    others are computed from the finite columns.
+    """
+    J = np.asarray(J, float)
+    lost = ~np.all(np.isfinite(J), axis=0)
+    if lost.any():
+        cov = np.full((J.shape[1], J.shape[1]), np.nan)
+        corr = np.full_like(cov, np.nan)
+        keep = np.flatnonzero(~lost)
+        if keep.size:
+            sub_cov, sub_corr = covariance(J[:, keep], scale)
+            cov[np.ix_(keep, keep)], corr[np.ix_(keep, keep)] = sub_cov, sub_corr
+        cov[np.flatnonzero(lost), np.flatnonzero(lost)] = np.inf
+        np.fill_diagonal(corr, 1.0)
+        return cov, corr
     norms = np.linalg.norm(J, axis=0)
     safe = np.where(norms > 0, norms, 1.0)
     Jn = J / safe
@@ -113,12 +130,17 @@ def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma
     """
     names = list(names)
     problems = []
+    lost = ~np.all(np.isfinite(J), axis=0)
+    for i in np.flatnonzero(lost):
+        problems.append(Note.make("not_evaluated", "the model cannot be evaluated on either side of {parameter}'s "
+                                  "estimate (its derivative is unknown)", parameters=(names[i],)))
+    J = np.where(lost, 0.0, J)
     norms = np.linalg.norm(J, axis=0)
-    dead = norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)
+    dead = (norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)) & ~lost
     for i in np.flatnonzero(dead):
         problems.append(Note.make("no_effect", "{parameter} does not change any measured frequency",
                                   parameters=(names[i],)))
-    live = np.flatnonzero(~dead)
+    live = np.flatnonzero(~dead & ~lost)
     for a, i in enumerate(live):
         for j in live[a + 1:]:
             if abs(corr[i, j]) > CORRELATION_LIMIT:
