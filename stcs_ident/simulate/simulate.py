@@ -18,6 +18,11 @@ a record has the realistic content of a band-limited sensor. Hidden
 effects (:class:`~stcs_ident.simulate.effects.Effects`) act on the true
 model only. :func:`~stcs_ident.simulate.simulate_campaign.simulate_campaign`
 writes a whole campaign directory from them, for tests and benchmarks.
+
+Field-like disturbances (coloured loading, a drifting tension, pink noise,
+mains hum, offsets, float32 samples) are off by default and given as one
+:class:`~stcs_ident.simulate.disturbances.FieldConditions`; without them a
+record is exactly what it was before they existed.
 """
 
 from __future__ import annotations
@@ -33,12 +38,17 @@ from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
 from ..model import Attachment, Cable
 from ..spectra.record import Record
+from .disturbances import (
+    FieldConditions, RecordTruth, apply_sensor_disturbances, check_field, field_rng, lowpass_force_filter,
+    relative_tension, tension_sensitivities,
+)
 from .effects import Effects, true_model
+from .field_response import superpose_field
 from .modal_response import matrix_sqrt, modal_force_covariance, superpose
 
 __all__ = [
-    "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "Effects", "Impulse", "modal_basis", "modal_damping",
-    "simulate_record", "true_model",
+    "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "Effects", "FieldConditions", "Impulse", "RecordTruth",
+    "modal_basis", "modal_damping", "simulate_record", "simulate_record_with_truth", "true_model",
 ]
 
 #: Modes are kept up to this fraction of the sampling rate (just below Nyquist).
@@ -104,7 +114,7 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
                     impulses: Sequence[Impulse] = (), ambient: Ambient | None = None, snr_db: float | None = None,
                     effects: Effects | None = None, n_modes: int | None = None,
                     seed: int | np.random.SeedSequence | None = 0, channel_names: Sequence[str] | None = None,
-                    progress: Progress | None = None) -> Record:
+                    field: FieldConditions | None = None, progress: Progress | None = None) -> Record:
     """Simulate a multi-channel acceleration record of one configuration.
 
     Parameters
@@ -125,7 +135,9 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
     impulses : sequence of Impulse
         Blows, evaluated exactly.
     ambient : Ambient or None
-        Distributed random pressure. At least one excitation is needed.
+        Distributed random pressure. At least one excitation is needed;
+        with both, the blows' decays ride on the continuing ambient
+        response (they add: the model is linear).
     snr_db : float or None
         Sensor noise: white Gaussian, per channel with rms = the channel's
         signal rms × 10^(−snr_db/20). None: noise-free.
@@ -139,6 +151,14 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
         and the same signal with or without noise (noise is drawn last).
     channel_names : sequence of str or None
         Default ``"A1"``, ``"A2"``, ...
+    field : FieldConditions or None
+        Field-like disturbances (:mod:`~stcs_ident.simulate.disturbances`):
+        low-pass ambient loading, tension drift, pink noise, mains hum, DC
+        offsets, float32 samples. None (or ``FieldConditions()``): none,
+        and the record is bit for bit the one without this argument. Their
+        random draws use a stream of their own: turning on pink noise, hum,
+        offsets or float32 leaves the signal and the white noise as they
+        were; a coloured loading or a drift makes another signal.
     progress : callable(done, total), optional
         Called after each block of samples.
 
@@ -151,6 +171,33 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
     ------
     ModelError
         For an invalid option; the field names it.
+
+    See Also
+    --------
+    simulate_record_with_truth : the same record and what it truly holds
+        (the time-averaged frequencies under a drift).
+    """
+    return simulate_record_with_truth(cable, attachments, tension, positions, duration=duration,
+                                      sampling_rate=sampling_rate, damping=damping, impulses=impulses,
+                                      ambient=ambient, snr_db=snr_db, effects=effects, n_modes=n_modes, seed=seed,
+                                      channel_names=channel_names, field=field, progress=progress)[0]
+
+
+def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], tension: float,
+                               positions: Sequence[float], *, duration: float, sampling_rate: float,
+                               damping: float | Sequence[float] = 0.005, impulses: Sequence[Impulse] = (),
+                               ambient: Ambient | None = None, snr_db: float | None = None,
+                               effects: Effects | None = None, n_modes: int | None = None,
+                               seed: int | np.random.SeedSequence | None = 0,
+                               channel_names: Sequence[str] | None = None, field: FieldConditions | None = None,
+                               progress: Progress | None = None) -> tuple[Record, RecordTruth]:
+    """:func:`simulate_record`'s record and what it truly holds.
+
+    The parameters are :func:`simulate_record`'s. The
+    :class:`~stcs_ident.simulate.disturbances.RecordTruth` gives the true
+    model's frequencies and, under a tension drift, the relative tension at
+    every sample, each mode's sensitivity to it, the instantaneous and the
+    time-averaged frequencies.
     """
     fs, n_samples = _check_timing(duration, sampling_rate)
     impulses = _check_impulses(impulses)
@@ -165,9 +212,12 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
     for imp in impulses:
         _check_positions([imp.position], cable.length, "impulse.position")
     names = _channel_names(channel_names, len(x))
+    if field is not None:
+        check_field(field, len(x), fs, ambient is not None)
     shapes = modal_basis(cable, atts, tension, fs, n_modes)
     zeta = modal_damping(damping, len(shapes.frequencies))
     rng = np.random.default_rng(seed)
+    own_rng = field_rng(rng) if field is not None else None
     force_sqrt = None
     if ambient is not None:
         cov = modal_force_covariance(shapes, ambient.rms_pressure, ambient.correlation_length, length=cable.length,
@@ -175,8 +225,24 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
                                      uncorrelated_length=UNCORRELATED_LENGTH)
         force_sqrt = matrix_sqrt(cov)
     kicks = [(imp.time, shapes([imp.position])[0] * imp.magnitude) for imp in impulses]
-    clean = superpose(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng, progress)
-    return Record(_with_noise(clean, snr_db, rng), fs, names, x)
+    truth = RecordTruth(np.asarray(shapes.frequencies, dtype=float), tension, fs, n_samples)
+    lowpass = field.ambient_lowpass if field is not None else None
+    drift = field.drift if field is not None else None
+    if lowpass is None and drift is None:
+        clean = superpose(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng, progress)
+    else:
+        if drift is not None:
+            d = relative_tension(drift, n_samples, fs, own_rng)
+            s = tension_sensitivities(cable, atts, tension, len(shapes.frequencies))
+            truth = RecordTruth(truth.frequencies, tension, fs, n_samples, d, s)
+        clean = superpose_field(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng,
+                                force_filter=None if lowpass is None else lowpass_force_filter(lowpass, fs),
+                                relative_tension=truth.relative_tension, sensitivities=truth.sensitivities,
+                                progress=progress)
+    signal = _with_noise(clean, snr_db, rng)
+    if field is not None:
+        signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
+    return Record(signal, fs, names, x), truth
 
 
 def modal_basis(cable: Cable, attachments: Sequence[Attachment], tension: float, sampling_rate: float,

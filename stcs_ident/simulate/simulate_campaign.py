@@ -4,6 +4,9 @@
 directory whose records come from a true model that may differ from it
 (:class:`~stcs_ident.simulate.effects.Effects`), and writes the truth
 beside it in ``truth.json`` for scoring identification and diagnosis.
+Field-like disturbances (:class:`~stcs_ident.simulate.disturbances.FieldConditions`)
+may be given for all tests or per test; a test with a tension drift gets
+its time-averaged frequencies in ``truth.json``.
 """
 
 from __future__ import annotations
@@ -23,9 +26,9 @@ from ..errors import ModelError
 from ..files import whole_directory
 from ..forward.dsm import natural_frequencies
 from ..model import Cable, Campaign, Test
-from ..spectra.io_hdf5 import write_record
+from .disturbances import FieldConditions, write_record_as
 from .effects import Effects, true_model
-from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record
+from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record_with_truth
 
 __all__ = ["TRUTH_FILE", "simulate_campaign"]
 
@@ -38,6 +41,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
                       ambient: Ambient | None = None, snr_db: float | None = None,
                       effects: Effects | Mapping[str, Effects] | None = None, n_modes: int | None = None,
                       seed: int = 0, channel_names: Sequence[str] | None = None, overwrite: bool = False,
+                      field: FieldConditions | Mapping[str, FieldConditions] | None = None,
                       progress: Progress | None = None) -> Path:
     """Write a campaign directory whose records come from a (hidden) true model.
 
@@ -66,6 +70,17 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
         Each test gets its own stream, spawned from ``SeedSequence(seed)``.
     overwrite : bool
         Replace an existing non-empty ``out_dir`` (as a whole).
+    field : FieldConditions or mapping of test name to FieldConditions, optional
+        Field-like disturbances (as for :func:`simulate_record`), for all
+        tests or per test (tests not in the mapping get none). A test with
+        any gets ``"field"`` (the parts that are on) in ``truth.json``; with
+        a drift also ``"time_averaged_frequencies"`` (Hz, per mode: the
+        instantaneous frequency averaged over the record's samples, the
+        value an estimate should be scored against) and ``"mean_tension"``
+        (its ``"tension"`` is then the tension at t = 0); with ``float32``
+        the record's samples are written as float32. Without ``field`` the
+        records' samples, ``campaign.toml`` and ``truth.json`` are what they
+        were before this option existed.
     progress : callable(done, total), optional
         Called after each test with the number of tests done.
 
@@ -85,6 +100,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
     _check_target(out, overwrite)
     selected = _select_tests(campaign, tests)
     per_test = _effects_per_test(effects, selected)
+    field_per_test = _field_per_test(field, selected)
     stems = _record_stems([t.name for t in selected])
     streams = np.random.SeedSequence(seed).spawn(len(selected))
     options = {"duration": duration, "sampling_rate": sampling_rate, "damping": damping,
@@ -96,7 +112,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
         for i, (test, stem) in enumerate(zip(selected, stems)):
             rel = f"records/{stem}.h5"
             truth_tests.append(_simulate_test(campaign, test, tmp / rel, positions, per_test[test.name],
-                                              streams[i], options))
+                                              streams[i], options, field_per_test[test.name]))
             truth_tests[-1]["record"] = rel
             nominal_tests.append(replace(test, frequencies=None, modes=None, reference=(), record=rel))
             if progress is not None:
@@ -111,15 +127,15 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
 
 
 def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effects: Effects | None,
-                   stream: np.random.SeedSequence, options: dict) -> dict:
+                   stream: np.random.SeedSequence, options: dict, field: FieldConditions | None = None) -> dict:
     attachments = campaign.setup(test.setup).attachments
-    record = simulate_record(campaign.cable, attachments, test.tension, positions, effects=effects, seed=stream,
-                             **options)
-    write_record(record, path)
+    record, record_truth = simulate_record_with_truth(campaign.cable, attachments, test.tension, positions,
+                                                      effects=effects, seed=stream, field=field, **options)
+    write_record_as(record, path, float32=field is not None and field.float32)
     cable, atts, tension = true_model(campaign.cable, attachments, test.tension, effects)
     shapes = modal_basis(cable, atts, tension, options["sampling_rate"], options["n_modes"])
     n = len(shapes.frequencies)
-    return {
+    truth = {
         "name": test.name, "setup": test.setup, "stated_tension": test.tension, "tension": tension,
         "effects": effects.to_dict() if effects else {}, "effect_names": effects.names if effects else [],
         "cable": _cable_json(cable),
@@ -130,6 +146,12 @@ def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effect
         "nominal_frequencies": [float(f) for f in natural_frequencies(campaign.cable, attachments, test.tension, n)],
         "damping": [float(z) for z in modal_damping(options["damping"], n)],
     }
+    if field is not None:
+        truth["field"] = field.to_dict()
+        if record_truth.drifts:
+            truth["time_averaged_frequencies"] = [float(f) for f in record_truth.mean_frequencies]
+            truth["mean_tension"] = record_truth.mean_tension
+    return truth
 
 
 def _cable_json(cable: Cable) -> dict:
@@ -176,6 +198,21 @@ def _effects_per_test(effects, tests: list[Test]) -> dict[str, Effects | None]:
     if unknown:
         raise ModelError(f"names tests not simulated: {sorted(unknown)}", field="effects")
     return {t.name: effects.get(t.name) for t in tests}
+
+
+def _field_per_test(field, tests: list[Test]) -> dict[str, FieldConditions | None]:
+    if field is None or isinstance(field, FieldConditions):
+        return {t.name: field for t in tests}
+    if not isinstance(field, Mapping):
+        raise ModelError("must be a FieldConditions, a mapping of test name to FieldConditions, or None",
+                         field="field")
+    unknown = set(field) - {t.name for t in tests}
+    if unknown:
+        raise ModelError(f"names tests not simulated: {sorted(unknown)}", field="field")
+    for name, value in field.items():
+        if value is not None and not isinstance(value, FieldConditions):
+            raise ModelError(f"must be a FieldConditions or None, got {type(value).__name__}", field=f"field[{name}]")
+    return {t.name: field.get(t.name) for t in tests}
 
 
 def _record_stems(names: list[str]) -> list[str]:
