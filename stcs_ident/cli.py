@@ -1,4 +1,4 @@
-"""Command line: ``stcs-ident forward CAMPAIGN ...``.
+"""The ``stcs-ident`` command line (forward, spectra, simulate, identify, diagnose).
 
 Exit status 0 on success, 2 for bad input (one line on standard error
 naming the file, the field and what is wrong; nothing written), 1 for a
@@ -12,30 +12,67 @@ import os
 import sys
 import traceback
 
-from . import effects
+from . import __version__, effects
 from .errors import ComputationError, InputError
 
+DESCRIPTION = """\
+stcs-ident: cable force, bending stiffness and model diagnosis from the
+vibration records of stay cables, hangers and suspension cables (exact
+dynamic-stiffness model of a tensioned, sagging cable with attachments)."""
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="stcs-ident", description=__doc__.splitlines()[0])
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose help starts with what the tool is, then the usage."""
+
+    def format_help(self) -> str:
+        formatter = self._get_formatter()
+        formatter.add_text(self.description)
+        formatter.add_usage(self.usage, self._actions, self._mutually_exclusive_groups)
+        for group in self._action_groups:
+            formatter.start_section(group.title)
+            formatter.add_text(group.description)
+            formatter.add_arguments(group._group_actions)
+            formatter.end_section()
+        formatter.add_text(self.epilog)
+        return formatter.format_help()
+
+#: One real example per command (the shipped campaigns), shown in --help.
+EXAMPLES = {
+    "forward": "stcs-ident forward campaigns/han2020 --test case1-L4 --modes 8",
+    "spectra": "stcs-ident spectra campaigns/hanger-hidden-mass --json picked.json --plot spectra/",
+    "simulate": "stcs-ident simulate campaigns/han2020 --out sim/ --test case1-L4 --extra-mass 5@6.0 --seed 1",
+    "identify": "stcs-ident identify campaigns/han2020 --test case1-L4 --params tension,EI --method contour --plot figures/",
+    "diagnose": "stcs-ident diagnose campaigns/han2020 --out report/",
+}
+
+
+def _epilog(*commands: str) -> str:
+    return "example" + ("s" if len(commands) > 1 else "") + ":\n" + "\n".join(f"  {EXAMPLES[c]}" for c in commands)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``stcs-ident`` (its subcommands and options)."""
+    raw = argparse.RawDescriptionHelpFormatter
+    parser = _Parser(prog="stcs-ident", description=DESCRIPTION, epilog=_epilog(*EXAMPLES), formatter_class=raw)
+    parser.add_argument("--version", action="version", version=f"stcs-ident {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", required=True)
-    fwd = sub.add_parser("forward", help="nominal model against measured and published frequencies")
+    fwd = sub.add_parser("forward", epilog=_epilog("forward"), formatter_class=argparse.RawDescriptionHelpFormatter, help="nominal model against measured and published frequencies")
     fwd.add_argument("campaign", help="campaign directory or its campaign.toml")
     fwd.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
     fwd.add_argument("--modes", type=int, metavar="N", help="modes to compute (default: measured, at least 6)")
     fwd.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform",
                      help="additional tension from sag-extensibility (default uniform)")
     fwd.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
-    fwd.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
-    spe = sub.add_parser("spectra", help="numbered modal frequencies picked from the acceleration records")
+    fwd.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    spe = sub.add_parser("spectra", epilog=_epilog("spectra"), formatter_class=argparse.RawDescriptionHelpFormatter, help="numbered modal frequencies picked from the acceleration records")
     spe.add_argument("campaign", help="campaign directory or its campaign.toml")
     spe.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
     spe.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
-    spe.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    spe.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     _simulate_parser(sub)
-    idf = sub.add_parser("identify", help="correct tension, EI, attachment positions... from measured frequencies")
+    idf = sub.add_parser("identify", epilog=_epilog("identify"), formatter_class=argparse.RawDescriptionHelpFormatter, help="correct tension, EI, attachment positions... from measured frequencies")
     idf.add_argument("campaign", help="campaign directory or its campaign.toml")
     idf.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
     idf.add_argument("--params", default="tension,EI",
@@ -45,8 +82,8 @@ def _parser() -> argparse.ArgumentParser:
     idf.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")
     idf.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     idf.add_argument("--plot", metavar="DIR", help="write the figures into DIR")
-    idf.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
-    dia = sub.add_parser("diagnose", help="what the model gets wrong, its cause among physical effects, and the gain")
+    idf.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    dia = sub.add_parser("diagnose", epilog=_epilog("diagnose"), formatter_class=argparse.RawDescriptionHelpFormatter, help="what the model gets wrong, its cause among physical effects, and the gain")
     dia.add_argument("campaign", help="campaign directory or its campaign.toml")
     dia.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
     dia.add_argument("--effects", metavar="LIST",
@@ -58,12 +95,12 @@ def _parser() -> argparse.ArgumentParser:
     dia.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")
     dia.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     dia.add_argument("--out", metavar="DIR", help="write the report (report.md, figures, CSV tables) into DIR")
-    dia.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    dia.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     return parser
 
 
 def _simulate_parser(sub) -> None:
-    sim = sub.add_parser("simulate", help="simulated records of a campaign's tests, with optional hidden effects",
+    sim = sub.add_parser("simulate", epilog=_epilog("simulate"), formatter_class=argparse.RawDescriptionHelpFormatter, help="simulated records of a campaign's tests, with optional hidden effects",
                          description="Writes OUT/campaign.toml (the nominal cable only), OUT/records/<test>.h5 "
                                      "and OUT/truth.json (the true model and frequencies).")
     sim.add_argument("campaign", help="campaign directory or its campaign.toml")
@@ -87,7 +124,7 @@ def _simulate_parser(sub) -> None:
             o = effect.option
             eff.add_argument(o.flag, dest=f"effect_{effect.name}", metavar=o.metavar,
                              action="append" if o.repeatable else "store", help=f"{effect.name}: {o.help}")
-    sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    sim.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
 
 
 def _simulate(args) -> int:
@@ -285,7 +322,7 @@ def _forward(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
-    parser = _parser()
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,

@@ -232,3 +232,26 @@ def test_identify_states_the_published_value_beside_ours(capsys):
 def test_bad_published_table_exits_2(tmp_path, capsys, table, field):
     code, _, err = run(["forward", _write(tmp_path, GOOD + table)], capsys)
     assert code == 2 and field in err and "campaign.toml" in err
+
+
+def test_version_help_and_examples(capsys):
+    from stcs_ident import __version__
+    from stcs_ident.cli import EXAMPLES, build_parser
+
+    with pytest.raises(SystemExit) as out:
+        main(["--version"])
+    assert out.value.code == 0 and capsys.readouterr().out.strip() == f"stcs-ident {__version__}"
+    parser = build_parser()
+    text = parser.format_help()
+    assert text.splitlines()[0].startswith("stcs-ident: cable force")  # what the tool is, before the usage
+    sub = parser._subparsers._group_actions[0].choices
+    assert set(EXAMPLES) == set(sub)
+    for command, example in EXAMPLES.items():
+        assert example in text and example in sub[command].format_help()
+        args = parser.parse_args(example.split()[1:])  # every example is a valid command line
+        assert args.command == command
+
+
+def test_debug_before_the_command_shows_the_traceback(tmp_path, capsys):
+    assert main(["--debug", "forward", str(tmp_path / "missing")]) == 2
+    assert "Traceback" in capsys.readouterr().err

@@ -15,7 +15,7 @@ import pytest
 
 import stcs_ident
 from stcs_ident import effects
-from stcs_ident.cli import _parser
+from stcs_ident.cli import build_parser
 from stcs_ident.diagnose import diagnose
 from stcs_ident.effects.base import Effect, Option, Quantity, Truth, positive_ratio
 from stcs_ident.forward import batch_frequencies
@@ -82,7 +82,7 @@ def test_every_effect_is_documented_for_users():
 
 
 def test_cli_help_and_simulate_options_come_from_the_registry():
-    parser = _parser()
+    parser = build_parser()
     sub = parser._subparsers._group_actions[0].choices
     help_text = " ".join(sub["diagnose"].format_help().split())
     for name in BUILT_IN:
@@ -204,7 +204,7 @@ def test_a_toy_effect_added_from_a_test_file_is_named_by_the_diagnosis(toy):
     # 5e-5 frequency noise on 12 modes: the mass per length to a few 1e-5 (3 % of the change as the limit)
     assert cause["parameters"]["mass_per_length"]["mass_per_length"] == pytest.approx(1.08 * 30.0, rel=0.003)
     assert "mass per length" in cause["description"]
-    sub = _parser()._subparsers._group_actions[0].choices
+    sub = build_parser()._subparsers._group_actions[0].choices
     assert "--mass-per-length-ratio" in sub["simulate"].format_help()
     assert "mass_per_length" in " ".join(sub["diagnose"].format_help().split())
 
