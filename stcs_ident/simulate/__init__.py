@@ -5,12 +5,24 @@ The simulator builds on the forward model and writes records of the type
 """
 
 from .disturbances import (
-    DcOffsets, FieldConditions, LowPassLoading, MainsHum, PinkNoise, RecordTruth, TensionDrift,
+    DcOffsets,
+    FieldConditions,
+    LowPassLoading,
+    MainsHum,
+    PinkNoise,
+    RecordTruth,
+    TensionDrift,
     random_field_conditions,
 )
 from .effects import Effects, true_model
 from .simulate import (
-    NYQUIST_FRACTION, UNCORRELATED_LENGTH, Ambient, Impulse, modal_basis, modal_damping, simulate_record,
+    NYQUIST_FRACTION,
+    UNCORRELATED_LENGTH,
+    Ambient,
+    Impulse,
+    modal_basis,
+    modal_damping,
+    simulate_record,
     simulate_record_with_truth,
 )
 from .simulate_campaign import TRUTH_FILE, simulate_campaign

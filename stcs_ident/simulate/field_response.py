@@ -39,7 +39,11 @@ from scipy.signal import lfilter
 from ..forward.shapes import ModeShapes
 from .disturbances import filter_state_space
 from .modal_response import (
-    acceleration_filters, impulse_acceleration, matrix_sqrt, stationary_covariance, zoh_transition,
+    acceleration_filters,
+    impulse_acceleration,
+    matrix_sqrt,
+    stationary_covariance,
+    zoh_transition,
 )
 
 __all__ = ["DRIFT_SEGMENT", "augmented_stationary_covariance", "impulse_state", "superpose_field"]

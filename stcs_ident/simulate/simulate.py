@@ -39,8 +39,14 @@ from ..forward.shapes import ModeShapes, mode_shapes
 from ..model import Attachment, Cable
 from ..spectra.record import Record
 from .disturbances import (
-    FieldConditions, RecordTruth, apply_sensor_disturbances, check_field, field_rng, lowpass_force_filter,
-    relative_tension, tension_sensitivities,
+    FieldConditions,
+    RecordTruth,
+    apply_sensor_disturbances,
+    check_field,
+    field_rng,
+    lowpass_force_filter,
+    relative_tension,
+    tension_sensitivities,
 )
 from .effects import Effects, true_model
 from .field_response import superpose_field
