@@ -56,6 +56,7 @@ __all__ = ["AmbientFit", "fit_ambient"]
 
 MAX_ITERATIONS = 60
 DAMPING_GRID = np.logspace(-4.0, -1.0, 7)
+_TINY = np.finfo(float).tiny
 
 
 @dataclass(frozen=True)
@@ -131,13 +132,17 @@ def _design(theta_nl: np.ndarray, problem: _Problem, derivative: bool = True) ->
     z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
     h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples, derivative)
     # α Re H + β Im H with |β| ≤ α, written as p (Re H + Im H) + q (Re H − Im H) with p, q ≥ 0.
-    basis = np.column_stack([h.real + h.imag, h.real - h.imag, problem.fixed])
+    basis = np.empty((h.size, 2 + problem.fixed.shape[1]))
+    np.add(h.real, h.imag, out=basis[:, 0])
+    np.subtract(h.real, h.imag, out=basis[:, 1])
+    basis[:, 2:] = problem.fixed
     if not derivative:
         return basis, None
-    dz = (2j * np.pi * problem.dt, -problem.dt)
-    deriv = np.stack(
-        [np.column_stack([(dh * d).real + (dh * d).imag, (dh * d).real - (dh * d).imag]) for d in dz], axis=-1
-    )  # (m, 2, 2)
+    deriv = np.empty((h.size, 2, 2))
+    for j, d in enumerate((2j * np.pi * problem.dt, -problem.dt)):
+        dh_d = dh * d
+        np.add(dh_d.real, dh_d.imag, out=deriv[:, 0, j])
+        np.subtract(dh_d.real, dh_d.imag, out=deriv[:, 1, j])
     return basis, deriv
 
 
@@ -145,14 +150,20 @@ def _expected(theta: np.ndarray, problem: _Problem):
     basis, deriv = _design(theta[:2], problem)
     lin = theta[2:]
     mean = basis @ lin
-    grad = np.column_stack([deriv[:, :, 0] @ lin[:2], deriv[:, :, 1] @ lin[:2], basis])
+    grad = np.empty((basis.shape[0], 2 + basis.shape[1]))
+    grad[:, 0] = deriv[:, :, 0] @ lin[:2]
+    grad[:, 1] = deriv[:, :, 1] @ lin[:2]
+    grad[:, 2:] = basis
     return mean, grad
 
 
 def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
-    if np.any(mean <= 0):
+    lowest = mean.min()
+    if lowest <= 0 or (lowest != lowest and np.any(mean <= 0)):  # (min is nan if any entry is)
         return np.inf
-    return float(np.sum(np.log(mean) + periodogram / mean))
+    terms = np.log(mean)
+    terms += periodogram / mean
+    return float(terms.sum())
 
 
 def _linear_start(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, float]:
@@ -203,21 +214,27 @@ def _weighted_least_squares(basis, target, weight, nonnegative) -> np.ndarray:
     A small active-set loop (the columns are few); the normal equations are
     solved with column scaling and a tiny ridge.
     """
-    a = basis * weight[:, None]
+    # Rows of a_t are the weighted columns (sub_t @ sub_t.T: the normal matrix of the free ones). Called
+    # thousands of times per record: few numpy calls per pass, the same arithmetic as the plain form.
+    a_t = np.multiply(basis.T, weight, order="C")
     b = target * weight
-    free = np.ones(basis.shape[1], dtype=bool)
-    coef = np.zeros(basis.shape[1])
-    for _ in range(basis.shape[1]):
-        sub = a[:, free]
-        normal = sub.T @ sub
-        scale = np.sqrt(np.maximum(np.diag(normal), np.finfo(float).tiny))
-        normal = normal / np.outer(scale, scale) + 1e-12 * np.eye(scale.size)
-        coef = np.zeros(basis.shape[1])
-        coef[free] = np.linalg.solve(normal, (sub.T @ b) / scale) / scale
-        negative = np.flatnonzero(free & nonnegative & (coef < 0))
-        if negative.size == 0:
+    n_columns = basis.shape[1]
+    free = np.ones(n_columns, dtype=bool)
+    bounded = nonnegative.copy()  # free columns that must stay >= 0
+    sub_t = a_t
+    for _ in range(n_columns):
+        normal = sub_t @ sub_t.T
+        scale = np.sqrt(np.maximum(normal.diagonal(), _TINY))
+        normal /= scale[:, None] * scale
+        normal.flat[:: scale.size + 1] += 1e-12  # the ridge
+        coef = np.zeros(n_columns)
+        coef[free] = np.linalg.solve(normal, (sub_t @ b) / scale) / scale
+        candidate = np.where(bounded, coef, 0.0)
+        worst = int(np.argmin(candidate))
+        if not candidate[worst] < 0:
             break
-        free[negative[np.argmin(coef[negative])]] = False
+        free[worst] = bounded[worst] = False
+        sub_t = a_t[free]
     return coef
 
 
@@ -231,28 +248,32 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     bounded = np.concatenate([[False, False], nonnegative])
     free = np.ones(theta.size, dtype=bool)
     step = np.zeros(theta.size)
+    sub = fisher
     for _ in range(theta.size):
-        sub = fisher[np.ix_(free, free)]
-        scale = np.sqrt(np.maximum(np.diag(sub), np.finfo(float).tiny))
+        scale = np.sqrt(np.maximum(sub.diagonal(), _TINY))
         step = np.zeros(theta.size)
-        step[free] = np.linalg.lstsq(sub / np.outer(scale, scale), score[free] / scale, rcond=1e-12)[0] / scale
+        step[free] = np.linalg.lstsq(sub / (scale[:, None] * scale), score[free] / scale, rcond=1e-12)[0] / scale
         blocked = np.flatnonzero(free & bounded & (theta + step < 0) & (theta <= 1e-12 * np.abs(theta).max()))
         if blocked.size == 0:
             break
         free[blocked] = False
+        sub = fisher[np.ix_(free, free)]
     return step
 
 
-def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, bool]:
-    """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits)."""
+def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+    """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits).
+
+    Returns θ, whether it converged, and the expected periodogram and its gradient at θ.
+    """
     mean, grad = _expected(theta, problem)
     nll = _neg_log_likelihood(mean, problem.periodogram)
     for _ in range(MAX_ITERATIONS):
         score = grad.T @ ((problem.periodogram - mean) / mean**2)
         fisher = _fisher(grad, mean)
         step = _scoring_step(theta, score, fisher, problem.nonnegative)
-        if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], np.finfo(float).tiny)) < 1e-4):
-            return theta, True
+        if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], _TINY)) < 1e-4):
+            return theta, True, mean, grad
         for _ in range(30):
             trial = theta + step
             trial[2:] = np.where(problem.nonnegative, np.maximum(trial[2:], 0.0), trial[2:])
@@ -265,8 +286,8 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, 
                     break
             step = step / 2
         else:
-            return theta, True  # no decrease along the scoring direction: at the optimum within rounding
-    return theta, False
+            return theta, True, mean, grad  # no decrease along the scoring direction: at the optimum within rounding
+    return theta, False, mean, grad
 
 
 def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray) -> np.ndarray:
@@ -369,8 +390,7 @@ def fit_ambient(
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
     )
     theta = _grid_start(starts, problem, limits)
-    theta, ok = _scoring(theta, problem, limits)
-    mean, grad = _expected(theta, problem)
+    theta, ok, mean, grad = _scoring(theta, problem, limits)
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
     try:

@@ -118,9 +118,10 @@ def _jumps(energy: np.ndarray, history: int, jump_db: float) -> np.ndarray:
     return k[ahead[k] >= 10 ** (jump_db / 10) * before]
 
 
-def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale) -> list[_Onset]:
+def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.ndarray | None = None) -> list[_Onset]:
+    """Onsets at one scale; `energy`: the signal's :func:`_frame_energy` at this scale, if already computed."""
     frame = _frame_length(scale, sampling_rate)
-    energy = _frame_energy(signal, frame)
+    energy = _frame_energy(signal, frame) if energy is None else energy
     if energy.size < 8:
         return []
     history = max(4, round(scale[1] * sampling_rate / frame))
@@ -152,10 +153,13 @@ def _merge(fine: list[_Onset], coarse: list[_Onset], gap: int) -> list[_Onset]:
     return merged
 
 
-def _starts_in_decay(x: np.ndarray, sampling_rate: float) -> bool:
-    """The record opens inside a decay: its first second 15 dB above the median of its last quarter."""
+def _starts_in_decay(x: np.ndarray, sampling_rate: float, energy: np.ndarray | None = None) -> bool:
+    """The record opens inside a decay: its first second 15 dB above the median of its last quarter.
+
+    `energy`: :func:`_frame_energy` of `x` in COARSE frames, if already computed.
+    """
     frame = _frame_length(COARSE, sampling_rate)
-    energy = _frame_energy(x, frame)
+    energy = _frame_energy(x, frame) if energy is None else energy
     head = max(1, round(sampling_rate / frame))
     if energy.size < 4 * head:
         return False
@@ -179,10 +183,14 @@ def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]
     """
     x = np.asarray(acceleration, dtype=float)
     fine = _scale_onsets(np.diff(x, axis=0), sampling_rate, FINE)
-    coarse = _scale_onsets(x, sampling_rate, COARSE)
-    x2 = (x**2 / np.maximum(np.mean(x**2, axis=0), np.finfo(float).tiny)).mean(axis=1)
-    onsets = [o for o in _merge(fine, coarse, int(MIN_GAP * sampling_rate)) if _confirmed(x2, o, sampling_rate)]
-    if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate):
+    coarse_energy = _frame_energy(x, _frame_length(COARSE, sampling_rate))
+    coarse = _scale_onsets(x, sampling_rate, COARSE, coarse_energy)
+    merged = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
+    onsets = []
+    if merged:  # (an ambient record has none: the normalised power is not needed)
+        x2 = (x**2 / np.maximum(np.mean(x**2, axis=0), np.finfo(float).tiny)).mean(axis=1)
+        onsets = [o for o in merged if _confirmed(x2, o, sampling_rate)]
+    if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, coarse_energy):
         frame = _frame_length(COARSE, sampling_rate)
         onsets.insert(0, _Onset(sample=0, frame=frame, start=0))
     events = []

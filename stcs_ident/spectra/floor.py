@@ -91,14 +91,16 @@ def noise_floor(spectra: np.ndarray, dof, cell: int, passes: int = FLOOR_PASSES)
     a spectrum whose peaks have been taken out already).
     """
     dof = np.broadcast_to(np.asarray(dof, dtype=float), spectra.shape[:1])
-    correction = _quantile_to_mean(dof, 0.5)[:, None]
-    threshold = (stats.chi2.isf(MASK_PROBABILITY, dof) / dof)[:, None]
+    # The quantiles once per distinct value (often one for all bins), then spread over the bins.
+    dof, bins = np.unique(dof, return_inverse=True)
+    correction = _quantile_to_mean(dof, 0.5)[bins][:, None]
+    threshold = (stats.chi2.isf(MASK_PROBABILITY, dof) / dof)[bins][:, None]
     # A broad peak may stand only a few times above a first floor that it lifts itself: it is found in the
     # spectrum averaged over MASK_SMOOTHING cells, whose scatter is that many times smaller.
     smoothing = MASK_SMOOTHING * cell
     smooth_dof = dof * MASK_SMOOTHING
     # At least twice the floor: a smooth spectrum a little off its floor (curvature) is no peak.
-    smooth_threshold = np.maximum(stats.chi2.isf(MASK_PROBABILITY, smooth_dof) / smooth_dof, 2.0)[:, None]
+    smooth_threshold = np.maximum(stats.chi2.isf(MASK_PROBABILITY, smooth_dof) / smooth_dof, 2.0)[bins][:, None]
     masked = spectra
     floor = None
     for k in range(passes):

@@ -218,7 +218,8 @@ def _welch_segments(x: np.ndarray, nperseg: int) -> tuple[np.ndarray, float]:
     window = signal.windows.hann(nperseg, sym=False)
     segments = np.lib.stride_tricks.sliding_window_view(x, nperseg, axis=0)[::step][:n_segments]  # (K, C, nperseg)
     segments = segments - segments.mean(axis=-1, keepdims=True)
-    return rfft(segments * window, axis=-1, workers=-1).transpose(0, 2, 1), float(np.sum(window**2))
+    segments *= window  # in place: one copy of the overlapping segments, not two
+    return rfft(segments, axis=-1, workers=-1).transpose(0, 2, 1), float(np.sum(window**2))
 
 
 def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
