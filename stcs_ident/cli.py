@@ -89,7 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
     dia.add_argument("--effects", metavar="LIST",
                      help=f"effects to consider, comma-separated (default all: {', '.join(effects.names())})")
     dia.add_argument("--max-effects", type=int, choices=(1, 2), default=2,
-                     help="largest number of effects in one hypothesis (default 2)")
+                     help="largest number of effects in one hypothesis, besides the baseline (tension + EI) "
+                          "plus max-effects - 1 further ones (default 2)")
     dia.add_argument("--all-hypotheses", action="store_true",
                      help="fit every pair of effects even when the nominal model explains the data")
     dia.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform")

@@ -64,18 +64,51 @@ def test_no_effect_gives_an_empty_cause():
     assert s["gain"]["rms_error_corrected"] == s["gain"]["rms_error_nominal"]
 
 
-def test_hidden_bending_stiffness_is_named_with_its_value():
-    campaign, picked = synthetic(Effects(EI_ratio=1.25), seed=1)
+def test_hidden_bending_stiffness_beyond_its_tolerance_is_named_with_its_value():
+    campaign, picked = synthetic(Effects(EI_ratio=1.45), seed=1)  # beyond the default tolerance of 30 %
     d = diagnose(campaign, picked=picked, max_effects=1)
     s = d.summary()
-    assert s["cause"]["principal"] == "bending_stiffness"
+    assert s["cause"]["effects"] == ["bending_stiffness"] and s["cause"]["principal"] == "bending_stiffness"
     # 5e-5 relative noise on 12 frequencies of a cable with ξ ≈ 11: EI to well under 1 %.
-    assert s["cause"]["parameters"]["bending_stiffness"]["EI"] == pytest.approx(1.25 * CABLE.EI, rel=0.01)
+    assert s["cause"]["parameters"]["bending_stiffness"]["EI"] == pytest.approx(1.45 * CABLE.EI, rel=0.01)
     assert s["gain"]["rms_error_corrected"] < 0.1 * s["gain"]["rms_error_nominal"]
 
 
+@pytest.mark.parametrize("hidden,effect", [(Effects(EI_ratio=1.2), "bending_stiffness"),
+                                           (Effects(tension_ratio=1.008), "tension")])
+def test_a_departure_within_tolerance_is_a_correction_not_a_cause(hidden, effect):
+    campaign, picked = synthetic(hidden, seed=6)
+    s = diagnose(campaign, picked=picked, max_effects=1).summary()
+    assert not s["cause"]["explained_by_nominal"]  # the records see it (5e-5 noise) ...
+    assert s["cause"]["effects"] == [] and s["cause"]["principal"] is None  # ... but it is no cause
+    assert s["cause"]["fitted"] == [effect] and list(s["cause"]["corrections"]) == [effect]
+    assert "within the tolerance" in s["cause"]["description"]
+    assert s["gain"]["rms_error_corrected"] < 0.1 * s["gain"]["rms_error_nominal"]
+
+
+def test_a_campaign_tolerance_turns_a_correction_into_a_cause(tmp_path):
+    from dataclasses import replace
+
+    campaign, picked = synthetic(Effects(tension_ratio=1.008), seed=6)
+    tight = replace(campaign, tolerance=(("tension", 0.002),))  # a calibrated load cell: 0.2 %
+    s = diagnose(tight, picked=picked, max_effects=1).summary()
+    assert s["cause"]["effects"] == ["tension"] and s["cause"]["corrections"] == {}
+
+
+def test_tension_plus_length_does_not_pass_for_a_stiffer_cable():
+    """Frequencies of a tensioned beam depend on H/(m l²) and EI/(H l²) only, so tension + length
+    reproduce an EI change exactly: only the tolerances of the nominal values can decide (the issue's
+    hanger with EI × 1.45 was diagnosed as tension −17 % + length −9 %). A bare cable: with an attachment
+    at a fixed distance from end A the two are not exactly equivalent."""
+    campaign, picked = synthetic(Effects(EI_ratio=1.45), seed=7, setup=Setup("S"))
+    s = diagnose(campaign, picked=picked, effects="tension,bending_stiffness,length").summary()
+    assert s["cause"]["effects"] == ["bending_stiffness"]
+    assert ["tension", "length"] in s["cause"]["implausible"]
+    assert "do not separate" in s["cause"]["description"]
+
+
 def test_json_follows_the_contract(tmp_path):
-    campaign, picked = synthetic(Effects(tension_ratio=1.02), seed=2)
+    campaign, picked = synthetic(Effects(tension_ratio=1.05), seed=2)  # beyond the 2 % tolerance
     s = diagnose(campaign, picked=picked, max_effects=1).summary()
     assert {"campaign", "tests", "hypotheses", "cause", "gain"} <= set(s)
     for t in s["tests"]:
@@ -91,7 +124,7 @@ def test_json_follows_the_contract(tmp_path):
         s["gain"])
     assert s["cause"]["principal"] == "tension"
     ratios = s["cause"]["parameters"]["tension"]["ratio"]
-    assert ratios == pytest.approx({"T1": 1.02, "T2": 1.02}, rel=1e-3)
+    assert ratios == pytest.approx({"T1": 1.05, "T2": 1.05}, rel=1e-3)
     json.dumps(s, allow_nan=False)  # strict JSON: no NaN or inf
 
 

@@ -8,6 +8,7 @@ by AICc, cross-validates each by leaving one mode out, and names the cause
 
 from __future__ import annotations
 
+import itertools
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -20,10 +21,20 @@ from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
 from ..notes import Note
 from ..settings import Settings
-from .fitting import HypothesisFit, cross_validate, failed_fit, fit_hypothesis, fit_nominal, mirror_symmetric
+from .fitting import (
+    HypothesisFit,
+    aicc,
+    cross_validate,
+    cross_validate_tests,
+    failed_fit,
+    fit_hypothesis,
+    fit_nominal,
+    mirror_symmetric,
+)
 from .hypotheses import applicable, build, hypothesis_sets, parse_effects
+from .model_error import fit_epsilon
 from .result import Diagnosis
-from .selection import BASELINE, explains, select
+from .selection import BASELINE, explains, needs_model_error, select
 
 Progress = Callable[[int, int, str], None]
 
@@ -117,32 +128,69 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     fits: dict[tuple[str, ...], HypothesisFit] = {}
     timings: dict[tuple[str, ...], float] = {}
     done = 0
-    # Single effects first (their estimates and profile minima seed the pairs), each stage in parallel.
-    stages = [[s for s in sets if len(s) <= 1], [s for s in sets if len(s) > 1]]
+    # Single effects first (their estimates and profile minima seed the pairs, the pairs the baseline plus
+    # one), each stage in parallel.
+    stages = [[s for s in sets if len(s) <= 1], [s for s in sets if len(s) == 2], [s for s in sets if len(s) > 2]]
     total = len(sets)
     for i, stage in enumerate(stages):
-        if i == 1 and not settings.all_hypotheses and explains(fits[()], n):
+        if i >= 1 and not settings.all_hypotheses and explains(fits[()], n):
             # No pair can change an empty cause: fit only the baseline, which the gain needs.
             kept = [s for s in stage if s == baseline]
-            notes.append(Note.make("pairs_not_fitted", "the nominal model explains the data: {value} pairs of "
-                                   "effects not fitted (they cannot change an empty cause; all_hypotheses fits them)",
-                                   value=len(stage) - len(kept)))
+            if len(stage) > len(kept):
+                notes.append(Note.make("pairs_not_fitted", "the nominal model explains the data: {value} "
+                                       "{what} of effects not fitted (they cannot change an empty cause; "
+                                       "all_hypotheses fits them)", value=len(stage) - len(kept),
+                                       what="pairs" if i == 1 else "combinations"))
             total -= len(stage) - len(kept)
             stage = kept
         jobs = [(campaign, measurements, s, settings.tension_model, symmetric,
-                 _pair_seeds(fits, s) if len(s) > 1 else [])
+                 _seeds(fits, s) if len(s) > 1 else [])
                 for s in stage]
         for s, fit, seconds in _map(_fit_job, jobs, workers):
             fits[s], timings[s] = fit, seconds
             done += 1
             if progress is not None:
                 progress(done, total, " + ".join(s) if s else "nominal")
+    if needs_model_error(fits, n):
+        for fit in fits.values():
+            with_model_error(fit, measurements)
     selection = select(fits, n, settings.max_effects)
+    test_cv = _test_cv(fits, selection, measurements, settings.tension_model)
     comparison = nominal_comparison(campaign, measurements, given, settings)
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
                      elapsed=time.perf_counter() - started, considered=tuple(usable), settings=settings,
-                     comparison=comparison)
+                     comparison=comparison, test_cv=test_cv)
+
+
+def with_model_error(fit: HypothesisFit, measurements: Sequence[Measurement]) -> None:
+    """Give a fitted hypothesis its model error ε (:mod:`.model_error`) and the AICc of the likelihood with
+    it (ε one more parameter)."""
+    if fit.failure is not None or not np.all(np.isfinite(fit.predicted)):
+        return
+    measured = np.concatenate([m.frequencies for m in measurements])
+    sigma = np.concatenate([m.uncertainty for m in measurements])
+    fit.epsilon, dev = fit_epsilon(fit.predicted - measured, sigma, measured)
+    fit.aicc = aicc(dev + fit.penalty, measured.size, fit.n_parameters + 1)
+
+
+def _test_cv(fits: dict, selection, measurements: Sequence[Measurement], tension_model: str) -> dict[str, float]:
+    """Leave-one-test-out prediction error (%) of the nominal model, the baseline and the corrected model."""
+    if len(measurements) < 2:
+        return {}
+    chosen = {"nominal": (), "corrected": selection.fitted}
+    base = next((k for k in (BASELINE, ("tension",)) if k in fits and fits[k].failure is None), None)
+    if base is not None:
+        chosen["baseline"] = base
+    out = {}
+    for label, key in chosen.items():
+        try:
+            value = cross_validate_tests(fits[key], measurements, tension_model)
+        except Exception:  # noqa: BLE001 (a failed fold leaves this figure out; the diagnosis stands)
+            value = None
+        if value is not None:
+            out[label] = value
+    return out
 
 
 def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], picked: Mapping[str, object],
@@ -164,13 +212,15 @@ def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], 
     return compare_forward(campaign, names, None, settings.tension_model, picked=given)
 
 
-def _pair_seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
-    """Starts of a pair: each single effect's estimate and profile minima, completed by the other's estimate."""
-    singles = [fits[(e,)] for e in effects if (e,) in fits]
+def _seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
+    """Starts of a combination: each sub-combination's estimate (one effect fewer) and profile minima,
+    completed by the other sub-combinations' estimates."""
+    subs = [fits[s] for s in itertools.combinations(effects, len(effects) - 1)
+            if s in fits and fits[s].failure is None]
     seeds = []
-    for i, fit in enumerate(singles):
+    for i, fit in enumerate(subs):
         others: dict = {}
-        for j, other in enumerate(singles):
+        for j, other in enumerate(subs):
             if j != i:
                 others.update(other.values())
         for point in [fit.values(), *fit.minima]:

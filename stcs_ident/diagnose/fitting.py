@@ -31,6 +31,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .. import effects as registry
 from ..formatting import PARAMETER_UNITS
 from ..forward import batch_frequencies
 from ..identify.lsq import fit_lsq, local_fit
@@ -76,6 +77,16 @@ class HypothesisFit:
         The profile scan of an unmodeled attachment's position.
     failure : str or None
         Why the fit failed (it then ranks last: χ² and AICc infinite).
+    penalty : float
+        How implausible the departures are (:func:`prior_penalty`: −2 log of
+        the Gaussian priors that the tolerances of the nominal values give,
+        at the estimate). The estimate is the data's alone (least squares);
+        ``aicc`` counts the penalty beside ``chi2``, so that of hypotheses the
+        frequencies cannot tell apart the more plausible one ranks first.
+    epsilon : float
+        The relative model error per frequency of :mod:`.model_error` (0
+        when the data need none); ``aicc`` is then that of the likelihood
+        with it.
     minima : list of dict
         The best distinct points of the profile scan (SI values by (kind,
         member)): the starts of pairs that contain this effect.
@@ -92,6 +103,8 @@ class HypothesisFit:
     profile: list[tuple[float, float]] = field(default_factory=list)
     minima: list[dict] = field(default_factory=list)
     failure: str | None = None
+    penalty: float = 0.0
+    epsilon: float = 0.0
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -106,6 +119,34 @@ class HypothesisFit:
         if self.result is None:
             return {}
         return {(p.kind, p.member): float(v) for p, v in zip(self.result.parameters, self.result.values)}
+
+
+def prior_widths(campaign: Campaign, hypothesis: Hypothesis, parameters: Sequence | None = None) -> list:
+    """Prior width (variable units, or None) of each parameter: the tolerance of the nominal value it
+    changes, as its effect declares it and the campaign's ``[tolerance]`` overrides it."""
+    owner = dict(zip((id(p) for p in hypothesis.parameters), hypothesis.owners))
+    out = []
+    for p in hypothesis.parameters if parameters is None else parameters:
+        effect = owner[id(p)]
+        out.append(registry.get(effect).prior_width(p, registry.tolerance(campaign, effect)))
+    return out
+
+
+def hypothesis_problem(hypothesis: Hypothesis, measurements: Sequence[Measurement], tension_model: str,
+                       parameters: Sequence | None = None) -> Problem:
+    """The identification problem of a hypothesis (or of some of its ``parameters``)."""
+    chosen = hypothesis.parameters if parameters is None else tuple(parameters)
+    return Problem(hypothesis.campaign, measurements, chosen, tension_model)
+
+
+def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray) -> float:
+    """Σ ((x − nominal)/width)² over the parameters whose nominal value has a tolerance, at ``estimate``:
+    how implausible the departures a hypothesis needs are (−2 log of their Gaussian prior)."""
+    total = 0.0
+    for p, x, width in zip(hypothesis.parameters, estimate, prior_widths(hypothesis.campaign, hypothesis)):
+        if width is not None:
+            total += ((float(x) - p.start) / width) ** 2
+    return total
 
 
 def failed_fit(campaign: Campaign, measurements: Sequence[Measurement], effects: Sequence[str], reason: str,
@@ -237,7 +278,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         previous: dict = {}
         for x in grid:
             hyp = build(campaign, tests, effects, {**positions, scanned: float(x)}, fixed=(scanned,))
-            problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+            problem = hypothesis_problem(hyp, measurements, tension_model)
             starts = _starts_from(problem, [previous] if previous else seeds, nominal=not previous)
             xb, c = _quiet(lambda problem=problem, starts=starts: min(
                 (local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
@@ -258,7 +299,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         minima = [c[2] for c in chosen]
         seeds = minima + seeds
     hyp = build(campaign, tests, effects, positions)
-    problem = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+    problem = hypothesis_problem(hyp, measurements, tension_model)
     starts = _starts_from(problem, seeds)
     has_position = any(p.kind == "position" and not p.slots for p in problem.parameters)
     options = {} if has_position else {"n_starts": 0}
@@ -272,9 +313,11 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     notes = [in_si_units(note, problem.parameters) for note in notes]
     n = problem.n_data
     predicted = problem.predict(result.estimate)
-    fit = HypothesisFit(hyp, result, predicted, result.chi2, aicc(result.chi2, n, len(hyp.parameters)),
+    chi2 = float(np.sum(((predicted - problem.measured) / problem.sigma) ** 2))
+    penalty = prior_penalty(hyp, result.estimate)
+    fit = HypothesisFit(hyp, result, predicted, chi2, aicc(chi2 + penalty, n, len(hyp.parameters)),
                         rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
-                        minima=minima)
+                        minima=minima, penalty=penalty)
     return fit
 
 
@@ -284,7 +327,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
     if fit.result is None:
         return fit.rms_error
     hyp = fit.hypothesis
-    full = Problem(hyp.campaign, measurements, hyp.parameters, tension_model)
+    full = hypothesis_problem(hyp, measurements, tension_model)
     x_full = fit.result.estimate
     measured = full.measured
     modes = np.concatenate([m.modes for m in measurements])
@@ -300,7 +343,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
         n_kept = sum(m.modes.size for m in kept)
         if not used or n_kept <= len(used):
             return None
-        sub = Problem(hyp.campaign, kept, [hyp.parameters[j] for j in used], tension_model)
+        sub = hypothesis_problem(hyp, kept, tension_model, [hyp.parameters[j] for j in used])
         x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
         x[used] = x_sub
         left = modes == mode
@@ -308,6 +351,40 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
     if not np.all(np.isfinite(predicted)):
         return None
     return rms_percent(predicted, measured)
+
+
+def cross_validate_tests(fit: HypothesisFit, measurements: Sequence[Measurement], tension_model: str,
+                         max_nfev: int = 100) -> float | None:
+    """Leave-one-test-out prediction error, %: each test predicted by the hypothesis fitted to the other
+    tests (None with fewer than two tests, or when a fold cannot be fitted).
+
+    A parameter that belongs to the left-out test alone (its tension ratio) keeps its nominal value: the
+    prediction is that of an unseen test, as a user would make it, so a stated tension's own error counts.
+    """
+    if len(measurements) < 2:
+        return None
+    if fit.result is None:
+        return fit.rms_error
+    hyp = fit.hypothesis
+    full = hypothesis_problem(hyp, measurements, tension_model)
+    x_full = fit.result.estimate
+    predicted, k = [], 0
+    for i, left in enumerate(measurements):
+        kept = [m for j, m in enumerate(measurements) if j != i]
+        used = [j for j, p in enumerate(hyp.parameters) if any(p.applies_to(m.test) for m in kept)]
+        x = full.start.copy()
+        if used:
+            if sum(m.modes.size for m in kept) <= len(used):
+                return None
+            sub = hypothesis_problem(hyp, kept, tension_model, [hyp.parameters[j] for j in used])
+            x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
+            x[used] = x_sub
+        predicted.append(full.predict(x)[k:k + left.modes.size])
+        k += left.modes.size
+    predicted = np.concatenate(predicted)
+    if not np.all(np.isfinite(predicted)):
+        return None
+    return rms_percent(predicted, full.measured)
 
 
 def mirror_symmetric(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> bool:

@@ -165,8 +165,12 @@ def build(campaign: Campaign, tests: Sequence[Test], effects: Sequence[str],
 
 
 def hypothesis_sets(effects: Sequence[str], max_effects: int = 2) -> list[tuple[str, ...]]:
-    """The nominal model, every single effect and every pair (up to ``max_effects``)."""
+    """The nominal model, every single effect and every pair (up to ``max_effects``), and, with pairs, the
+    baseline (the source paper's correction of tension and EI) plus each further effect."""
     out: list[tuple[str, ...]] = [()]
     for k in range(1, max_effects + 1):
         out += list(itertools.combinations(effects, k))
+    baseline = registry.baseline()
+    if max_effects >= 2 and baseline and set(baseline) <= set(effects):
+        out += [registry.in_order((*baseline, e)) for e in effects if e not in baseline]
     return out

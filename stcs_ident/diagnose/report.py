@@ -34,20 +34,29 @@ def diagnosis_text(diagnosis) -> str:
     d = diagnosis
     n = sum(m.modes.size for m in d.measurements)
     lines = [f"Diagnosis of {d.campaign.name}: {len(d.measurements)} tests, {n} measured frequencies", ""]
-    lines.append(f"{'hypothesis':<44} {'k':>3} {'chi2':>12} {'dAICc':>10} {'rms %':>8} {'cv rms %':>9}")
+    with_error = d.selection.model_error
+    lines.append(f"{'hypothesis':<48} {'k':>3} {'chi2':>12} {'prior':>8}" + (f" {'eps':>9}" if with_error else "")
+                 + f" {'dAICc':>10} {'rms %':>8} {'cv rms %':>9}")
     best = d.ranked[0].aicc
     for f in d.ranked:
         label = " + ".join(f.effects) if f.effects else "nominal"
+        if f.failure:
+            lines.append(f"{label:<48} {f.n_parameters:>3} failed: {f.failure}")
+            continue
         delta = number(f.aicc - best, "{:.1f}", width=10, finite_only=True)
-        lines.append(f"{label:<44} {f.n_parameters:>3} {f.chi2:>12.4g} {delta} {f.rms_error:>8.3f} "
-                     f"{number(f.cv_rms_error, width=9, finite_only=True)}")
+        eps = f" {f.epsilon:>9.2e}" if with_error else ""
+        lines.append(f"{label:<48} {f.n_parameters:>3} {f.chi2:>12.4g} {f.penalty:>8.2f}{eps} {delta} "
+                     f"{f.rms_error:>8.3f} {number(f.cv_rms_error, width=9, finite_only=True)}")
     lines += ["", "Cause: " + d.cause_text()]
     s = d.summary()["gain"]
     baseline, cv_baseline, cv_corrected = (number(s.get(k), finite_only=True) for k in (
         "rms_error_baseline", "cv_rms_error_baseline", "cv_rms_error_corrected"))
     lines.append(f"Gain: rms error nominal {s['rms_error_nominal']:.3f} %, baseline (tension, EI) {baseline} %, "
-                 f"corrected {s['rms_error_corrected']:.3f} %; cross-validated baseline {cv_baseline} %, corrected "
-                 f"{cv_corrected} %.")
+                 f"corrected {s['rms_error_corrected']:.3f} %; cross-validated (leave one mode out) baseline "
+                 f"{cv_baseline} %, corrected {cv_corrected} %.")
+    if d.test_cv:
+        shown = ", ".join(f"{label} {value:.3f} %" for label, value in d.test_cv.items())
+        lines.append(f"Leave one test out (each test predicted from the others, its tension as stated): {shown}.")
     for note in d.notes:
         lines.append(f"Note: {note}")
     for name, reason in d.skipped:
@@ -119,23 +128,33 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
     n = d.measured.size
     gate = float(chi2_distribution.isf(ALPHA, n))
     columns = {"rank": "#", "effects": "hypothesis", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
-               "delta_aicc": "ΔAICc", "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %", "cause": "cause",
-               "parameters": "key parameter values"}
-    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "delta_aicc": "{:.1f}", "rms_error_%": "{:.3f}",
-           "cv_rms_error_%": "{:.3f}"}
+               "prior_penalty": "prior", "epsilon": "ε", "delta_aicc": "ΔAICc", "rms_error_%": "rms %",
+               "cv_rms_error_%": "CV rms %", "cause": "chosen", "parameters": "key parameter values"}
+    if not d.selection.model_error:
+        del columns["epsilon"]
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "prior_penalty": "{:.2f}", "epsilon": "{:.2e}",
+           "delta_aicc": "{:.1f}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
     return ["## Hypotheses ranked by AICc", "", markdown_table(ranking, fmt, columns),
             "How to read this:", "",
             (f"- χ² sums the squared misfits in units of the frequency uncertainties; k is the number of fitted "
             f"parameters, n = {n} the number of measured frequencies."),
-            ("- AICc = χ² + 2k + 2k(k + 1)/(n − k − 1) trades misfit against parameters; lower is better and "
-            "ΔAICc is measured from the best hypothesis."),
+            ("- AICc = χ² + prior + 2k + 2k(k + 1)/(n − k − 1) trades misfit against parameters; lower is better "
+            "and ΔAICc is measured from the best hypothesis."),
+            ("- prior = Σ ((x − nominal)/tolerance)² over the parameters whose nominal value has a tolerance "
+            "(stated tension, nominal EI, recorded positions and masses, length; the campaign's [tolerance] or "
+            "the defaults): of hypotheses the frequencies cannot tell apart, the one needing the more plausible "
+            "departures ranks first. A departure within its tolerance is a correction, never a cause."),
+            ("- ε (shown when no hypothesis reaches the measurement uncertainty): the relative model error per "
+            "frequency each hypothesis needs; χ² in AICc is then replaced by the likelihood with variances "
+            "σ² + (ε f)², ε one more parameter, so that ΔAICc keeps its meaning."),
             (f"- Hypotheses within ΔAICc < {AMBIGUITY:g} of the chosen one are not told apart (ambiguous); of "
             "nested ones the simpler is preferred."),
             (f"- The χ² gate: the nominal model is accepted (no cause named) when its χ² is below the "
             f"{100 * (1 - ALPHA):g} % quantile of the χ² distribution with n degrees of freedom ({gate:.1f} here). "
             f"The nominal χ² is {d.nominal.chi2:.4g}: {'accepted' if d.selection.explained else 'rejected'}."),
             ("- rms % is the root mean square relative error in-sample; CV rms % predicts each mode number left "
-            "out of the fit (leave-one-mode-out cross-validation), the honest measure of the gain."), ""]
+            "out of the fit (leave-one-mode-out cross-validation). The gain also predicts each test from the "
+            "others (leave-one-test-out, its tension as stated): the honest measure on real data."), ""]
 
 
 def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
@@ -146,12 +165,16 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
     sel = d.selection
     n = d.measured.size
     out = ["## Named cause", "", d.cause_text(), "", sel.statement, ""]
-    if sel.effects:
-        out.append(f"Principal effect: {sel.principal}. Removal cost (AICc rise when an effect is dropped): "
+    if sel.fitted:
+        out.append(f"Principal effect: {sel.principal or 'none (corrections only)'}. Removal cost (AICc rise when "
+                   f"an effect is dropped): "
                    + "; ".join(f"{e} {number(v, '{:.1f}', finite_only=True)}" for e, v in sel.removal_cost.items())
                    + ".")
         out.append("Ambiguous alternatives (ΔAICc < 2): "
                    + ("; ".join(effects_label(a) for a in sel.ambiguous_with) if sel.ambiguous_with else "none") + ".")
+        out.append("Alternatives the frequencies alone do not separate, set aside for implausible departures from "
+                   "the nominal values: "
+                   + ("; ".join(effects_label(a) for a in sel.implausible) if sel.implausible else "none") + ".")
         out += ["", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
     best = d.ranked[0]
     searched = max((len(e) for e in d.fits if e != BASELINE), default=0)
@@ -199,19 +222,23 @@ def _gain_section(d, gain: pd.DataFrame) -> list[str]:
                 f"model")
     if "rms_error_baseline" in g:
         sentence += f", {percent(g['rms_error_baseline'])} with tension and EI re-estimated (baseline)"
-    sentence += (f" and {percent(g['rms_error_corrected'])} with the named cause ({effects_label(d.corrected.effects)}); "
+    sentence += (f" and {percent(g['rms_error_corrected'])} with the corrected model ({effects_label(d.corrected.effects)}); "
                  f"cross-validated, nominal {percent(g['cv_rms_error_nominal'])}")
     if "rms_error_baseline" in g:
         sentence += f", baseline {percent(g.get('cv_rms_error_baseline'))}"
     sentence += f", corrected {percent(g['cv_rms_error_corrected'])}."
+    if d.test_cv:
+        sentence += (" Predicting each test from the others (leave one test out, its tension as stated): "
+                     + ", ".join(f"{label} {percent(value)}" for label, value in d.test_cv.items()) + ".")
     out = ["## Gain", "", sentence, ""]
     if d.selection.effects and d.corrected.rms_error > d.nominal.rms_error:
         out += [(f"The corrected model lowers χ² (errors in Hz weighted by the uncertainties) but its relative "
                 f"rms error ({percent(d.corrected.rms_error)}) is larger than the nominal model's "
                 f"({percent(d.nominal.rms_error)})."), ""]
     columns = {"model": "model", "effects": "effects", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
-               "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %"}
-    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
+               "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %", "test_cv_rms_error_%": "test CV rms %"}
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}",
+           "test_cv_rms_error_%": "{:.3f}"}
     return out + [markdown_table(gain, fmt, columns)]
 
 

@@ -11,11 +11,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import effects as registry
 from ..compare import ForwardResult
+from ..effects.base import Context
 from ..formatting import percent_error
 from ..identify.problem import Measurement
-from .. import effects as registry
-from ..effects.base import Context
 from ..model import Cable, Campaign
 from ..settings import Settings
 from .fitting import HypothesisFit
@@ -74,6 +74,10 @@ class Diagnosis:
         The nominal model against the measured frequencies (taut string,
         pinned beam, DSM), computed by :func:`~stcs_ident.diagnose.diagnose`
         with the same settings.
+    test_cv : dict
+        Leave-one-test-out prediction error (%) of ``nominal``, ``baseline``
+        and ``corrected`` (each test predicted by the model fitted to the
+        others; empty with one test).
     """
 
     campaign: Campaign
@@ -88,6 +92,7 @@ class Diagnosis:
     considered: tuple = ()
     settings: Settings = field(default_factory=Settings)
     comparison: ForwardResult | None = None
+    test_cv: dict = field(default_factory=dict)
 
     @property
     def measured(self) -> np.ndarray:
@@ -99,8 +104,9 @@ class Diagnosis:
 
     @property
     def corrected(self) -> HypothesisFit:
-        """The fit of the named cause (the nominal model when the cause is empty)."""
-        return self.fits[self.selection.effects]
+        """The chosen hypothesis: the named cause and the corrections within tolerance (the nominal model
+        when the data need neither)."""
+        return self.fits[self.selection.fitted]
 
     @property
     def baseline(self) -> HypothesisFit | None:
@@ -151,6 +157,7 @@ class Diagnosis:
                                "rms_error": _finite_or_none(f.rms_error), "failed": f.failure,
                                "aicc": _finite_or_none(f.aicc), "delta_aicc": _finite_or_none(f.aicc - best),
                                "cv_rms_error": _finite_or_none(f.cv_rms_error), "cv_rank": cv_rank.get(f.effects),
+                               "epsilon": f.epsilon, "prior_penalty": f.penalty,
                                "notes": [str(n) for n in f.notes]})
         sel = self.selection
         values, sigmas = self.parameters(corrected)
@@ -160,12 +167,21 @@ class Diagnosis:
         if baseline is not None:
             gain["rms_error_baseline"] = baseline.rms_error
             gain["cv_rms_error_baseline"] = _finite_or_none(baseline.cv_rms_error)
+        for label, value in self.test_cv.items():
+            gain[f"test_cv_rms_error_{label}"] = value
+        cause_values = {e: v for e, v in values.items() if e in sel.effects}
+        cause_sigmas = {e: v for e, v in sigmas.items() if e in sel.effects}
         return {
             "campaign": self.campaign.name,
             "tests": tests,
             "hypotheses": hypotheses,
-            "cause": {"effects": list(sel.effects), "principal": sel.principal, "parameters": values,
-                      "uncertainty": sigmas, "ambiguous_with": [list(a) for a in sel.ambiguous_with],
+            "cause": {"effects": list(sel.effects), "principal": sel.principal, "parameters": cause_values,
+                      "uncertainty": cause_sigmas, "ambiguous_with": [list(a) for a in sel.ambiguous_with],
+                      "fitted": list(sel.fitted),
+                      "corrections": {e: values.get(e, {}) for e in sel.corrections},
+                      "corrections_uncertainty": {e: sigmas.get(e, {}) for e in sel.corrections},
+                      "implausible": [list(a) for a in sel.implausible], "model_error": sel.model_error,
+                      "epsilon": corrected.epsilon,
                       "explained_by_nominal": sel.explained, "p_value_nominal": sel.p_value,
                       "removal_cost": {k: _finite_or_none(v) for k, v in sel.removal_cost.items()},
                       "statement": sel.statement, "description": self.cause_text()},
@@ -186,9 +202,15 @@ class Diagnosis:
     def cause_text(self) -> str:
         """The named cause in plain words, with values and uncertainties."""
         sel = self.selection
-        if not sel.effects:
-            return sel.statement
         values, sigmas = self.parameters(self.corrected)
+        corrections = ""
+        if sel.corrections:
+            said = [registry.get(e).describe(values.get(e, {}), sigmas.get(e, {}), self.campaign.cable)
+                    for e in sel.corrections]
+            corrections = (f" Corrections within the tolerance of the nominal values (not causes): "
+                           f"{'; '.join(said)}.")
+        if not sel.effects:
+            return sel.statement + corrections
         parts = [registry.get(e).describe(values.get(e, {}), sigmas.get(e, {}), self.campaign.cable)
                  for e in sel.effects]
         delta = self.nominal.aicc - self.corrected.aicc
@@ -205,4 +227,11 @@ class Diagnosis:
         if sel.ambiguous_with:
             text += (" Not told apart from: " + "; ".join(" + ".join(a) for a in sel.ambiguous_with)
                      + " (ΔAICc < 2).")
-        return text
+        if sel.implausible:
+            text += (" The frequencies alone do not separate it from "
+                     + "; ".join(" + ".join(a) for a in sel.implausible)
+                     + ", which need departures beyond the tolerances of the nominal values.")
+        if chosen.epsilon > 0:
+            text += (f" No hypothesis reaches the measurement uncertainty: the ranking includes a model error of "
+                     f"{chosen.epsilon:.2g} (relative, per frequency) for this one.")
+        return text + corrections

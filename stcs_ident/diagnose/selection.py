@@ -7,7 +7,16 @@
    empty: no effect is invented. ALPHA = 0.001 keeps false alarms at about
    one in a thousand data sets with honest uncertainties, while a hidden
    effect worth naming raises χ² by orders of magnitude.
-2. **Ranking**: by AICc (:func:`~.fitting.aicc`), best first.
+2. **Ranking**: by AICc (:func:`~.fitting.aicc`), best first. Parameters
+   whose nominal value has a tolerance (:mod:`stcs_ident.effects`: a
+   stated tension, the nominal EI, a recorded position or mass, the
+   length) carry a Gaussian prior of that width, and its penalty counts in
+   AICc: of two hypotheses the frequencies cannot tell apart (tension +
+   length reproduce any EI change exactly), the one that needs the more
+   plausible departures wins. When no hypothesis reaches the measurement
+   uncertainty (step 3's gate fails for all), every hypothesis gets a
+   relative model error ε per frequency (:mod:`.model_error`) and AICc is
+   that of the likelihood with it, one more parameter each.
 3. **Parsimony**: a hypothesis nested in the best one (a subset of its
    effects) that is within :data:`AMBIGUITY` of it in AICc explains the data
    as well with fewer effects and is preferred (Burnham & Anderson: an
@@ -20,7 +29,16 @@
    raises AICc most.
 5. **Ambiguity**: every other hypothesis within :data:`AMBIGUITY` of the
    chosen one's AICc and not merely the chosen effects plus another is
-   reported as ambiguous, never hidden.
+   reported as ambiguous, never hidden; so are those that explain the
+   frequencies as well (within their uncertainty, or χ² within AMBIGUITY of
+   the chosen one's) but need less plausible departures (``implausible``).
+6. **Corrections or causes**: an effect with a tolerance is a *cause* only
+   when the data require a departure beyond it: for some parameter,
+   (|x − nominal| − tolerance) > :data:`BEYOND` σ. Otherwise it is a
+   *correction* (reported with its value, never as a cause). Effects
+   without a tolerance (an unmodeled mass or support, an end restraint)
+   are causes when chosen. The corrected model is the chosen hypothesis,
+   corrections included.
 """
 
 from __future__ import annotations
@@ -31,7 +49,7 @@ from dataclasses import dataclass
 from scipy.stats import chi2 as chi2_distribution
 
 from .. import effects
-from .fitting import HypothesisFit
+from .fitting import HypothesisFit, prior_widths
 
 #: False-alarm probability of the test "the nominal model explains the data".
 ALPHA = 1e-3
@@ -39,6 +57,9 @@ ALPHA = 1e-3
 AMBIGUITY = 2.0
 #: The baseline hypothesis: the source paper's correction of tension and EI.
 BASELINE = effects.baseline()
+#: A departure is beyond tolerance when it exceeds it by more than this many standard deviations
+#: (one-sided 97.7 %: the data require it).
+BEYOND = 2.0
 
 
 @dataclass(frozen=True)
@@ -48,7 +69,8 @@ class Selection:
     Attributes
     ----------
     effects : tuple of str
-        The cause (empty when the nominal model explains the data).
+        The cause (empty when the nominal model explains the data, or
+        needs only corrections within tolerance).
     principal : str or None
     ambiguous_with : tuple of tuple of str
     explained : bool
@@ -60,6 +82,18 @@ class Selection:
         ΔAICc when each effect of the cause is removed.
     statement : str
         One sentence on what was decided and why.
+    fitted : tuple of str
+        The chosen hypothesis (the cause and the corrections): the
+        corrected model.
+    corrections : tuple of str
+        Effects of the chosen hypothesis whose departures stay within the
+        tolerance of the nominal values.
+    implausible : tuple of tuple of str
+        Hypotheses the frequencies alone do not separate from the chosen
+        one, that lose on the plausibility of their departures.
+    model_error : bool
+        Whether no hypothesis reaches the measurement uncertainty, so that
+        AICc includes a model error ε.
     """
 
     effects: tuple[str, ...]
@@ -69,6 +103,10 @@ class Selection:
     p_value: float
     removal_cost: dict[str, float]
     statement: str
+    fitted: tuple[str, ...] = ()
+    corrections: tuple[str, ...] = ()
+    implausible: tuple[tuple[str, ...], ...] = ()
+    model_error: bool = False
 
 
 def explains(nominal: HypothesisFit, n: int) -> bool:
@@ -87,6 +125,21 @@ def _p_value(chi2: float, dof: int) -> float:
     return float(chi2_distribution.sf(chi2, dof))
 
 
+def allowed(effects_: tuple[str, ...], max_effects: int) -> bool:
+    """Whether a hypothesis may be chosen: at most ``max_effects`` effects, or the baseline (tension and EI)
+    plus at most ``max_effects`` − 1 further ones."""
+    if len(effects_) <= max_effects:
+        return True
+    return set(BASELINE) <= set(effects_) and len(effects_) <= len(BASELINE) + max_effects - 1
+
+
+def needs_model_error(fits: dict[tuple[str, ...], HypothesisFit], n: int) -> bool:
+    """Whether no fitted hypothesis (the nominal model included) explains the data within their uncertainty:
+    the ranking then needs a model error (:mod:`.model_error`)."""
+    fitted = [f for f in fits.values() if f.failure is None and math.isfinite(f.chi2)]
+    return bool(fitted) and not any(_within_noise(f, n) for f in fitted)
+
+
 def ranking(fits: dict[tuple[str, ...], HypothesisFit]) -> list[HypothesisFit]:
     """Fits sorted by AICc (ties: fewer parameters first)."""
     return sorted(fits.values(), key=lambda f: (f.aicc, f.n_parameters, len(f.effects)))
@@ -101,11 +154,12 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
         return Selection((), None, (), True, p_value, {},
                          f"The nominal model explains the data within their uncertainty: chi2 = {nominal.chi2:.1f} "
                          f"for {n} frequencies (p = {p_value:.3g} >= {ALPHA:g}); no effect is named.")
-    ranked = [f for f in ranking(fits) if f.effects and len(f.effects) <= max_effects and math.isfinite(f.aicc)]
+    ranked = [f for f in ranking(fits) if f.effects and allowed(f.effects, max_effects) and math.isfinite(f.aicc)]
+    model_error = needs_model_error(fits, n)
     if not ranked or ranked[0].aicc >= nominal.aicc:
         return Selection((), None, (), False, p_value, {},
                          f"The nominal model does not explain the data (chi2 = {nominal.chi2:.1f} for {n} "
-                         f"frequencies, p = {p_value:.2g}), but no hypothesis improves on it.")
+                         f"frequencies, p = {p_value:.2g}), but no hypothesis improves on it.", model_error=model_error)
     best = ranked[0]
     while True:
         nested = [f for f in ranked if f.effects and set(f.effects) < set(best.effects)
@@ -113,18 +167,50 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
         if not nested:
             break
         best = min(nested, key=lambda f: (len(f.effects), f.aicc))
+    beyond = beyond_tolerance(best)
+    corrections = tuple(e for e in best.effects if beyond.get(e) is False)
+    cause = tuple(e for e in best.effects if e not in corrections)
     cost = {}
     for e in best.effects:
         rest = tuple(x for x in best.effects if x != e)
         other = fits.get(rest)
-        cost[e] = (other.aicc - best.aicc) if other is not None else math.inf
-    principal = max(cost, key=lambda e: cost[e])
+        cost[e] = (other.aicc - best.aicc) if other is not None and math.isfinite(other.aicc) else math.inf
+    principal = max(cause, key=lambda e: cost[e]) if cause else None
     ambiguous = tuple(f.effects for f in ranked if f is not best and f.aicc - best.aicc < AMBIGUITY
                       and not set(f.effects) > set(best.effects))
+    implausible = tuple(f.effects for f in ranked if f is not best and f.effects not in ambiguous
+                        and not set(f.effects) > set(best.effects) and f.penalty > best.penalty + AMBIGUITY
+                        and (_within_noise(f, n) or f.chi2 - best.chi2 < AMBIGUITY))
     delta = nominal.aicc - best.aicc
-    statement = (f"The nominal model does not explain the data (chi2 = {nominal.chi2:.1f} for {n} frequencies, "
-                 f"p = {p_value:.2g}); {' + '.join(best.effects)} explains them best "
-                 f"(AICc {delta:.1f} below the nominal model's)")
+    head = (f"The nominal model does not explain the data (chi2 = {nominal.chi2:.1f} for {n} frequencies, "
+            f"p = {p_value:.2g}); ")
+    shown = " + ".join(best.effects)
+    if cause:
+        statement = head + f"{shown} explains them best (AICc {delta:.1f} below the nominal model's)"
+        if corrections:
+            statement += f"; {', '.join(corrections)} within tolerance (a correction, not a cause)"
+    else:
+        statement = (head + f"corrections within the tolerances of the nominal values ({shown}) explain them "
+                     f"(AICc {delta:.1f} below the nominal model's); no effect is named")
     if ambiguous:
         statement += f", but {'; '.join(' + '.join(a) for a in ambiguous)} explain them about as well (ΔAICc < 2)"
-    return Selection(best.effects, principal, ambiguous, False, p_value, cost, statement + ".")
+    return Selection(cause, principal, ambiguous, False, p_value, cost, statement + ".", best.effects, corrections,
+                     implausible, model_error)
+
+
+def beyond_tolerance(fit: HypothesisFit) -> dict[str, bool]:
+    """For each effect of ``fit`` whose parameters have a tolerance: whether the data require a departure
+    beyond it (step 6 of the module docstring)."""
+    if fit.result is None:
+        return {}
+    widths = prior_widths(fit.hypothesis.campaign, fit.hypothesis)
+    res = fit.result
+    out: dict[str, bool] = {}
+    for p, owner, x, sigma, width in zip(res.parameters, fit.hypothesis.owners, res.estimate, res.uncertainty,
+                                         widths):
+        if width is None:
+            continue
+        excess = abs(float(x) - p.start) - width
+        required = bool(excess > 0 and math.isfinite(sigma) and excess > BEYOND * sigma)
+        out[owner] = out.get(owner, False) or required
+    return out

@@ -73,7 +73,8 @@ def ranking_table(diagnosis) -> pd.DataFrame:
     rows = []
     for rank, f in enumerate(ranked, start=1):
         rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters, "chi2": f.chi2,
-                     "reduced_chi2": _reduced_chi2(f, n), "aicc": f.aicc, "delta_aicc": f.aicc - best,
+                     "reduced_chi2": _reduced_chi2(f, n), "prior_penalty": f.penalty, "epsilon": f.epsilon,
+                     "aicc": f.aicc, "delta_aicc": f.aicc - best,
                      "rms_error_%": f.rms_error,
                      "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
                      "cause": f.effects == d.selection.effects,
@@ -110,15 +111,19 @@ def gain_table(diagnosis) -> pd.DataFrame:
             continue
         rows.append({"model": key, "effects": effects_label(fit.effects), "k": fit.n_parameters, "chi2": fit.chi2,
                      "reduced_chi2": _reduced_chi2(fit, n), "aicc": fit.aicc, "rms_error_%": fit.rms_error,
-                     "cv_rms_error_%": math.nan if fit.cv_rms_error is None else fit.cv_rms_error})
+                     "cv_rms_error_%": math.nan if fit.cv_rms_error is None else fit.cv_rms_error,
+                     "test_cv_rms_error_%": d.test_cv.get(key, math.nan)})
     return pd.DataFrame(rows)
 
 
 def cause_table(diagnosis) -> pd.DataFrame:
-    """The parameters of the named cause (no rows when the cause is empty)."""
+    """The parameters of the chosen hypothesis, each marked ``cause`` or ``correction`` (within the tolerance
+    of its nominal value); no rows when the nominal model stands."""
     d = diagnosis
-    rows = parameter_rows(*d.parameters(d.corrected)) if d.selection.effects else []
-    return pd.DataFrame(rows, columns=["effect", "parameter", "value", "uncertainty", "unit"])
+    rows = parameter_rows(*d.parameters(d.corrected)) if d.selection.fitted else []
+    for row in rows:
+        row["role"] = "correction" if row["effect"] in d.selection.corrections else "cause"
+    return pd.DataFrame(rows, columns=["effect", "role", "parameter", "value", "uncertainty", "unit"])
 
 
 def nominal_comparison(diagnosis) -> pd.DataFrame:

@@ -162,6 +162,15 @@ class Effect:
         """The identification parameters the effect frees for the measured ``tests``."""
         return list(parse_parameters(campaign, tests, self.parameter_kind))
 
+    def prior_width(self, p: Parameter, tolerance: float | None) -> float | None:
+        """Standard width of the Gaussian prior of ``p`` (variable units) that the tolerance of the
+        nominal value gives, or None (no tolerance, or a relative one of a zero nominal value)."""
+        if tolerance is None or self.tolerance is None:
+            return None
+        if self.tolerance.relative:
+            return tolerance if p.is_ratio else None
+        return tolerance / p.scale
+
     def record(self, p: Parameter, variable: float, sigma: float, value: float, value_sigma: float | None,
                values: dict, sigmas: dict, context: Context) -> None:
         """Put one fitted parameter into ``values`` and ``sigmas`` (this effect's entries, JSON units).
