@@ -97,6 +97,7 @@ class CableBatch:
             length, positions, weight / tension, self.kinks
         )
         self.stretched = stretched_lengths(self.seg_len, self.slope_start, self.slope_end)
+        self._stretched_total = self.stretched.sum(axis=1)
         self.v_dof, self.t_dof, self.h_dof, self.n_dof = _dof_map(topology)
         self._constant = self._constant_part()
         self._scale = self._dof_scales()
@@ -120,33 +121,33 @@ class CableBatch:
 
     def _constant_part(self):
         """The ω-independent part of K per configuration: springs, end
-        restraints, the −L_e/EA diagonal and the static-slope couplings."""
+        restraints, the −L_e/EA diagonal and the static-slope couplings.
+
+        Every entry receives one term at most, so all are written by one
+        indexed addition onto zeros (positions from :func:`_constant_layout`)."""
         topo = self.topology
-        K = np.zeros((len(self.length), self.n_dof, self.n_dof))
+        n = len(self.length)
+        values = []
         if topo.n_attachments:
-            v = self.v_dof[1:-1]
-            K[:, v, v] += self.springs
+            values.append(self.springs)
         if not topo.string:
             for node, end in ((0, self.end_a), (topo.n_attachments + 1, self.end_b)):
-                t = self.t_dof[node]
-                if t >= 0:
-                    K[:, t, t] += end
+                if self.t_dof[node] >= 0:
+                    values.append(end[:, None])
         if topo.tension_model == "uniform":
-            h = self.h_dof[0]
-            K[:, h, h] -= self.stretched.sum(axis=1) / self.EA
+            values.append(-(self._stretched_total / self.EA)[:, None])
             if topo.n_attachments:
-                K[:, self.v_dof[1:-1], h] += self.kinks
-                K[:, h, self.v_dof[1:-1]] += self.kinks
+                values += [self.kinks, self.kinks]
         elif topo.tension_model == "per-segment":
             for j in range(topo.n_segments):
-                h = self.h_dof[j]
-                K[:, h, h] -= self.stretched[:, j] / self.EA
+                values.append(-(self.stretched[:, j] / self.EA)[:, None])
                 for node, slope in ((j, -self.slope_start[:, j]), (j + 1, self.slope_end[:, j])):
-                    v = self.v_dof[node]
-                    if v >= 0:
-                        K[:, v, h] += slope
-                        K[:, h, v] += slope
-        return K.reshape(len(self.length), -1)
+                    if self.v_dof[node] >= 0:
+                        values += [slope[:, None], slope[:, None]]
+        K = np.zeros((n, self.n_dof * self.n_dof))
+        if values:
+            K[:, _constant_layout(topo)] += np.concatenate(values, axis=1)
+        return K
 
     def _dof_scales(self):
         """Fixed (ω-independent) scale of every unknown, so that the scaled
@@ -162,13 +163,12 @@ class CableBatch:
             with np.errstate(divide="ignore"):
                 p = np.maximum(np.sqrt(self.H / self.EI), 1.0 / self.length)
         scale = np.ones((n, self.n_dof))
-        v = self.v_dof[self.v_dof >= 0]
+        v, t = _free_dofs(topo)
         scale[:, v] = 1.0 / np.sqrt(self.H * p)[:, None]
-        t = self.t_dof[self.t_dof >= 0]
         if t.size:
             scale[:, t] = 1.0 / np.sqrt(self.EI * p)[:, None]
         if topo.n_h:
-            scale[:, self.h_dof] = np.sqrt(self.EA / self.stretched.sum(axis=1))[:, None]
+            scale[:, self.h_dof] = np.sqrt(self.EA / self._stretched_total)[:, None]
         return scale
 
     def assemble(self, idx, omega, segments=None):
@@ -232,6 +232,37 @@ def _scatter_matrix(topo):
         for r, c in pairs:
             S[col, r * nd + c] += 1.0
     return S
+
+
+@functools.lru_cache(maxsize=64)
+def _constant_layout(topo):
+    """Flat positions (row × n_dof + column) in K of the terms of
+    :meth:`CableBatch._constant_part`, in the order it lists them."""
+    v, t, h, nd = _dof_map(topo)
+    pairs = [(v[k + 1], v[k + 1]) for k in range(topo.n_attachments)]
+    if not topo.string:
+        pairs += [(t[node], t[node]) for node in (0, topo.n_attachments + 1) if t[node] >= 0]
+    if topo.tension_model == "uniform":
+        pairs.append((h[0], h[0]))
+        inner = v[1:-1]
+        pairs += [(d, h[0]) for d in inner] + [(h[0], d) for d in inner]
+    elif topo.tension_model == "per-segment":
+        for j in range(topo.n_segments):
+            pairs.append((h[j], h[j]))
+            for node in (j, j + 1):
+                if v[node] >= 0:
+                    pairs += [(v[node], h[j]), (h[j], v[node])]
+    flat = np.array([r * nd + c for r, c in pairs], dtype=np.intp)
+    assert len(set(flat.tolist())) == len(flat), "one term per entry"
+    flat.flags.writeable = False
+    return flat
+
+
+@functools.lru_cache(maxsize=64)
+def _free_dofs(topo):
+    """Indices of the free displacement and rotation unknowns."""
+    v, t, _, _ = _dof_map(topo)
+    return v[v >= 0], t[t >= 0]
 
 
 def _element_dofs(topo, j):

@@ -11,6 +11,7 @@ Public entry points:
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 
@@ -71,56 +72,101 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
             raise ModelError(f"last axis must have one value per attachment ({na})", field=k)
         att_arrays[k] = v
     shape = np.broadcast_shapes(*(a.shape for a in arrays.values()), *(a.shape[:-1] for a in att_arrays.values()))
-    n = int(np.prod(shape, dtype=np.int64))
-    flat = {k: np.broadcast_to(v, shape).reshape(n) for k, v in arrays.items()}
-    flat.update({k: np.broadcast_to(v, shape + (na,)).reshape(n, na) for k, v in att_arrays.items()})
-    _validate_arrays(flat)
-    order = np.argsort(flat["positions"], axis=1)
-    for k in per_att:
-        flat[k] = np.take_along_axis(flat[k], order, axis=1)
+    n = math.prod(shape)
+    # Checked before broadcasting (every value reaches some parameter set when there is one), so
+    # a value repeated over the batch is checked once; an empty batch has nothing to check.
+    ascending = _validate_inputs(arrays, att_arrays) if n else True
+    flat = {k: _flat(v, shape, n) for k, v in arrays.items()}
+    flat.update({k: _flat(v, shape, n, na) for k, v in att_arrays.items()})
+    if not ascending:
+        order = np.argsort(flat["positions"], axis=1)
+        for k in per_att:
+            flat[k] = np.take_along_axis(flat[k], order, axis=1)
     theta, g = cable.inclination, cable.gravity
     model = tension_model if cable.EA is not None else "none"
+    ends = (arrays["end_a"], arrays["end_b"], arrays["EI"])
+    if not n:
+        kinds = []
+    elif all(a.ndim == 0 for a in ends):  # not overridden: one topology
+        kinds = [(bool(np.isinf(ends[0])), bool(np.isinf(ends[1])), bool(ends[2] == 0), None)]
+    else:
+        clamped_a, clamped_b = np.isinf(flat["end_a"]), np.isinf(flat["end_b"])
+        string = flat["EI"] == 0
+        flags = (clamped_a, clamped_b, string)
+        if all(f.all() or not f.any() for f in flags):
+            kinds = [(bool(clamped_a[0]), bool(clamped_b[0]), bool(string[0]), None)]
+        else:
+            kinds = [(ca, cb, st, np.flatnonzero((clamped_a == ca) & (clamped_b == cb) & (string == st)))
+                     for ca, cb, st in {(bool(x), bool(y), bool(z)) for x, y, z in zip(*flags)}]
     groups = []
-    clamped_a, clamped_b = np.isinf(flat["end_a"]), np.isinf(flat["end_b"])
-    string = flat["EI"] == 0
-    for ca, cb, st in {(bool(x), bool(y), bool(z)) for x, y, z in zip(clamped_a, clamped_b, string)}:
-        sel = np.flatnonzero((clamped_a == ca) & (clamped_b == cb) & (string == st))
-        topo = Topology(na, ca or st, cb or st, st, model)
-        m = flat["mass_per_length"][sel]
+    for ca, cb, st, sel in kinds:
+        topo = _topology(na, ca or st, cb or st, st, model)
+        part = flat if sel is None else {k: v[sel] for k, v in flat.items()}
+        m = part["mass_per_length"]
+        count = len(m)
         batch = CableBatch(
             topo,
-            length=flat["length"][sel], mass_per_length=m, EI=flat["EI"][sel],
-            tension=flat["tension"][sel],
-            EA=np.full(len(sel), cable.EA if cable.EA is not None else np.inf),
-            weight=m * g * math.cos(theta), gcos=np.full(len(sel), g * math.cos(theta)),
-            positions=flat["positions"][sel], masses=flat["masses"][sel], springs=flat["stiffnesses"][sel],
-            end_a=flat["end_a"][sel], end_b=flat["end_b"][sel],
+            length=part["length"], mass_per_length=m, EI=part["EI"],
+            tension=part["tension"],
+            EA=np.full(count, cable.EA if cable.EA is not None else np.inf),
+            weight=m * g * math.cos(theta), gcos=np.full(count, g * math.cos(theta)),
+            positions=part["positions"], masses=part["masses"], springs=part["stiffnesses"],
+            end_a=part["end_a"], end_b=part["end_b"],
         )
-        groups.append((batch, sel))
+        groups.append((batch, np.arange(n) if sel is None else sel))
     return shape, groups
 
 
-def _validate_arrays(flat):
+@functools.lru_cache(maxsize=256)
+def _topology(n_attachments, clamped_a, clamped_b, string, tension_model):
+    return Topology(n_attachments, clamped_a, clamped_b, string, tension_model)
+
+
+def _flat(v, shape, n, *tail):
+    """``v`` broadcast to ``shape + tail`` as an (n, *tail) array (a view when it has that shape)."""
+    full = shape + tail
+    if v.shape == full:
+        return v.reshape((n,) + tail)
+    out = np.empty((n,) + tail)
+    out.reshape(full)[...] = v
+    return out
+
+
+def _at_least(v, low, strict):
+    """Whether every value of ``v`` is finite and > ``low`` (``strict``) or >= ``low``."""
+    if v.ndim == 0:
+        x = float(v)
+        return math.isfinite(x) and (x > low if strict else x >= low)
+    if not v.size:
+        return True
+    lo = v.min()  # NaN propagates, and fails both comparisons
+    return bool((lo > low if strict else lo >= low) and v.max() < math.inf)
+
+
+def _validate_inputs(arrays, att_arrays):
+    """Check the parameter values (before broadcasting); whether every row's positions ascend."""
     for name in ("tension", "length", "mass_per_length"):
-        v = flat[name]
-        if not np.all(np.isfinite(v) & (v > 0)):
+        if not _at_least(arrays[name], 0.0, True):
             raise ModelError("must be finite and > 0", field=name)
-    for name in ("EI", "masses", "stiffnesses"):
-        v = flat[name]
-        if not np.all(np.isfinite(v) & (v >= 0)):
+    for name, v in (("EI", arrays["EI"]), ("masses", att_arrays["masses"]),
+                    ("stiffnesses", att_arrays["stiffnesses"])):
+        if not _at_least(v, 0.0, False):
             raise ModelError("must be finite and >= 0", field=name)
     for name in ("end_a", "end_b"):
-        v = flat[name]
-        if np.any(np.isnan(v) | (v < 0)):
+        v = arrays[name]
+        if not (v.min() >= 0 if v.ndim else float(v) >= 0):  # NaN fails; inf (clamped) passes
             raise ModelError("must be >= 0 (inf for clamped)", field=name)
-    pos = flat["positions"]
-    if pos.size:
-        inside = (pos > 0) & (pos < flat["length"][:, None])
-        if not np.all(inside):
-            raise ModelError("attachments must lie strictly inside the span", field="positions")
-        s = np.sort(pos, axis=1)
-        if np.any(np.diff(s, axis=1) <= 0):
-            raise ModelError("two attachments at one position", field="positions")
+    pos = att_arrays["positions"]
+    if not pos.size:
+        return True
+    if not ((pos > 0).all() and (pos < arrays["length"][..., None]).all()):
+        raise ModelError("attachments must lie strictly inside the span", field="positions")
+    if pos.shape[-1] < 2 or (pos[..., 1:] - pos[..., :-1] > 0).all():
+        return True
+    s = np.sort(pos, axis=-1)
+    if np.any(s[..., 1:] - s[..., :-1] <= 0):
+        raise ModelError("two attachments at one position", field="positions")
+    return False
 
 
 def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, n_modes: int = 6, *,
@@ -153,21 +199,43 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
         raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
     n_modes = int(n_modes)
     shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
-    total = int(np.prod(shape, dtype=np.int64))
+    total = math.prod(shape)
+    if len(groups) == 1 and total <= CHUNK:  # the usual small batch: no scattering
+        config, mode = _items(0, total, n_modes)
+        out = solve_modes(groups[0][0], config, mode).reshape(total, n_modes) / (2 * math.pi)
+        if progress is not None:
+            progress(total, total)
+        return out.reshape(shape + (n_modes,))
     out = np.empty((total, n_modes))
-    modes = np.arange(1, n_modes + 1)
     done = 0
     for batch, sel in groups:
         for start in range(0, len(sel), CHUNK):
-            cfg = np.arange(start, min(start + CHUNK, len(sel)))
-            config = np.repeat(cfg, n_modes)
-            mode = np.tile(modes, len(cfg))
+            stop = min(start + CHUNK, len(sel))
+            config, mode = _items(start, stop, n_modes)
             omega = solve_modes(batch, config, mode)
-            out[sel[cfg]] = omega.reshape(len(cfg), n_modes) / (2 * math.pi)
-            done += len(cfg)
+            out[sel[start:stop]] = omega.reshape(stop - start, n_modes) / (2 * math.pi)
+            done += stop - start
             if progress is not None:
                 progress(done, total)
     return out.reshape(shape + (n_modes,))
+
+
+def _items(start, stop, n_modes):
+    """(configuration, mode) of every item of configurations ``start:stop``, modes 1..n_modes."""
+    if start == 0 and stop <= 256:
+        return _small_items(stop, n_modes)
+    config = np.repeat(np.arange(start, stop, dtype=np.int64), n_modes)
+    mode = np.tile(np.arange(1, n_modes + 1, dtype=np.int64), stop - start)
+    return config, mode
+
+
+@functools.lru_cache(maxsize=256)
+def _small_items(count, n_modes):
+    """The items of a small batch, shared between calls (so read-only)."""
+    config = np.repeat(np.arange(count, dtype=np.int64), n_modes)
+    mode = np.tile(np.arange(1, n_modes + 1, dtype=np.int64), count)
+    config.flags.writeable = mode.flags.writeable = False
+    return config, mode
 
 
 def natural_frequencies(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
