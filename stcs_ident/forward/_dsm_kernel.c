@@ -17,6 +17,7 @@
 #include <math.h>
 #include <string.h>
 #include <stdlib.h>
+#include <stdint.h>
 
 #define RTOL 2e-13
 #define MAX_ITER 200
@@ -237,6 +238,64 @@ static int solve_one(const Problem *P, long long cfg, long long mode, double *re
     return -2;
 }
 
+/* Whether configurations a and b have identical inputs (bit for bit), so identical roots. */
+static int same_config(const Problem *P, long long a, long long b) {
+    int nd = P->n_dof, ns = P->n_seg, na = P->n_att;
+    if (a == b) return 1;
+#define SAME(arr, n) (memcmp((arr) + a * (n), (arr) + b * (n), sizeof(double) * (size_t)(n)) == 0)
+    return SAME(P->length, 1) && SAME(P->m, 1) && SAME(P->EI, 1) && SAME(P->H, 1) && SAME(P->w, 1)
+        && SAME(P->seg_len, ns) && SAME(P->masses, na) && SAME(P->scale, nd) && SAME(P->kconst, nd * nd);
+#undef SAME
+}
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) { h ^= p[i]; h *= 1099511628211ULL; }
+    return h;
+}
+
+static uint64_t config_hash(const Problem *P, long long c) {
+    int nd = P->n_dof, ns = P->n_seg, na = P->n_att;
+    uint64_t h = 14695981039346656037ULL;
+#define MIX(arr, n) h = fnv1a(h, (arr) + c * (n), sizeof(double) * (size_t)(n))
+    MIX(P->length, 1); MIX(P->m, 1); MIX(P->EI, 1); MIX(P->H, 1); MIX(P->w, 1);
+    MIX(P->seg_len, ns); MIX(P->masses, na); MIX(P->scale, nd); MIX(P->kconst, nd * nd);
+#undef MIX
+    return h;
+}
+
+/* source[i] = an earlier item with the same mode and identical inputs, or -1: such an item
+ * (the rows of a finite-difference Jacobian that do not move a test's parameters are copies
+ * of its base row) takes that item's root instead of being solved again. Returns 0, or -1
+ * when out of memory (then nothing is shared). */
+static int find_repeats(const Problem *P, const long long *config, const long long *mode, Py_ssize_t n,
+                        long long *source) {
+    size_t cap = 16;
+    while (cap < 2 * (size_t)n) cap <<= 1;
+    long long *table = malloc(cap * sizeof(long long));
+    uint64_t *hashes = malloc((size_t)(n > 0 ? n : 1) * sizeof(uint64_t));
+    if (!table || !hashes) { free(table); free(hashes); return -1; }
+    for (size_t k = 0; k < cap; k++) table[k] = -1;
+    long long last_cfg = -1;
+    uint64_t last_hash = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (config[i] != last_cfg) { last_cfg = config[i]; last_hash = config_hash(P, last_cfg); }
+        uint64_t h = last_hash ^ ((uint64_t)mode[i] * 0x9E3779B97F4A7C15ULL);
+        hashes[i] = h;
+        source[i] = -1;
+        size_t slot = (size_t)(h ^ (h >> 29)) & (cap - 1);
+        for (;;) {
+            long long j = table[slot];
+            if (j < 0) { table[slot] = i; break; }
+            if (hashes[j] == h && mode[j] == mode[i] && same_config(P, config[j], config[i])) { source[i] = j; break; }
+            slot = (slot + 1) & (cap - 1);
+        }
+    }
+    free(table);
+    free(hashes);
+    return 0;
+}
+
 static int get_buffer(PyObject *obj, Py_buffer *view, const char *name) {
     if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0) {
         PyErr_Format(PyExc_TypeError, "%s: a contiguous buffer is required", name);
@@ -274,10 +333,21 @@ static PyObject *py_solve(PyObject *self, PyObject *args) {
     if (!out) goto done;
     double *omega = (double *)PyBytes_AS_STRING(out);
     Py_ssize_t failed = 0;
+    long long *source = malloc((size_t)(n_items > 0 ? n_items : 1) * sizeof(long long));
     Py_BEGIN_ALLOW_THREADS
-    for (Py_ssize_t i = 0; i < n_items; i++)
-        if (solve_one(&P, config[i], mode[i], &omega[i]) != 0) { omega[i] = NAN; failed++; }
+    int shared = source && find_repeats(&P, config, mode, n_items, source) == 0;
+    for (Py_ssize_t i = 0; i < n_items; i++) {
+        if (shared && source[i] >= 0) {  /* an earlier item, solved already (source -2 if it failed) */
+            omega[i] = omega[source[i]];
+            failed += source[source[i]] == -2;
+        } else if (solve_one(&P, config[i], mode[i], &omega[i]) != 0) {
+            omega[i] = NAN;
+            failed++;
+            if (shared) source[i] = -2;
+        }
+    }
     Py_END_ALLOW_THREADS
+    free(source);
     result = Py_BuildValue("Nn", out, failed);
 done:
     for (int i = 0; i < got; i++) PyBuffer_Release(&views[i]);
