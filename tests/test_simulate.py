@@ -18,7 +18,7 @@ from stcs_ident.forward import natural_frequencies
 from stcs_ident.model import Attachment, Boundary, Cable, Campaign, Setup, Test
 from stcs_ident.simulate.effects import Effects, true_model
 from stcs_ident.simulate.modal_response import (
-    _exponential_gram,
+    exponential_gram,
     modal_force_covariance,
     stationary_covariance,
     zoh_transition,
@@ -176,7 +176,7 @@ def test_exponential_kernel_recursion_equals_the_double_sum():
     """The O(n) one-pole recursion reproduces the O(n²) double sum on the same grid (round-off only)."""
     shapes = modal_basis(CABLE, [], TENSION, 20.0)
     L, spacing = 3.0, 0.05
-    C = _exponential_gram(shapes, LENGTH, L, spacing)
+    C = exponential_gram(shapes, LENGTH, L, spacing)
     x = np.linspace(0, LENGTH, math.ceil(LENGTH / spacing) + 1)
     w = np.full(x.size, x[1] - x[0])
     w[[0, -1]] /= 2

@@ -65,7 +65,7 @@ def modal_force_covariance(shapes: ModeShapes, rms_pressure: float, correlation_
     wavelength = wave_speed / shapes.frequencies[-1]
     if L < wavelength / 200:
         return sigma2 * 2 * L * _gram(shapes)
-    return sigma2 * _exponential_gram(shapes, length, L, min(L / 8, wavelength / 40))
+    return sigma2 * exponential_gram(shapes, length, L, min(L / 8, wavelength / 40))
 
 
 def _gram(shapes: ModeShapes) -> np.ndarray:
@@ -74,7 +74,7 @@ def _gram(shapes: ModeShapes) -> np.ndarray:
     return (phi * w[:, None]).T @ phi
 
 
-def _exponential_gram(shapes: ModeShapes, length: float, L: float, spacing: float) -> np.ndarray:
+def exponential_gram(shapes: ModeShapes, length: float, L: float, spacing: float) -> np.ndarray:
     """Σ_ij v_i v_jᵀ e^{−|x_i−x_j|/L} on a uniform trapezoid grid, v_i = w_i φ(x_i).
 
     On a uniform grid the lower-triangular sum S_i = Σ_{j≤i} e^{−(x_i−x_j)/L} v_j
