@@ -262,3 +262,14 @@ def test_selection_adds_an_effect_only_when_the_simpler_model_fails():
     fits[()] = _fit((), 0, 14.0, n)
     sel = select(fits, n)
     assert sel.effects == () and sel.principal is None and sel.explained
+
+
+def test_a_zero_tolerance_means_the_nominal_value_is_exact():
+    from dataclasses import replace
+
+    campaign, picked = synthetic(Effects(EI_ratio=1.45), seed=8)
+    exact = replace(campaign, tolerance=(("tension", 0.0),))
+    d = diagnose(exact, picked=picked, max_effects=1)
+    assert "tension" not in d.considered and not any(f.failure for f in d.fits.values())
+    assert any("tension = 0" in str(n) for n in d.notes)
+    assert d.summary()["cause"]["effects"] == ["bending_stiffness"]

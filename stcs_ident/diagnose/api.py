@@ -1,9 +1,12 @@
 """Diagnosis: does the nominal model explain the data, and if not, which effect is missing?
 
 :func:`diagnose` fits the nominal model, every single effect of the
-vocabulary and every pair (:mod:`.hypotheses`, :mod:`.fitting`), ranks them
-by AICc, cross-validates each by leaving one mode out, and names the cause
-(:mod:`.selection`).
+vocabulary, every pair and the baseline (tension + EI) plus each further
+effect (:mod:`.hypotheses`, :mod:`.fitting`), ranks them by AICc (with the
+plausibility of their departures from the nominal values and, when no
+hypothesis reaches the measurement uncertainty, a model error),
+cross-validates each by leaving one mode out, names the cause and the
+corrections (:mod:`.selection`) and predicts each test from the others.
 """
 
 from __future__ import annotations

@@ -79,8 +79,9 @@ class HypothesisFit:
         Why the fit failed (it then ranks last: χ² and AICc infinite).
     penalty : float
         How implausible the departures are (:func:`prior_penalty`: −2 log of
-        the Gaussian priors that the tolerances of the nominal values give,
-        at the estimate). The estimate is the data's alone (least squares);
+        the priors that the tolerances of the nominal values give, and the
+        Occam factor of an unmodeled attachment's position, at the
+        estimate). The estimate is the data's alone (least squares);
         ``aicc`` counts the penalty beside ``chi2``, so that of hypotheses the
         frequencies cannot tell apart the more plausible one ranks first.
     epsilon : float
@@ -139,13 +140,29 @@ def hypothesis_problem(hypothesis: Hypothesis, measurements: Sequence[Measuremen
     return Problem(hypothesis.campaign, measurements, chosen, tension_model)
 
 
-def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray) -> float:
-    """Σ ((x − nominal)/width)² over the parameters whose nominal value has a tolerance, at ``estimate``:
-    how implausible the departures a hypothesis needs are (−2 log of their Gaussian prior)."""
+def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray, uncertainty: np.ndarray | None = None) -> float:
+    """How implausible the departures a hypothesis needs are, at ``estimate`` (−2 log of their prior).
+
+    - A parameter whose nominal value has a tolerance t: 2 ln(1 + ((x − nominal)/t)²), a Cauchy prior of
+      scale t. Within the tolerance a departure costs little (at most 2 ln 2); far beyond it the cost
+      grows only logarithmically (a shift of 25 t costs 13, of 500 t 25), so that decisive frequencies
+      still win over a recorded value, while of hypotheses they cannot separate the one with the smaller
+      departures does.
+    - The position of an unmodeled attachment, known only to lie on the span: the Occam factor of a
+      search, 2 ln(l / (√(2π) σ_x)) − 2 (σ_x its standard deviation; the 2 that AICc already charges for
+      the parameter taken off; never below 0). A position the data pin down to 1 cm on a 120 m stay costs
+      about 15: a point attachment found anywhere has to earn its place.
+    """
     total = 0.0
-    for p, x, width in zip(hypothesis.parameters, estimate, prior_widths(hypothesis.campaign, hypothesis)):
+    length = hypothesis.campaign.cable.length
+    sigma = np.full(len(hypothesis.parameters), np.nan) if uncertainty is None else np.asarray(uncertainty, float)
+    for p, x, s, width in zip(hypothesis.parameters, estimate, sigma,
+                              prior_widths(hypothesis.campaign, hypothesis)):
         if width is not None:
-            total += ((float(x) - p.start) / width) ** 2
+            total += 2.0 * math.log1p(((float(x) - p.start) / width) ** 2)
+        elif p.kind == "position" and p.slots and math.isfinite(s) and s > 0:
+            sigma_x = float(p.value_uncertainty(x, s))
+            total += max(0.0, 2.0 * math.log(length / (math.sqrt(2 * math.pi) * sigma_x)) - 2.0)
     return total
 
 
@@ -314,7 +331,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     n = problem.n_data
     predicted = problem.predict(result.estimate)
     chi2 = float(np.sum(((predicted - problem.measured) / problem.sigma) ** 2))
-    penalty = prior_penalty(hyp, result.estimate)
+    penalty = prior_penalty(hyp, result.estimate, result.uncertainty)
     fit = HypothesisFit(hyp, result, predicted, chi2, aicc(chi2 + penalty, n, len(hyp.parameters)),
                         rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
                         minima=minima, penalty=penalty)

@@ -82,7 +82,11 @@ def recorded_attachments(campaign: Campaign, tests: Sequence[Test]) -> list[tupl
 
 
 def applicable(campaign: Campaign, tests: Sequence[Test], effect: str) -> str | None:
-    """Why ``effect`` cannot be a hypothesis for these tests (None when it can)."""
+    """Why ``effect`` cannot be a hypothesis for these tests (None when it can): the effect's own reason, or a
+    tolerance of 0 (the campaign says the nominal value is known exactly)."""
+    if registry.tolerance(campaign, effect) == 0:
+        key = registry.get(effect).tolerance.key
+        return f"{effect} is not considered: the campaign's [tolerance] {key} = 0 says the nominal value is exact"
     return registry.get(effect).applicable(campaign, tests)
 
 

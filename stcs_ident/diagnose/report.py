@@ -160,7 +160,7 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
 def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
     from scipy.stats import chi2 as chi2_distribution
 
-    from .selection import ALPHA, BASELINE
+    from .selection import ALPHA, BASELINE, allowed
 
     sel = d.selection
     n = d.measured.size
@@ -177,11 +177,10 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
                    + ("; ".join(effects_label(a) for a in sel.implausible) if sel.implausible else "none") + ".")
         out += ["", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
     best = d.ranked[0]
-    searched = max((len(e) for e in d.fits if e != BASELINE), default=0)
-    if best is not d.corrected and best.effects == BASELINE and len(BASELINE) > searched:
+    if best is not d.corrected and best.effects == BASELINE and not allowed(BASELINE, d.settings.max_effects):
         out += [(f"The first-ranked {effects_label(best.effects)} is the baseline (the source paper's correction), fitted "
-                f"as a reference with more effects than the hypotheses searched (at most {searched} here), so it "
-                "is not named as the cause."), ""]
+                f"as a reference with more effects than the hypotheses searched (at most {d.settings.max_effects} "
+                "here), so it is not chosen."), ""]
     dof = n - best.n_parameters
     if dof > 0 and best.chi2 > chi2_distribution.isf(ALPHA, dof):
         red = best.chi2 / dof

@@ -230,7 +230,7 @@ class Diagnosis:
         if sel.implausible:
             text += (" The frequencies alone do not separate it from "
                      + "; ".join(" + ".join(a) for a in sel.implausible)
-                     + ", which need departures beyond the tolerances of the nominal values.")
+                     + ", which need less plausible departures from the nominal values.")
         if chosen.epsilon > 0:
             text += (f" No hypothesis reaches the measurement uncertainty: the ranking includes a model error of "
                      f"{chosen.epsilon:.2g} (relative, per frequency) for this one.")

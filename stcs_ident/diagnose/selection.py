@@ -10,10 +10,12 @@
 2. **Ranking**: by AICc (:func:`~.fitting.aicc`), best first. Parameters
    whose nominal value has a tolerance (:mod:`stcs_ident.effects`: a
    stated tension, the nominal EI, a recorded position or mass, the
-   length) carry a Gaussian prior of that width, and its penalty counts in
-   AICc: of two hypotheses the frequencies cannot tell apart (tension +
-   length reproduce any EI change exactly), the one that needs the more
-   plausible departures wins. When no hypothesis reaches the measurement
+   length) carry a Cauchy prior of that scale, an unmodeled attachment's
+   position the Occam factor of a search over the span
+   (:func:`~.fitting.prior_penalty`), and the penalty counts in AICc: of
+   two hypotheses the frequencies cannot tell apart (tension + length
+   reproduce any EI change exactly), the one that needs the more plausible
+   departures wins. When no hypothesis reaches the measurement
    uncertainty (step 3's gate fails for all), every hypothesis gets a
    relative model error ε per frequency (:mod:`.model_error`) and AICc is
    that of the likelihood with it, one more parameter each.

@@ -77,7 +77,7 @@ def ranking_table(diagnosis) -> pd.DataFrame:
                      "aicc": f.aicc, "delta_aicc": f.aicc - best,
                      "rms_error_%": f.rms_error,
                      "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
-                     "cause": f.effects == d.selection.effects,
+                     "cause": f.effects == d.selection.fitted,
                      "parameters": f"failed: {f.failure}" if f.failure else _short(parameter_rows(*d.parameters(f))),
                      "seconds": d.timings.get(f.effects, math.nan)})
     return pd.DataFrame(rows)
