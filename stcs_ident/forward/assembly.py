@@ -159,6 +159,8 @@ class CableBatch:
         n = len(self.length)
         if topo.string:
             p = 1.0 / self.length
+        elif self.EI.all():  # the usual case: no division by zero to silence
+            p = np.maximum(np.sqrt(self.H / self.EI), 1.0 / self.length)
         else:
             with np.errstate(divide="ignore"):
                 p = np.maximum(np.sqrt(self.H / self.EI), 1.0 / self.length)

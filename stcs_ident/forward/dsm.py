@@ -71,7 +71,9 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
         if v.ndim == 0 or v.shape[-1] != na:
             raise ModelError(f"last axis must have one value per attachment ({na})", field=k)
         att_arrays[k] = v
-    shape = np.broadcast_shapes(*(a.shape for a in arrays.values()), *(a.shape[:-1] for a in att_arrays.values()))
+    shapes = {a.shape for a in arrays.values()} | {a.shape[:-1] for a in att_arrays.values()}
+    shapes.discard(())
+    shape = np.broadcast_shapes(*shapes) if len(shapes) > 1 else (shapes.pop() if shapes else ())
     n = math.prod(shape)
     # Checked before broadcasting (every value reaches some parameter set when there is one), so
     # a value repeated over the batch is checked once; an empty batch has nothing to check.
@@ -108,8 +110,8 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
             topo,
             length=part["length"], mass_per_length=m, EI=part["EI"],
             tension=part["tension"],
-            EA=np.full(count, cable.EA if cable.EA is not None else np.inf),
-            weight=m * g * math.cos(theta), gcos=np.full(count, g * math.cos(theta)),
+            EA=_filled(count, cable.EA if cable.EA is not None else np.inf),
+            weight=m * g * math.cos(theta), gcos=_filled(count, g * math.cos(theta)),
             positions=part["positions"], masses=part["masses"], springs=part["stiffnesses"],
             end_a=part["end_a"], end_b=part["end_b"],
         )
@@ -122,6 +124,12 @@ def _topology(n_attachments, clamped_a, clamped_b, string, tension_model):
     return Topology(n_attachments, clamped_a, clamped_b, string, tension_model)
 
 
+def _filled(n, value):
+    out = np.empty(n)
+    out.fill(value)
+    return out
+
+
 def _flat(v, shape, n, *tail):
     """``v`` broadcast to ``shape + tail`` as an (n, *tail) array (a view when it has that shape)."""
     full = shape + tail
@@ -132,14 +140,18 @@ def _flat(v, shape, n, *tail):
     return out
 
 
+#: Up to this many values a check runs on a Python list (cheaper than numpy's reductions).
+_FEW = 64
+
+
 def _at_least(v, low, strict):
     """Whether every value of ``v`` is finite and > ``low`` (``strict``) or >= ``low``."""
-    if v.ndim == 0:
-        x = float(v)
-        return math.isfinite(x) and (x > low if strict else x >= low)
-    if not v.size:
-        return True
-    lo = v.min()  # NaN propagates, and fails both comparisons
+    if v.size <= _FEW:  # NaN fails every comparison, inf the upper one
+        values = v.ravel().tolist()
+        if strict:
+            return all(low < x < math.inf for x in values)
+        return all(low <= x < math.inf for x in values)
+    lo = v.min()
     return bool((lo > low if strict else lo >= low) and v.max() < math.inf)
 
 
@@ -154,15 +166,24 @@ def _validate_inputs(arrays, att_arrays):
             raise ModelError("must be finite and >= 0", field=name)
     for name in ("end_a", "end_b"):
         v = arrays[name]
-        if not (v.min() >= 0 if v.ndim else float(v) >= 0):  # NaN fails; inf (clamped) passes
+        if not (all(x >= 0 for x in v.ravel().tolist()) if v.size <= _FEW else v.min() >= 0):  # NaN fails
             raise ModelError("must be >= 0 (inf for clamped)", field=name)
     pos = att_arrays["positions"]
     if not pos.size:
         return True
-    if not ((pos > 0).all() and (pos < arrays["length"][..., None]).all()):
-        raise ModelError("attachments must lie strictly inside the span", field="positions")
-    if pos.shape[-1] < 2 or (pos[..., 1:] - pos[..., :-1] > 0).all():
-        return True
+    length = arrays["length"]
+    if length.ndim == 0 and pos.size <= _FEW:
+        span = float(length)
+        rows = pos.reshape(-1, pos.shape[-1]).tolist()
+        if not all(0 < x < span for row in rows for x in row):
+            raise ModelError("attachments must lie strictly inside the span", field="positions")
+        if all(a < b for row in rows for a, b in zip(row, row[1:])):
+            return True
+    else:
+        if not ((pos > 0).all() and (pos < length[..., None]).all()):
+            raise ModelError("attachments must lie strictly inside the span", field="positions")
+        if pos.shape[-1] < 2 or (pos[..., 1:] - pos[..., :-1] > 0).all():
+            return True
     s = np.sort(pos, axis=-1)
     if np.any(s[..., 1:] - s[..., :-1] <= 0):
         raise ModelError("two attachments at one position", field="positions")
