@@ -140,10 +140,12 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
             f"parameters, n = {n} the number of measured frequencies."),
             ("- AICc = χ² + prior + 2k + 2k(k + 1)/(n − k − 1) trades misfit against parameters; lower is better "
             "and ΔAICc is measured from the best hypothesis."),
-            ("- prior = Σ ((x − nominal)/tolerance)² over the parameters whose nominal value has a tolerance "
-            "(stated tension, nominal EI, recorded positions and masses, length; the campaign's [tolerance] or "
-            "the defaults): of hypotheses the frequencies cannot tell apart, the one needing the more plausible "
-            "departures ranks first. A departure within its tolerance is a correction, never a cause."),
+            ("- prior = Σ 2 ln(1 + ((x − nominal)/tolerance)²) over the parameters whose nominal value has a "
+            "tolerance (stated tension, nominal EI, recorded positions and masses, length; the campaign's "
+            "[tolerance] or the defaults), plus 2 ln(l/(√(2π) σ_x)) − 2 for the position of an unmodeled "
+            "attachment found on the span: of hypotheses the frequencies cannot tell apart, the one needing the "
+            "more plausible departures ranks first. A departure within its tolerance is a correction, never a "
+            "cause."),
             ("- ε (shown when no hypothesis reaches the measurement uncertainty): the relative model error per "
             "frequency each hypothesis needs; χ² in AICc is then replaced by the likelihood with variances "
             "σ² + (ε f)², ε one more parameter, so that ΔAICc keeps its meaning."),
