@@ -273,3 +273,4 @@ def test_a_zero_tolerance_means_the_nominal_value_is_exact():
     assert "tension" not in d.considered and not any(f.failure for f in d.fits.values())
     assert any("tension = 0" in str(n) for n in d.notes)
     assert d.summary()["cause"]["effects"] == ["bending_stiffness"]
+    assert d.baseline is not None and d.baseline.effects == ("bending_stiffness",)  # what of (tension, EI) applies

@@ -182,7 +182,7 @@ def _test_cv(fits: dict, selection, measurements: Sequence[Measurement], tension
     if len(measurements) < 2:
         return {}
     chosen = {"nominal": (), "corrected": selection.fitted}
-    base = next((k for k in (BASELINE, ("tension",)) if k in fits and fits[k].failure is None), None)
+    base = next((k for k in (BASELINE, *((e,) for e in BASELINE)) if k in fits and fits[k].failure is None), None)
     if base is not None:
         chosen["baseline"] = base
     out = {}

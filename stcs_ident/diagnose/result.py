@@ -111,7 +111,7 @@ class Diagnosis:
     @property
     def baseline(self) -> HypothesisFit | None:
         """Tension and EI re-estimated (the paper's correction), or what of it applies."""
-        for key in (BASELINE, ("tension",)):
+        for key in (BASELINE, *((e,) for e in BASELINE)):  # what of it applies (a tolerance of 0 leaves one out)
             if key in self.fits and self.fits[key].failure is None:
                 return self.fits[key]
         return None
