@@ -160,7 +160,7 @@ def _expected(theta: np.ndarray, problem: _Problem):
 
 def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
     lowest = mean.min()
-    if lowest <= 0 or (lowest != lowest and np.any(mean <= 0)):  # (min is nan if any entry is)
+    if lowest <= 0 or (np.isnan(lowest) and np.any(mean <= 0)):  # (min is nan if any entry is)
         return np.inf
     terms = np.log(mean)
     terms += periodogram / mean
