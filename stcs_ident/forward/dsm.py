@@ -71,9 +71,9 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
         if v.ndim == 0 or v.shape[-1] != na:
             raise ModelError(f"last axis must have one value per attachment ({na})", field=k)
         att_arrays[k] = v
-    shapes = {a.shape for a in arrays.values()} | {a.shape[:-1] for a in att_arrays.values()}
-    shapes.discard(())
-    shape = np.broadcast_shapes(*shapes) if len(shapes) > 1 else (shapes.pop() if shapes else ())
+    shapes = [a.shape for a in arrays.values()] + [a.shape[:-1] for a in att_arrays.values()]
+    distinct = set(shapes) - {()}
+    shape = np.broadcast_shapes(*shapes) if len(distinct) > 1 else (distinct.pop() if distinct else ())
     n = math.prod(shape)
     # Checked before broadcasting (every value reaches some parameter set when there is one), so
     # a value repeated over the batch is checked once; an empty batch has nothing to check.
