@@ -10,7 +10,8 @@ recorded attachment and two tests at different tensions:
 Every record carries field-like conditions drawn by
 ``stcs_ident.simulate.random_field_conditions`` (coloured wind under the
 blows, tension drift, pink noise, mains hum, DC offsets, float32 samples,
-each on with probability 0.75), SNR 20–40 dB, damping 0.2–1 %. The
+each on with probability 0.75) under ambient wind that keeps going through
+the blow, SNR 20–40 dB, damping 0.2–1 %. The
 campaign's stated tensions differ from the true ones by up to ±1.5 %
 (within the default 2 % tolerance), as a ring gauge's would.
 
@@ -44,16 +45,17 @@ import stcs_ident
 from stcs_ident.campaign_io import load_campaign
 from stcs_ident.diagnose import diagnose
 from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
-from stcs_ident.simulate import Effects, Impulse, random_field_conditions, simulate_campaign
+from stcs_ident.simulate import Ambient, Effects, Impulse, random_field_conditions, simulate_campaign
 from stcs_ident.spectra import analyse_test
 
 MAX_MODES = 12
 
 BENCHES = {
     "hanger": {"cable": Cable(length=8.0, mass_per_length=30.0, EI=2.0e5), "attachment": Attachment("clamp", 2.7, 15.0),
-                   "tensions": (4.0e5, 5.0e5), "duration": 40.0, "rate": 256.0},
+               "tensions": (4.0e5, 5.0e5), "duration": 40.0, "rate": 256.0, "blow": 1.0, "wind": (0.01, 0.5)},
     "stay": {"cable": Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9, inclination=math.radians(30)),
-                 "attachment": Attachment("damper", 3.0, 50.0), "tensions": (4.0e6, 4.6e6), "duration": 120.0, "rate": 64.0},
+             "attachment": Attachment("damper", 3.0, 50.0), "tensions": (4.0e6, 4.6e6), "duration": 120.0,
+             "rate": 64.0, "blow": 30.0, "wind": (0.05, 2.0)},
 }
 
 
@@ -97,7 +99,9 @@ def run_case(case: dict) -> dict:
         out = simulate_campaign(nominal, Path(tmp) / "c", positions=[0.23 * length, 0.5 * length, 0.71 * length],
                                 duration=b["duration"], sampling_rate=b["rate"],
                                 damping=float(rng.uniform(0.002, 0.01)),
-                                impulses=(Impulse(0.5, 0.17 * length, 1.0),), snr_db=float(rng.uniform(20, 40)),
+                                impulses=(Impulse(0.5, 0.17 * length, b["blow"]),),
+                                ambient=Ambient(float(np.exp(rng.uniform(*np.log(b["wind"]))))),
+                                snr_db=float(rng.uniform(20, 40)),
                                 effects=effects, seed=seed, field=field)
         campaign = load_campaign(out)
         picked = {t.name: analyse_test(campaign, t, max_modes=MAX_MODES) for t in campaign.tests}
