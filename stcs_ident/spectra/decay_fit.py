@@ -23,9 +23,18 @@ Model
 Noise and uncertainty
     Each channel's noise variance is estimated from its residual in the
     band (pooled over events); a second fit weights the channels by it.
-    The covariance is the inverse Fisher information 2 Re(J^H W J) of the
-    projected problem, which is the Cramér–Rao bound evaluated at the
-    estimate with the nuisance amplitudes marginalised.
+    With white sensor noise the covariance is the inverse Fisher
+    information 2 Re(J^H W J) of the projected problem, the Cramér–Rao
+    bound at the estimate with the nuisance amplitudes marginalised. Wind
+    that goes on under the decays adds the mode's own random response: a
+    Lorentzian of the same pole, largest exactly where the frequency is
+    decided and common to all channels. The band noise is therefore
+    modelled as diag(n) + L_k M (sensor floor n per channel, forced
+    response L_k M), both estimated from the residuals, and the
+    covariance is the sandwich of the fit under that noise
+    (:func:`_forced_response_covariance`); it reduces to the bound when
+    M = 0. White-noise Fisher σ under light wind was up to 6 times too
+    small (benchmarks/calibrate_spectra.py).
 
 Reported frequency
     The undamped natural frequency f_n = |s| / 2π of the pole s = −σ + i2πf_d,
@@ -37,7 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
+from scipy import optimize, stats
 
 __all__ = ["DecayFit", "EventSpectrum", "event_spectra", "fit_decay", "pole_statistics"]
 
@@ -78,6 +87,11 @@ class DecayFit:
         over that in the outer two thirds: about 1 when the decay model
         explains the peak, large when a random response (ambient loading
         continuing through the decay) or another misfit sits under it.
+    forced_ratio : float
+        Power of the mode's random (forced) response in the band over that
+        of its free decay, both in noise units (:func:`_noise_model`): about
+        0 for a clean decay, above 1 where ambient loading rather than the
+        blows makes the peak.
     significance : float
         The mode's amplitudes against their noise, Λ = Σ |b|² / var(b) over
         channels and events, as the equivalent one-sided Gaussian z (about
@@ -99,6 +113,7 @@ class DecayFit:
     residual_excess: float
     significance: float
     converged: bool
+    forced_ratio: float = 0.0
 
 
 def event_spectra(x: np.ndarray, starts_stops: list[tuple[int, int]]) -> list[EventSpectrum]:
@@ -294,12 +309,103 @@ def fit_decay(
     state = _evaluate(theta, bands, dt, weights, with_jacobian=True)
     jtj, _ = _normal_equations(state, weights)
     try:
-        cov = np.linalg.inv(2.0 * jtj)
+        cov, forced_ratio = _forced_response_covariance(theta, state, bands, dt, weights, jtj)
     except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
         return None
-    return _result(theta, cov, state, bands, dt, noise_var, ok)
+    return _result(theta, cov, state, bands, dt, noise_var, ok, forced_ratio)
+
+
+def _stationary_shape(z: complex, phase: np.ndarray, n: int) -> np.ndarray:
+    """Expected |X[k]|² (up to scale) of the mode's stationary random response in an N-sample segment.
+
+    Re(2G(u) − 1), u = exp(z − iφ), G(u) = Σ_{τ<N} (1 − τ/N) u^τ: the
+    Lorentzian of the pole convolved with the segment's Fejér kernel (the
+    debiased Whittle mean of :mod:`.ambient_fit`, its dispersive part left out).
+    """
+    log_u = z - 1j * phase
+    u = np.exp(log_u)
+    one_minus = -np.expm1(log_u)
+    g = 1.0 / one_minus - u * (-np.expm1(n * log_u)) / (n * one_minus**2)
+    return np.maximum(np.real(2.0 * g - 1.0), 0.0)
+
+
+def _noise_model(theta, state: _State, bands: list[_Band], dt: float) -> tuple[np.ndarray, np.ndarray, list]:
+    """White floor n_c and forced-response matrix M (C × C) of the band noise Σ_k = diag(n) + L_k M.
+
+    Ambient loading that goes on under a decay leaves, besides the sensor
+    noise, the mode's own random response: a Lorentzian L_k of the fitted
+    pole in every channel, common to all (M is the cross-spectral matrix
+    of that response, rank one for one mode). Both are estimated from the
+    residuals by moments that allow for what the fit removed: the
+    residual of bin k has E|r_kc|² = n_c (1 − h_k) + M_cc Σ_j |(I − P)_kj|² L_j
+    (P the projection on the model's linear columns), and its
+    cross-products between channels only the second term. M is then
+    projected on the positive semi-definite matrices.
+    """
+    z = _pole(theta[0], theta[1], dt)
+    lev, lor, res_all, shapes = [], [], [], []
+    for band, res in zip(bands, state.residuals):
+        basis = np.column_stack([_pole_column(z, band.phase, band.n_samples), band.background])
+        q, _ = np.linalg.qr(basis)
+        complement = np.eye(q.shape[0]) - q @ q.conj().T
+        shape = _stationary_shape(z, band.phase, band.n_samples)
+        lev.append(np.real(np.diag(complement)))
+        lor.append((np.abs(complement) ** 2) @ shape)
+        res_all.append(res)
+        shapes.append(shape)
+    a, b, r = np.concatenate(lev), np.concatenate(lor), np.concatenate(res_all)
+    n_channels = r.shape[1]
+    power = np.abs(r) ** 2
+    floor, forced = np.zeros(n_channels), np.zeros(n_channels)
+    design = np.column_stack([a, b])
+    for c in range(n_channels):
+        # Moments weighted by the inverse expected power (|r|² scatters in proportion to its mean).
+        weight = np.ones(a.size)
+        for _ in range(3):
+            coef, _ = optimize.nnls(design * weight[:, None], power[:, c] * weight)
+            expected = design @ coef
+            weight = 1.0 / np.maximum(expected, 1e-12 * max(expected.max(), np.finfo(float).tiny))
+        floor[c], forced[c] = coef
+    matrix = np.diag(forced).astype(complex)
+    if n_channels > 1 and np.any(forced > 0):
+        weight = b / np.maximum(a * floor.mean() + b * forced.mean(), np.finfo(float).tiny) ** 2
+        cross = (r * (weight * b)[:, None]).T @ r.conj() / max(float(np.sum(weight * b * b)), np.finfo(float).tiny)
+        matrix = cross.copy()
+        matrix[np.diag_indices(n_channels)] = forced
+        values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.conj().T))
+        matrix = (vectors * np.maximum(values, 0.0)) @ vectors.conj().T
+    floor = np.maximum(floor, np.finfo(float).tiny)
+    return floor, matrix, shapes
+
+
+def _forced_response_covariance(theta, state: _State, bands: list[_Band], dt: float, weights: np.ndarray,
+                                jtj: np.ndarray) -> tuple[np.ndarray, float]:
+    """Covariance of (f_d, σ) under the band noise diag(n) + L_k M (:func:`_noise_model`), and the forced ratio.
+
+    The estimate solves Re Σ_k J_kᴴ W r_k = 0, so to first order its
+    covariance is the sandwich F⁻¹ (½ Re Σ_k J_kᴴ W Σ_k W J_k) F⁻¹ with
+    F = Re Σ J^H W J: (2F)⁻¹, the Fisher information's bound, when the
+    noise is white and independent between channels (M = 0), larger when
+    a random response of the mode sits under the decay (it is coloured,
+    concentrated where the frequency is decided, and common to all
+    channels). The forced ratio is Σ L_k tr(M N⁻¹) over Σ |g_k|² bᴴ N⁻¹ b
+    (N = diag(n)): the random response's power in the band over the decay's.
+    """
+    floor, matrix, shapes = _noise_model(theta, state, bands, dt)
+    z = _pole(theta[0], theta[1], dt)
+    forced_power = sum(float(shape.sum()) for shape in shapes) * float(np.sum(np.real(np.diag(matrix)) / floor))
+    decay_power = sum(float(np.sum(np.abs(_pole_column(z, band.phase, band.n_samples)) ** 2))
+                      * float(np.sum(np.abs(coef[0]) ** 2 / floor)) for band, coef in zip(bands, state.coefficients))
+    meat = np.zeros((2, 2))
+    for jac, shape in zip(state.jacobian, shapes):
+        wj = jac * weights[None, :, None]  # (m, C, 2)
+        white = np.einsum("mci,c,mcj->ij", wj.conj(), floor, wj)
+        forced = np.einsum("m,mci,cd,mdj->ij", shape, wj.conj(), matrix, wj)
+        meat += 0.5 * np.real(white + forced)
+    inverse = np.linalg.inv(jtj)
+    return inverse @ meat @ inverse, forced_power / max(decay_power, np.finfo(float).tiny)
 
 
 def _independent_channels(state: _State, noise_var: np.ndarray) -> float:
@@ -346,7 +452,7 @@ def pole_statistics(f_d: float, sigma: float, cov: np.ndarray) -> tuple[float, f
     )
 
 
-def _result(theta, cov, state, bands, dt, noise_var, ok) -> DecayFit:
+def _result(theta, cov, state, bands, dt, noise_var, ok, forced_ratio=0.0) -> DecayFit:
     f_d, sigma = theta
     f_n, f_std, zeta, zeta_std = pole_statistics(f_d, sigma, cov)
     z = _pole(f_d, sigma, dt)
@@ -379,4 +485,5 @@ def _result(theta, cov, state, bands, dt, noise_var, ok) -> DecayFit:
         residual_excess=_residual_excess(state, bands, noise_var),
         significance=significance,
         converged=bool(ok),
+        forced_ratio=float(forced_ratio),
     )

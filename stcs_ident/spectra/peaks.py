@@ -19,11 +19,16 @@ Steps
        a band around it: free decays by a variable-projection least-squares
        fit of a common pole to all channels and events (:mod:`.decay_fit`);
        ambient records by the debiased Whittle likelihood of the modal
-       coordinate (:mod:`.ambient_fit`), also used for a mode of an impulse
-       record whose decay-fit residual shows a random response under the
-       peak (ambient loading continuing through the decay). Both are
-       maximum likelihood on the band; the 1σ comes from the Fisher
-       information. Detections whose fit is not a significant, lightly
+       coordinate (:mod:`.ambient_fit`). Where the decay-fit residual shows
+       a random response under the peak (ambient loading continuing through
+       the decay), the decay fit's 1σ allows for it (the band noise is the
+       sensor floor plus the mode's own forced response, coloured and
+       common to all channels: :mod:`.decay_fit`), and the Whittle fit of
+       the whole record is taken instead when its 1σ is smaller or the
+       forced response outweighs the decay in the band (the blows are then
+       too weak for the decay model). Both are maximum likelihood on the
+       band; the 1σ comes from the information of the fit under its noise
+       model. Detections whose fit is not a significant, lightly
        damped mode are dropped (the overview may propose a few: on the
        smooth skirts of free decays it is deliberately liberal).
        Ambient records then get a residual pass (:mod:`.residual`): the
@@ -32,7 +37,9 @@ Steps
        proposed and fitted with the others (a weak mode between broad
        resonances, too little prominent to be detected, whose neighbour's
        fit would otherwise absorb it).
-    4. Channels: those where the peak stands at least 6 dB above the
+    4. Mains hum: a fitted line with ζ < 5e-4 within 0.2 % of a harmonic
+       of 50 or 60 Hz is not reported (:func:`is_mains_hum`).
+    5. Channels: those where the peak stands at least 6 dB above the
        channel's own noise floor (free decay: the fitted mode's peak power
        per bin over the noise per bin, plus one; ambient: the Welch
        spectrum over its floor at the fitted frequency).
@@ -102,10 +109,14 @@ from .record import Record
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
 
-__all__ = ["Peak", "PeakResult", "find_peaks"]
+__all__ = ["Peak", "PeakResult", "find_peaks", "is_mains_hum"]
 
 CHANNEL_SNR_DB = 6.0  # a channel saw a peak standing this high above its own floor
-MAX_RESIDUAL_EXCESS = 2.0  # decay-fit residual under the peak / away from it, beyond which Whittle is used
+MAX_RESIDUAL_EXCESS = 2.0  # decay-fit residual under the peak / away from it, beyond which Whittle is tried
+MAX_FORCED_RATIO = 0.5  # random response / free decay in the band beyond which the record's Whittle fit is used
+MAINS_FREQUENCIES = (50.0, 60.0)  # Hz
+MAINS_TOLERANCE = 0.002  # relative: grids keep within ±0.1 % of their nominal frequency, with margin
+MAX_HUM_DAMPING = 5e-4  # a line this undamped at a mains harmonic is hum (cable modes: ζ ≥ 1e-3)
 BAND_MIN_BINS = 24  # free decays: narrowest band, DFT bins of the longest event
 BAND_MIN_WELCH_BINS = 12  # ambient: narrowest band, Welch resolution cells
 KINDS = ("auto", "impulse", "ambient")
@@ -269,6 +280,7 @@ def find_peaks(
     candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db)
     refine = _refine_decays if events else _refine_ambient
     peaks = _deduplicate(refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi)))
+    peaks = [p for p in peaks if not is_mains_hum(p)]
     if max_peaks is not None and len(peaks) > max_peaks:
         # After the fits: the overview's strongest candidates may include some that are not modes.
         strongest = sorted(peaks, key=lambda p: p.snr_db, reverse=True)[:max_peaks]
@@ -285,6 +297,25 @@ def find_peaks(
         channel_names=record.channel_names,
         threshold=threshold,
     )
+
+
+def is_mains_hum(peak: Peak) -> bool:
+    """Whether a peak is mains hum: a line at a harmonic of 50 or 60 Hz with no damping.
+
+    Hum is a sinusoid of constant amplitude through the whole record, so
+    its fit (free decay or ambient) gives ζ ≈ 0 (within MAX_HUM_DAMPING),
+    which no cable mode has; the frequency must also lie within
+    MAINS_TOLERANCE of h · 50 or h · 60 Hz. It stays in the fits as a
+    neighbour of the modes beside it (they were fitted with it) and is not
+    reported.
+    """
+    if peak.damping is None or peak.damping >= MAX_HUM_DAMPING:
+        return False
+    for mains in MAINS_FREQUENCIES:
+        harmonic = round(peak.frequency / mains)
+        if harmonic >= 1 and abs(peak.frequency - harmonic * mains) <= MAINS_TOLERANCE * harmonic * mains:
+            return True
+    return False
 
 
 def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple[float, float]:
@@ -318,8 +349,13 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
     def fit_band(f0, half_width, poles, peak_width):
         fit = fit_decay(spectra, fs, f0, half_width, poles, max_damping=2 * MAX_DAMPING)
         if fit is not None and fit.residual_excess > MAX_RESIDUAL_EXCESS:
-            # A random response under the decay: the stationary model of the whole record describes it.
-            return whittle(f0, half_width, poles, peak_width)
+            # A random response under the decay: the decay fit's 1σ allows for it (decay_fit's noise model);
+            # the stationary model of the whole record is kept where it pins the mode down better.
+            other = whittle(f0, half_width, poles, peak_width)
+            if other is not None and other.converged and (
+                other.frequency_std < fit.frequency_std or fit.forced_ratio > MAX_FORCED_RATIO
+            ):
+                return other
         return fit
 
     cell_width = overview.cell * (overview.frequency[1] - overview.frequency[0])
