@@ -376,7 +376,8 @@ def _noise_model(theta, state: _State, bands: list[_Band], dt: float) -> tuple[n
         matrix[np.diag_indices(n_channels)] = forced
         values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.conj().T))
         matrix = (vectors * np.maximum(values, 0.0)) @ vectors.conj().T
-    floor = np.maximum(floor, np.finfo(float).tiny)
+    # A floor the forced term explains away entirely is still not zero (the ratios below divide by it).
+    floor = np.maximum(floor, 1e-9 * power.mean(axis=0) + np.finfo(float).tiny)
     return floor, matrix, shapes
 
 
