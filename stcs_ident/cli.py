@@ -113,12 +113,27 @@ def _simulate_parser(sub) -> None:
     sim.add_argument("--sampling-rate", type=float, default=200.0, metavar="HZ", help="default 200 Hz")
     sim.add_argument("--damping", type=float, default=0.005, metavar="ZETA", help="modal damping ratio (0.005)")
     sim.add_argument("--impulses", type=int, default=1, metavar="N",
-                     help="hand-excitation events, N s apart from t = 1 s (default 1; 0 for none)")
+                     help="hand-excitation events from t = 1 s, duration/N s apart (at least 1 s; default 1; "
+                          "0 for none)")
     sim.add_argument("--ambient", type=float, default=None, metavar="PA",
                      help="ambient random pressure, RMS N/m per metre (default off)")
     sim.add_argument("--snr", type=float, default=30.0, metavar="DB", help="sensor noise, dB (default 30)")
     sim.add_argument("--seed", type=int, default=0)
     sim.add_argument("--overwrite", action="store_true", help="replace a non-empty output directory")
+    fld = sim.add_argument_group("field conditions (what field records carry besides the cable's response)")
+    fld.add_argument("--lowpass", type=float, metavar="HZ",
+                     help="colour the ambient loading with a 2nd-order low-pass at HZ (wind; needs --ambient)")
+    fld.add_argument("--drift", metavar="REL[@S]",
+                     help="slow tension drift within each record: a sinusoid of relative amplitude REL and "
+                          "period S s (default 300); truth.json then holds the time-averaged frequencies")
+    fld.add_argument("--pink-noise", type=float, metavar="REL", help="1/f sensor noise, rms relative to the signal")
+    fld.add_argument("--hum", metavar="HZ:A1[,A2...]",
+                     help="mains hum at HZ and its harmonics, amplitudes relative to the signal rms")
+    fld.add_argument("--dc-offset", type=float, metavar="REL", help="a DC offset in every channel, relative to "
+                                                                    "the signal rms")
+    fld.add_argument("--float32", action="store_true", help="write single-precision samples")
+    fld.add_argument("--field-random", action="store_true",
+                     help="random field-like conditions per test (each part on with probability 0.75; from --seed)")
     eff = sim.add_argument_group("hidden effects (in the records, not in the written campaign)")
     for effect in effects.effects():
         if effect.option is not None:
@@ -156,13 +171,60 @@ def _simulate(args) -> int:
         effect = Effects(**hidden) if hidden else None
     except (TypeError, ValueError) as err:
         raise InputError(str(err), field="effects") from None
+    field = _field_conditions(args, campaign, len(fractions))
     out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions], duration=args.duration,
                             sampling_rate=args.sampling_rate, tests=args.test, damping=args.damping,
                             impulses=impulses, ambient=ambient, snr_db=args.snr, effects=effect, seed=args.seed,
-                            overwrite=args.overwrite,
+                            overwrite=args.overwrite, field=field,
                             progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
     print(f"wrote {out}")
     return 0
+
+
+def _field_conditions(args, campaign, n_channels: int):
+    """``simulate``'s field-condition options as FieldConditions (per test with --field-random), or None."""
+    import numpy as np
+
+    from .simulate import (
+        DcOffsets,
+        FieldConditions,
+        LowPassLoading,
+        MainsHum,
+        PinkNoise,
+        TensionDrift,
+        random_field_conditions,
+    )
+
+    if args.field_random:
+        rng = np.random.default_rng([args.seed, 17])
+        return {t.name: random_field_conditions(rng, args.sampling_rate, args.duration, n_channels,
+                                                ambient=args.ambient is not None) for t in campaign.tests}
+    def drift(text):
+        amplitude, _, period = text.partition("@")
+        return TensionDrift(amplitude=float(amplitude), period=float(period) if period else 300.0)
+
+    def hum(text):
+        frequency, _, amplitudes = text.partition(":")
+        return MainsHum(float(frequency), tuple(float(a) for a in amplitudes.split(",")), relative=True)
+
+    builders = (("ambient_lowpass", "--lowpass", args.lowpass, LowPassLoading),
+                ("drift", "--drift", args.drift, drift),
+                ("pink_noise", "--pink-noise", args.pink_noise, lambda v: PinkNoise(v, relative=True)),
+                ("hum", "--hum", args.hum, hum),
+                ("dc_offsets", "--dc-offset", args.dc_offset, lambda v: DcOffsets(v, relative=True)))
+    if args.lowpass is not None and args.ambient is None:
+        raise InputError("colours the ambient loading: give --ambient too", field="--lowpass")
+    parts = {}
+    for key, flag, given, build in builders:
+        if given is None:
+            continue
+        try:
+            parts[key] = build(given)
+        except ValueError as err:  # a number that does not parse, or a ModelError naming the condition's field
+            raise InputError(" ".join(str(getattr(err, "message", err)).split()), field=flag) from None
+    if args.float32:
+        parts["float32"] = True
+    return FieldConditions(**parts) if parts else None
 
 
 def _selected_tests(campaign, names, file):

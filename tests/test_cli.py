@@ -255,3 +255,31 @@ def test_version_help_and_examples(capsys):
 def test_debug_before_the_command_shows_the_traceback(tmp_path, capsys):
     assert main(["--debug", "forward", str(tmp_path / "missing")]) == 2
     assert "Traceback" in capsys.readouterr().err
+
+
+def test_simulate_writes_field_conditions(tmp_path):
+    h5py = pytest.importorskip("h5py")
+    out = tmp_path / "field"
+    code = main(["simulate", str(HAN), "--out", str(out), "--test", "case1-L4", "--duration", "20", "--ambient", "5",
+                 "--lowpass", "2", "--drift", "5e-5@60", "--pink-noise", "0.01", "--hum", "50:0.02,0.01",
+                 "--dc-offset", "0.1", "--float32"])
+    assert code == 0
+    truth = json.loads((out / "truth.json").read_text())["tests"][0]
+    assert set(truth["field"]) >= {"ambient_lowpass", "drift", "pink_noise", "hum", "dc_offsets", "float32"}
+    assert len(truth["time_averaged_frequencies"]) == len(truth["frequencies"])  # the truth under drift
+    with h5py.File(out / "records" / "case1-L4.h5") as f:
+        assert f["acceleration"].dtype == np.float32
+
+
+@pytest.mark.parametrize("args,field", [
+    (["--hum", "50:abc"], "--hum"),
+    (["--drift", "big"], "--drift"),
+    (["--lowpass", "2"], "--lowpass"),  # without --ambient there is no loading to colour
+    (["--ambient", "5", "--lowpass", "-1"], "--lowpass"),
+])
+def test_simulate_refuses_bad_field_options_naming_them(tmp_path, capsys, args, field):
+    out = tmp_path / "bad"
+    assert main(["simulate", str(HAN), "--out", str(out), "--test", "case1-L4", "--duration", "20", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"field '{field}'" in err[0]
+    assert not out.exists()

@@ -39,6 +39,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError, ModelError
+from ..formatting import plus_minus as pm  # the effects' words use the reports' ± format
 from ..identify.parameters import Parameter, parse_parameters
 from ..model import Attachment, Cable, Campaign, Test
 
@@ -350,13 +351,6 @@ def at_pair(text: Any, option: str) -> tuple[str, float]:
     if not math.isfinite(x):
         raise InputError(f"the position must be finite, got {b!r}", field=option)
     return a, x
-
-
-def pm(value: float, sigma: float | None, digits: int = 3) -> str:
-    """``1.02 ± 0.0031`` (the value alone when the uncertainty is unknown)."""
-    if sigma is None or not math.isfinite(sigma):
-        return f"{value:.{digits}g}"
-    return f"{value:.{digits}g} ± {sigma:.2g}"
 
 
 def scaled(sigma: float | None, factor: float) -> float | None:
