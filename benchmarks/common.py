@@ -35,7 +35,7 @@ except ImportError as exc:
              f"    {INSTALL_HINT}\n"
              f"    /tmp/bench-venv/bin/python benchmarks/{Path(sys.argv[0]).name}")
 
-from stcs_ident.forward import roots  # noqa: E402
+from stcs_ident.forward import roots
 
 
 def _editable_of(tree: Path) -> bool:
@@ -77,8 +77,8 @@ def code_path() -> tuple[str, str | None]:
         if (directory.is_relative_to(CHECKOUT) and source.exists() and built
                 and built[0].stat().st_mtime < source.stat().st_mtime):
             return (f"compiled kernel ({built[0].name})",
-                    f"WARNING: {built[0].name} is older than _dsm_kernel.c beside it: it may be stale "
-                    f"(rebuild it by reinstalling: pip install [-e] .)")
+                    (f"WARNING: {built[0].name} is older than _dsm_kernel.c beside it: it may be stale "
+                    f"(rebuild it by reinstalling: pip install [-e] .)"))
         return f"compiled kernel ({built[0].name if built else roots._dsm_kernel.__file__})", None
     if roots._dsm_kernel is not None:  # built and importable, switched off
         return f"numpy fallback (STCS_IDENT_NUMPY={os.environ.get('STCS_IDENT_NUMPY')} set; kernel available)", None

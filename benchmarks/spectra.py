@@ -320,8 +320,8 @@ def print_case(r: dict) -> dict:
 def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) -> dict:
     """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time."""
     from stcs_ident.forward import count_below
-    from stcs_ident.spectra.peaks import find_peaks
     from stcs_ident.simulate.simulate import NYQUIST_FRACTION, Ambient
+    from stcs_ident.spectra.peaks import find_peaks
 
     _, stay = structures()
     fs, duration, n_channels = 256.0, 600.0, 16

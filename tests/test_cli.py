@@ -283,3 +283,19 @@ def test_simulate_refuses_bad_field_options_naming_them(tmp_path, capsys, args, 
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"field '{field}'" in err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("args,field", [
+    (["--end-stiffness", "a,b"], "--end-stiffness"),
+    (["--end-stiffness", "1e5"], "--end-stiffness"),
+    (["--extra-mass", "abc@1"], "--extra-mass"),
+    (["--extra-spring", "1e4@far"], "--extra-spring"),
+    (["--move", "W1"], "--move"),
+    (["--tension-ratio", "x"], "--tension-ratio"),
+])
+def test_simulate_refuses_bad_hidden_effect_options_naming_them(tmp_path, capsys, args, field):
+    out = tmp_path / "bad"
+    assert main(["simulate", str(HAN), "--out", str(out), "--test", "case1-L4", "--duration", "5", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"field '{field}'" in err[0], err
+    assert not out.exists()

@@ -20,8 +20,17 @@ from stcs_ident.errors import ModelError
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.model import Cable, Campaign, Setup, Test
 from stcs_ident.simulate import (
-    Ambient, DcOffsets, FieldConditions, Impulse, LowPassLoading, MainsHum, PinkNoise, TensionDrift,
-    random_field_conditions, simulate_record, simulate_record_with_truth,
+    Ambient,
+    DcOffsets,
+    FieldConditions,
+    Impulse,
+    LowPassLoading,
+    MainsHum,
+    PinkNoise,
+    TensionDrift,
+    random_field_conditions,
+    simulate_record,
+    simulate_record_with_truth,
 )
 from stcs_ident.simulate.disturbances import lowpass_force_filter, relative_tension
 from stcs_ident.simulate.field_response import augmented_stationary_covariance

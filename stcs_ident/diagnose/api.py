@@ -37,7 +37,7 @@ from .fitting import (
 from .hypotheses import applicable, build, hypothesis_sets, parse_effects
 from .model_error import fit_epsilon
 from .result import Diagnosis
-from .selection import BASELINE, explains, needs_model_error, select
+from .selection import BASELINE, baseline_fit, explains, needs_model_error, select
 
 Progress = Callable[[int, int, str], None]
 
@@ -155,8 +155,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             if progress is not None:
                 progress(done, total, " + ".join(s) if s else "nominal")
     if needs_model_error(fits, n):
+        measured = np.concatenate([m.frequencies for m in measurements])
+        sigma = np.concatenate([m.uncertainty for m in measurements])
         for fit in fits.values():
-            with_model_error(fit, measurements)
+            with_model_error(fit, measured, sigma)
     selection = select(fits, n, settings.max_effects)
     test_cv = _test_cv(fits, selection, measurements, settings.tension_model)
     comparison = nominal_comparison(campaign, measurements, given, settings)
@@ -166,13 +168,12 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
                      comparison=comparison, test_cv=test_cv)
 
 
-def with_model_error(fit: HypothesisFit, measurements: Sequence[Measurement]) -> None:
+def with_model_error(fit: HypothesisFit, measured: np.ndarray, sigma: np.ndarray) -> None:
     """Give a fitted hypothesis its model error ε (:mod:`.model_error`) and the AICc of the likelihood with
-    it (ε one more parameter)."""
+    it (ε one more parameter); ``measured`` and ``sigma`` are the measured frequencies and their
+    uncertainties, tests in order."""
     if fit.failure is not None or not np.all(np.isfinite(fit.predicted)):
         return
-    measured = np.concatenate([m.frequencies for m in measurements])
-    sigma = np.concatenate([m.uncertainty for m in measurements])
     fit.epsilon, dev = fit_epsilon(fit.predicted - measured, sigma, measured)
     fit.aicc = aicc(dev + fit.penalty, measured.size, fit.n_parameters + 1)
 
@@ -182,9 +183,9 @@ def _test_cv(fits: dict, selection, measurements: Sequence[Measurement], tension
     if len(measurements) < 2:
         return {}
     chosen = {"nominal": (), "corrected": selection.fitted}
-    base = next((k for k in (BASELINE, *((e,) for e in BASELINE)) if k in fits and fits[k].failure is None), None)
+    base = baseline_fit(fits)
     if base is not None:
-        chosen["baseline"] = base
+        chosen["baseline"] = base.effects
     out = {}
     for label, key in chosen.items():
         try:

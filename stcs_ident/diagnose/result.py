@@ -19,7 +19,7 @@ from ..identify.problem import Measurement
 from ..model import Cable, Campaign
 from ..settings import Settings
 from .fitting import HypothesisFit
-from .selection import BASELINE, Selection, ranking
+from .selection import Selection, baseline_fit, ranking
 
 
 def _finite_or_none(v: float | None) -> float | None:
@@ -111,10 +111,7 @@ class Diagnosis:
     @property
     def baseline(self) -> HypothesisFit | None:
         """Tension and EI re-estimated (the paper's correction), or what of it applies."""
-        for key in (BASELINE, *((e,) for e in BASELINE)):  # what of it applies (a tolerance of 0 leaves one out)
-            if key in self.fits and self.fits[key].failure is None:
-                return self.fits[key]
-        return None
+        return baseline_fit(self.fits)
 
     @property
     def ranked(self) -> list[HypothesisFit]:

@@ -127,6 +127,15 @@ def _p_value(chi2: float, dof: int) -> float:
     return float(chi2_distribution.sf(chi2, dof))
 
 
+def baseline_fit(fits: dict[tuple[str, ...], HypothesisFit]) -> HypothesisFit | None:
+    """The gain's reference: tension and EI re-estimated (the paper's correction), or what of it was fitted
+    (a tolerance of 0 leaves one out); None when neither was fitted successfully."""
+    for key in (BASELINE, *((e,) for e in BASELINE)):
+        if key in fits and fits[key].failure is None:
+            return fits[key]
+    return None
+
+
 def allowed(effects_: tuple[str, ...], max_effects: int) -> bool:
     """Whether a hypothesis may be chosen: at most ``max_effects`` effects, or the baseline (tension and EI)
     plus at most ``max_effects`` − 1 further ones."""

@@ -26,7 +26,7 @@ from . import (
     unmodeled_mass,
     unmodeled_support,
 )
-from .base import Context, Effect, Option, Quantity, Tolerance, Truth, UnmodeledAttachment
+from .base import Context, Effect, Option, Quantity, RecordedAttachment, Tolerance, Truth, UnmodeledAttachment
 from .registry import (
     baseline,
     by_truth_key,
@@ -46,7 +46,8 @@ for _module in (tension, bending_stiffness, attachment_position, attachment_mass
     register(_module.EFFECT)
 
 __all__ = [
-    "Context", "Effect", "Option", "Quantity", "Tolerance", "Truth", "UnmodeledAttachment", "baseline",
+    "Context", "Effect", "Option", "Quantity", "RecordedAttachment", "Tolerance", "Truth", "UnmodeledAttachment",
+    "baseline",
     "by_truth_key", "effects", "get", "in_order", "names", "parse", "register", "tolerance", "tolerance_keys",
     "unregister",
 ]

@@ -285,6 +285,37 @@ class UnmodeledAttachment(Effect):
         return number(amount, self.option.flag, error=InputError), position
 
 
+class RecordedAttachment(Effect):
+    """A recorded attachment's value differs from the record: one value per attachment (``attribute``:
+    ``"position"`` or ``"mass"``), shared by the tests of its setup; the simulator's truth maps attachment
+    names to true values, set by a repeatable ``NAME@VALUE`` option."""
+
+    shared_by = "the tests of its setup"
+    #: The Attachment field the effect changes.
+    attribute: ClassVar[str] = ""
+    #: Whether a true value must be > 0 (a position) or may be 0 (a mass).
+    positive: ClassVar[bool] = False
+
+    def applicable(self, campaign, tests):
+        setups = list(dict.fromkeys(t.setup for t in tests))
+        if any(campaign.setup(s).attachments for s in setups):
+            return None
+        return (f"{self.name} needs a recorded attachment in the setup of a measured test, and the measured "
+                f"tests' setups ({', '.join(setups)}) have none")
+
+    def check_truth(self, value, field):
+        return named_values(value, field, positive=self.positive)
+
+    def apply_truth(self, truth, value):
+        set_attachments(truth, value, self.attribute, self.truth_key)
+
+    def truth_json(self, value):
+        return dict(value)
+
+    def parse_option(self, given):
+        return dict(at_pair(item, self.option.flag) for item in given)
+
+
 # ---- small helpers shared by the effect modules --------------------------------------------------
 
 def number(value: Any, field: str, error: type[Exception] = ModelError) -> float:

@@ -12,6 +12,7 @@ Public entry points:
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -177,7 +178,7 @@ def _validate_inputs(arrays, att_arrays):
         rows = pos.reshape(-1, pos.shape[-1]).tolist()
         if not all(0 < x < span for row in rows for x in row):
             raise ModelError("attachments must lie strictly inside the span", field="positions")
-        if all(a < b for row in rows for a, b in zip(row, row[1:])):
+        if all(a < b for row in rows for a, b in itertools.pairwise(row)):
             return True
     else:
         if not ((pos > 0).all() and (pos < length[..., None]).all()):

@@ -4,7 +4,7 @@ The simulator builds on the forward model and writes records of the type
 :mod:`stcs_ident.spectra` reads; spectra never imports it.
 """
 
-from .disturbances import (
+from .conditions import (
     DcOffsets,
     FieldConditions,
     LowPassLoading,

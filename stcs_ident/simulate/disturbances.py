@@ -1,7 +1,7 @@
 """Field-like disturbances of a simulated record, all off by default.
 
 Records simulated with white loading, a constant tension and white sensor
-noise are kinder than field records. :class:`FieldConditions` groups what
+noise are kinder than field records. :class:`~.conditions.FieldConditions` groups what
 field records carry besides the cable's response, each part optional and
 validated when built (a :class:`~stcs_ident.errors.ModelError` names the
 field, e.g. ``drift.period``):
@@ -49,23 +49,13 @@ from scipy.signal import butter
 from ..errors import ModelError
 from ..forward.dsm import natural_frequencies
 from ..model import Attachment, Cable
-from .conditions import (
-    DRIFT_LIMIT,
-    DcOffsets,
-    FieldConditions,
-    LowPassLoading,
-    MainsHum,
-    PinkNoise,
-    RecordTruth,
-    TensionDrift,
-    random_field_conditions,
-)
+from .conditions import DRIFT_LIMIT, FieldConditions, LowPassLoading, MainsHum, TensionDrift
 
 __all__ = [
-    "DRIFT_LIMIT", "DcOffsets", "FieldConditions", "LowPassLoading", "MainsHum", "PinkNoise", "RecordTruth",
-    "TensionDrift", "apply_sensor_disturbances", "check_field", "field_rng", "lowpass_force_filter", "mains_hum",
-    "pink_noise", "random_field_conditions", "relative_tension", "tension_sensitivities", "write_record_as",
+    "apply_sensor_disturbances", "check_field", "field_rng", "filter_state_space", "lowpass_force_filter",
+    "mains_hum", "pink_noise", "relative_tension", "tension_sensitivities", "write_record_as",
 ]
+
 _SENSITIVITY_STEP = 1e-3  # relative tension step of the central difference d ln f / d ln H
 
 

@@ -38,9 +38,8 @@ from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
 from ..model import Attachment, Cable
 from ..spectra.record import Record
+from .conditions import FieldConditions, RecordTruth
 from .disturbances import (
-    FieldConditions,
-    RecordTruth,
     apply_sensor_disturbances,
     check_field,
     field_rng,

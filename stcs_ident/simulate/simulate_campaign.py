@@ -26,7 +26,8 @@ from ..errors import ModelError
 from ..files import whole_directory
 from ..forward.dsm import natural_frequencies
 from ..model import Cable, Campaign, Test
-from .disturbances import FieldConditions, write_record_as
+from .conditions import FieldConditions
+from .disturbances import write_record_as
 from .effects import Effects, true_model
 from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record_with_truth
 
