@@ -369,3 +369,66 @@ def test_sixteen_channels_ten_minutes_finds_every_mode():
     assert len(result.peaks) == 20
     found = np.sort([p.frequency for p in result.peaks])
     assert np.all(np.abs(found - truth) < 0.01 * truth)
+
+
+# ----------------------------------------------------------------------------------------------
+# Guards found on field-like records (benchmarks/validate_diagnosis.py, stay seed 1009)
+
+
+def _peak(frequency: float, uncertainty: float, snr_db: float):
+    from stcs_ident.spectra.peaks import Peak
+
+    return Peak(frequency=frequency, uncertainty=uncertainty, damping=0.002, damping_uncertainty=0.001,
+                channels=("A1",), amplitude=np.ones(1), snr_db=snr_db, channel_snr_db=np.full(1, snr_db))
+
+
+def test_a_wide_uncertainty_does_not_swallow_well_located_neighbours():
+    """A fundamental whose fit returned σ = 5 Hz (the strongest peak) once removed modes 2–14 as its duplicates."""
+    from stcs_ident.spectra.peaks import _deduplicate
+
+    peaks = [_peak(1.096, 5.14, 35.0)] + [_peak(1.096 * k, 0.002, 28.0) for k in range(2, 15)]
+    kept = _deduplicate(peaks)
+    assert [round(p.frequency, 3) for p in kept] == [round(p.frequency, 3) for p in peaks]
+    # Two fits of one mode still collapse to the stronger.
+    twin = _deduplicate([_peak(5.850, 0.002, 20.0), _peak(5.851, 0.002, 25.0)])
+    assert len(twin) == 1 and twin[0].snr_db == 25.0
+
+
+def test_a_flat_whittle_likelihood_is_not_an_estimate():
+    """A pole narrower than the record resolves: ζ at its bound, 1σ of hertz. It must not replace a decay fit."""
+    from types import SimpleNamespace
+
+    from stcs_ident.spectra.peaks import _sound
+
+    flat = SimpleNamespace(converged=True, frequency_std=5.14)
+    good = SimpleNamespace(converged=True, frequency_std=0.004)
+    assert not _sound(flat, 0.274) and _sound(good, 0.274) and not _sound(None, 0.274)
+
+
+def test_blows_ringing_at_different_frequencies_widen_the_uncertainty():
+    """Tension wander between blows: the σ of the joint estimate covers the events' disagreement.
+
+    Two clean decays 1e-3 apart in relative frequency (hundreds of their
+    own σ): the joint σ must reach at least a third of the half-difference
+    (the mean of two events known to ±τ/√2, τ ≈ half the difference).
+    Without the wander (same frequency), σ stays at the noise's level.
+    """
+    from stcs_ident.spectra.decay_fit import event_spectra, fit_decay
+
+    fs, n, f0, zeta = 256.0, 4096, 12.0, 0.003
+    rng = np.random.default_rng(3)
+    t = np.arange(n) / fs
+
+    def decay(f):
+        s = zeta * 2 * np.pi * f
+        return np.exp(-s * t) * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+
+    sigmas = {}
+    for label, shift in (("same", 0.0), ("wander", 1e-3)):
+        x = np.concatenate([decay(f0), decay(f0 * (1 + shift))])[:, None] * np.array([[1.0, 0.6]])
+        x = x + 1e-3 * rng.standard_normal(x.shape)
+        fit = fit_decay(event_spectra(x, [(0, n), (n, 2 * n)]), fs, f0, 0.5)
+        assert fit is not None and fit.converged
+        sigmas[label] = fit.frequency_std
+    assert sigmas["wander"] >= 0.5 * f0 * 1e-3 / 3
+    assert sigmas["same"] < 0.05 * sigmas["wander"]

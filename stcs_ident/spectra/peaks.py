@@ -113,7 +113,9 @@ __all__ = ["Peak", "PeakResult", "find_peaks", "is_mains_hum"]
 
 CHANNEL_SNR_DB = 6.0  # a channel saw a peak standing this high above its own floor
 MAX_RESIDUAL_EXCESS = 2.0  # decay-fit residual under the peak / away from it, beyond which Whittle is tried
-MAX_FORCED_RATIO = 0.5  # random response / free decay in the band beyond which the record's Whittle fit is used
+MAX_FORCED_RATIO = 0.3  # random response / free decay in the band beyond which the record's Whittle fit is used
+WHITTLE_MAX_STD = 0.25  # a Whittle fit whose 1σ exceeds this fraction of its band's half-width locates nothing
+DEDUPLICATE_MAX_STD = 0.005  # relative: a wider 1σ does not widen the window in which two peaks are one
 MAINS_FREQUENCIES = (50.0, 60.0)  # Hz
 MAINS_TOLERANCE = 0.002  # relative: grids keep within ±0.1 % of their nominal frequency, with margin
 MAX_HUM_DAMPING = 5e-4  # a line this undamped at a mains harmonic is hum (cable modes: ζ ≥ 1e-3)
@@ -352,7 +354,7 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
             # A random response under the decay: the decay fit's 1σ allows for it (decay_fit's noise model);
             # the stationary model of the whole record is kept where it pins the mode down better.
             other = whittle(f0, half_width, poles, peak_width)
-            if other is not None and other.converged and (
+            if _sound(other, half_width) and (
                 other.frequency_std < fit.frequency_std or fit.forced_ratio > MAX_FORCED_RATIO
             ):
                 return other
@@ -368,6 +370,18 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
         else:
             peaks.append(_decay_peak(c, fit, names))
     return peaks
+
+
+def _sound(fit: AmbientFit | None, half_width: float) -> bool:
+    """A converged Whittle fit that locates its mode: 1σ within a quarter of the band's half-width.
+
+    A pole narrower than the record resolves (ζ at its lower bound) leaves
+    the likelihood flat in frequency: the fit "converges" with a 1σ of
+    hertz, which is no estimate.
+    """
+    return fit is not None and fit.converged and bool(np.isfinite(fit.frequency_std)) and (
+        fit.frequency_std <= WHITTLE_MAX_STD * half_width
+    )
 
 
 def _decay_peak(c: Candidate, fit: DecayFit, names) -> Peak:
@@ -484,10 +498,20 @@ def _overview_peak(c: Candidate, overview: Overview, names) -> Peak:
 
 
 def _deduplicate(peaks: list[Peak]) -> list[Peak]:
-    """Two detections that converged on the same mode (within 3σ) keep the stronger one."""
+    """Two detections that converged on the same mode keep the stronger one.
+
+    The same mode means within 3σ, each σ counted at most
+    DEDUPLICATE_MAX_STD of its frequency: one poor fit's wide σ must not
+    swallow its well-located neighbours (a cable's modes lie a fundamental
+    apart, several percent below mode 30).
+    """
+
+    def reach(p: Peak) -> float:
+        return min(p.uncertainty, DEDUPLICATE_MAX_STD * p.frequency)
+
     out: list[Peak] = []
     for p in sorted(peaks, key=lambda p: p.frequency):
-        if out and abs(p.frequency - out[-1].frequency) < 3.0 * max(p.uncertainty, out[-1].uncertainty):
+        if out and abs(p.frequency - out[-1].frequency) < 3.0 * max(reach(p), reach(out[-1])):
             if p.snr_db > out[-1].snr_db:
                 out[-1] = p
             continue
