@@ -274,3 +274,23 @@ def test_a_zero_tolerance_means_the_nominal_value_is_exact():
     assert any("tension = 0" in str(n) for n in d.notes)
     assert d.summary()["cause"]["effects"] == ["bending_stiffness"]
     assert d.baseline is not None and d.baseline.effects == ("bending_stiffness",)  # what of (tension, EI) applies
+
+
+def test_corrections_alone_win_over_a_cause_the_frequencies_cannot_tell_apart(monkeypatch):
+    """Step 7: a stay's tension within tolerance and an end restraint fit about as well; no cause is named.
+
+    (validate_diagnosis healthy stay seed 3001 was diagnosed as end_restraint before.) With the correction
+    3.9 AICc behind, the data do prefer the end restraint, and it is named.
+    """
+    from stcs_ident.diagnose import selection
+
+    n = 12
+    monkeypatch.setattr(selection, "beyond_tolerance",
+                        lambda fit: {e: False for e in fit.effects if e != "end_restraint"})
+    fits = {(): _fit((), 0, 5000.0, n), ("end_restraint",): _fit(("end_restraint",), 1, 10.0, n),
+            ("tension",): _fit(("tension",), 2, 8.0, n)}  # AICc 12.4 and 13.3
+    sel = selection.select(fits, n)
+    assert sel.effects == () and sel.corrections == ("tension",) and ("end_restraint",) in sel.ambiguous_with
+    fits[("tension",)] = _fit(("tension",), 2, 11.0, n)  # AICc 16.3: 3.9 behind
+    sel = selection.select(fits, n)
+    assert sel.effects == ("end_restraint",)

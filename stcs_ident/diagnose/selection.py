@@ -41,6 +41,14 @@
    without a tolerance (an unmodeled mass or support, an end restraint)
    are causes when chosen. The corrected model is the chosen hypothesis,
    corrections included.
+7. **Plausibility first**: when a hypothesis of corrections alone (every
+   effect within its tolerance) is within :data:`AMBIGUITY` of the chosen
+   one, it is chosen instead: the frequencies cannot tell the two apart,
+   and stated values within their tolerance are the more plausible
+   explanation. On a string-like stay (ξ ≈ 170) a tension within its 2 %
+   tolerance, a length change or an end restraint reproduce one another;
+   without this step such records were diagnosed as `end_restraint` or
+   `length` (benchmarks/validate_diagnosis.py, healthy stays).
 """
 
 from __future__ import annotations
@@ -179,6 +187,12 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
             break
         best = min(nested, key=lambda f: (len(f.effects), f.aicc))
     beyond = beyond_tolerance(best)
+    if any(beyond.get(e) is not False for e in best.effects):
+        # Step 7: a cause is named only when no hypothesis of corrections alone explains the data as well.
+        plain = [f for f in ranked if f.aicc - best.aicc < AMBIGUITY and _corrections_only(f)]
+        if plain:
+            best = min(plain, key=lambda f: (len(f.effects), f.aicc))
+            beyond = beyond_tolerance(best)
     corrections = tuple(e for e in best.effects if beyond.get(e) is False)
     cause = tuple(e for e in best.effects if e not in corrections)
     cost = {}
@@ -207,6 +221,12 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
         statement += f", but {'; '.join(' + '.join(a) for a in ambiguous)} explain them about as well (ΔAICc < 2)"
     return Selection(cause, principal, ambiguous, False, p_value, cost, statement + ".", best.effects, corrections,
                      implausible, model_error)
+
+
+def _corrections_only(fit: HypothesisFit) -> bool:
+    """Whether every effect of ``fit`` has a tolerance and stays within it (step 6): nothing to name."""
+    beyond = beyond_tolerance(fit)
+    return bool(fit.effects) and all(beyond.get(e) is False for e in fit.effects)
 
 
 def beyond_tolerance(fit: HypothesisFit) -> dict[str, bool]:
