@@ -32,7 +32,7 @@ Noise and uncertainty
     modelled as diag(n) + L_k M (sensor floor n per channel, forced
     response L_k M), both estimated from the residuals, and the
     covariance is the sandwich of the fit under that noise
-    (:func:`_forced_response_covariance`); it reduces to the bound when
+    (:func:`.decay_covariance.forced_response_covariance`); it reduces to the bound when
     M = 0. White-noise Fisher σ under light wind was up to 6 times too
     small (benchmarks/calibrate_spectra.py).
 
@@ -43,15 +43,17 @@ Reported frequency
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import stats
+
+from .decay_covariance import forced_response_covariance
+from .wander import between_events_addition
 
 __all__ = ["DecayFit", "EventSpectrum", "event_spectra", "fit_decay", "pole_statistics"]
 
 MAX_ITERATIONS = 40
-HETEROGENEITY_LEVEL = 0.05  # Cochran's Q test of the events' agreement before a between-event variance is added
 DAMPING_GRID = np.concatenate([[0.0], np.logspace(-4.5, -1.0, 15)])
 
 
@@ -90,7 +92,7 @@ class DecayFit:
         continuing through the decay) or another misfit sits under it.
     forced_ratio : float
         Power of the mode's random (forced) response in the band over that
-        of its free decay, both in noise units (:func:`_noise_model`): about
+        of its free decay, both in noise units (:func:`.decay_covariance.noise_model`): about
         0 for a clean decay, above 1 where ambient loading rather than the
         blows makes the peak.
     significance : float
@@ -100,6 +102,12 @@ class DecayFit:
         as far as their residuals are independent (a random response
         common to all channels is one observation, not C).
     converged : bool
+    forced_ratio : float
+    event_frequencies, event_variances : ndarray (n_events,)
+        Each event's own fit of the mode (f_d, Hz, and its variance, Hz²;
+        NaN where the event is too short for the band or its fit failed),
+        in the order of the spectra; empty with one event. The 1σ above
+        already allows for their disagreement (:mod:`.wander`).
     """
 
     frequency: float
@@ -115,6 +123,8 @@ class DecayFit:
     significance: float
     converged: bool
     forced_ratio: float = 0.0
+    event_frequencies: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    event_variances: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
 
 def event_spectra(x: np.ndarray, starts_stops: list[tuple[int, int]]) -> list[EventSpectrum]:
@@ -290,9 +300,9 @@ def fit_decay(
         None when the fit leaves the band or the information matrix is singular.
     """
     dt = 1.0 / sampling_rate
-    bands = [
-        b for b in _bands(spectra, f_initial, half_width, dt, neighbours) if b.dft.shape[0] > b.background.shape[1] + 2
-    ]
+    all_bands = _bands(spectra, f_initial, half_width, dt, neighbours)
+    used = [b.dft.shape[0] > b.background.shape[1] + 2 for b in all_bands]
+    bands = [b for b, u in zip(all_bands, used) if u]
     if not bands:
         return None
     n_channels = bands[0].dft.shape[1]
@@ -307,151 +317,44 @@ def fit_decay(
     theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits)
     noise_var = _noise_variance(state, n_params)
     weights = 1.0 / noise_var
-    state = _evaluate(theta, bands, dt, weights, with_jacobian=True)
-    jtj, _ = _normal_equations(state, weights)
     try:
-        cov, forced_ratio = _forced_response_covariance(theta, state, bands, dt, weights, jtj)
+        cov, forced_ratio, state = _covariance(theta, bands, dt, weights)
     except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
         return None
-    cov[0, 0] += _between_events_variance(theta, bands, dt, weights, limits, cov[0, 0])
-    return _result(theta, cov, state, bands, dt, noise_var, ok, forced_ratio)
+    event_f = np.full(len(all_bands), np.nan) if len(spectra) > 1 else np.zeros(0)
+    event_v = event_f.copy()
+    if len(bands) > 1:
+        event_f[np.flatnonzero(used)], event_v[np.flatnonzero(used)] = _event_estimates(theta, bands, dt, weights, limits)
+        cov[0, 0] += between_events_addition(event_f, event_v, cov[0, 0])
+    fit = _result(theta, cov, state, bands, dt, noise_var, ok, forced_ratio)
+    return replace(fit, event_frequencies=event_f, event_variances=event_v)
 
 
-def _between_events_variance(theta, bands: list[_Band], dt: float, weights: np.ndarray, limits,
-                             joint_variance: float) -> float:
-    """What to add to the joint fit's frequency variance for the events' disagreement (0 with one event).
+def _covariance(theta, bands: list[_Band], dt: float, weights: np.ndarray) -> tuple[np.ndarray, float, _State]:
+    """Covariance of (f_d, σ) at ``theta`` under the band noise model, the forced ratio (:mod:`.decay_covariance`), the state."""
+    state = _evaluate(theta, bands, dt, weights, with_jacobian=True)
+    jtj, _ = _normal_equations(state, weights)
+    z = _pole(theta[0], theta[1], dt)
+    columns = [_pole_column(z, band.phase, band.n_samples) for band in bands]
+    return (*forced_response_covariance(z, columns, state, bands, weights, jtj), state)
 
-    The tension, and with it every frequency, wanders within a record
-    (temperature, traffic): blows minutes apart ring at frequencies that
-    differ by more than their noise, and the record's mean frequency is
-    known only as well as their scatter allows. Each event is fitted on
-    its own (its sandwich 1σ v_i); the between-event variance τ² is the
-    DerSimonian–Laird moment estimate from their weighted scatter, taken
-    only where Cochran's Q shows the events disagree (level
-    HETEROGENEITY_LEVEL: without the test, chance scatter of two or three
-    clean events made their σ too large, 78–88 % within 1σ), and the
-    joint estimate is given the random-effects variance of the mean,
-    1 / Σ 1/(v_i + τ²), where that exceeds its own.
-    """
-    if len(bands) < 2:
-        return 0.0
-    f, v = [], []
-    for band in bands:
+
+def _event_estimates(theta, bands: list[_Band], dt: float, weights: np.ndarray, limits) -> tuple[np.ndarray, np.ndarray]:
+    """Each band's own fit of the mode from the joint one: f_d (Hz) and its variance (NaN where it fails)."""
+    f, v = np.full(len(bands), np.nan), np.full(len(bands), np.nan)
+    for i, band in enumerate(bands):
         try:
-            t, st, ok = _levenberg_marquardt(theta.copy(), [band], dt, weights, limits)
+            t, _, ok = _levenberg_marquardt(theta.copy(), [band], dt, weights, limits)
             if not ok:
                 continue
-            st = _evaluate(t, [band], dt, weights, with_jacobian=True)
-            jtj, _ = _normal_equations(st, weights)
-            c, _ = _forced_response_covariance(t, st, [band], dt, weights, jtj)
+            c, _, _ = _covariance(t, [band], dt, weights)
         except np.linalg.LinAlgError:
             continue
         if np.isfinite(c[0, 0]) and c[0, 0] > 0:
-            f.append(t[0])
-            v.append(c[0, 0])
-    if len(f) < 2:
-        return 0.0
-    f, w = np.array(f), 1.0 / np.array(v)
-    mean = np.sum(w * f) / np.sum(w)
-    q = float(np.sum(w * (f - mean) ** 2))
-    if q <= stats.chi2.isf(HETEROGENEITY_LEVEL, len(f) - 1):
-        return 0.0  # the events agree within their noise (DerSimonian–Laird alone inflates clean records)
-    tau2 = (q - (len(f) - 1)) / (np.sum(w) - np.sum(w**2) / np.sum(w))
-    return max(0.0, 1.0 / float(np.sum(1.0 / (np.array(v) + tau2))) - joint_variance)
-
-
-def _stationary_shape(z: complex, phase: np.ndarray, n: int) -> np.ndarray:
-    """Expected |X[k]|² (up to scale) of the mode's stationary random response in an N-sample segment.
-
-    Re(2G(u) − 1), u = exp(z − iφ), G(u) = Σ_{τ<N} (1 − τ/N) u^τ: the
-    Lorentzian of the pole convolved with the segment's Fejér kernel (the
-    debiased Whittle mean of :mod:`.ambient_fit`, its dispersive part left out).
-    """
-    log_u = z - 1j * phase
-    u = np.exp(log_u)
-    one_minus = -np.expm1(log_u)
-    g = 1.0 / one_minus - u * (-np.expm1(n * log_u)) / (n * one_minus**2)
-    return np.maximum(np.real(2.0 * g - 1.0), 0.0)
-
-
-def _noise_model(theta, state: _State, bands: list[_Band], dt: float) -> tuple[np.ndarray, np.ndarray, list]:
-    """White floor n_c and forced-response matrix M (C × C) of the band noise Σ_k = diag(n) + L_k M.
-
-    Ambient loading that goes on under a decay leaves, besides the sensor
-    noise, the mode's own random response: a Lorentzian L_k of the fitted
-    pole in every channel, common to all (M is the cross-spectral matrix
-    of that response, rank one for one mode). Both are estimated from the
-    residuals by moments that allow for what the fit removed: the
-    residual of bin k has E|r_kc|² = n_c (1 − h_k) + M_cc Σ_j |(I − P)_kj|² L_j
-    (P the projection on the model's linear columns), and its
-    cross-products between channels only the second term. M is then
-    projected on the positive semi-definite matrices.
-    """
-    z = _pole(theta[0], theta[1], dt)
-    lev, lor, res_all, shapes = [], [], [], []
-    for band, res in zip(bands, state.residuals):
-        basis = np.column_stack([_pole_column(z, band.phase, band.n_samples), band.background])
-        q, _ = np.linalg.qr(basis)
-        complement = np.eye(q.shape[0]) - q @ q.conj().T
-        shape = _stationary_shape(z, band.phase, band.n_samples)
-        lev.append(np.real(np.diag(complement)))
-        lor.append((np.abs(complement) ** 2) @ shape)
-        res_all.append(res)
-        shapes.append(shape)
-    a, b, r = np.concatenate(lev), np.concatenate(lor), np.concatenate(res_all)
-    n_channels = r.shape[1]
-    power = np.abs(r) ** 2
-    floor, forced = np.zeros(n_channels), np.zeros(n_channels)
-    design = np.column_stack([a, b])
-    for c in range(n_channels):
-        # Moments weighted by the inverse expected power (|r|² scatters in proportion to its mean).
-        weight = np.ones(a.size)
-        for _ in range(3):
-            coef, _ = optimize.nnls(design * weight[:, None], power[:, c] * weight)
-            expected = design @ coef
-            weight = 1.0 / np.maximum(expected, 1e-12 * max(expected.max(), np.finfo(float).tiny))
-        floor[c], forced[c] = coef
-    matrix = np.diag(forced).astype(complex)
-    if n_channels > 1 and np.any(forced > 0):
-        weight = b / np.maximum(a * floor.mean() + b * forced.mean(), np.finfo(float).tiny) ** 2
-        cross = (r * (weight * b)[:, None]).T @ r.conj() / max(float(np.sum(weight * b * b)), np.finfo(float).tiny)
-        matrix = cross.copy()
-        matrix[np.diag_indices(n_channels)] = forced
-        values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.conj().T))
-        matrix = (vectors * np.maximum(values, 0.0)) @ vectors.conj().T
-    # A floor the forced term explains away entirely is still not zero (the ratios below divide by it).
-    floor = np.maximum(floor, 1e-9 * power.mean(axis=0) + np.finfo(float).tiny)
-    return floor, matrix, shapes
-
-
-def _forced_response_covariance(theta, state: _State, bands: list[_Band], dt: float, weights: np.ndarray,
-                                jtj: np.ndarray) -> tuple[np.ndarray, float]:
-    """Covariance of (f_d, σ) under the band noise diag(n) + L_k M (:func:`_noise_model`), and the forced ratio.
-
-    The estimate solves Re Σ_k J_kᴴ W r_k = 0, so to first order its
-    covariance is the sandwich F⁻¹ (½ Re Σ_k J_kᴴ W Σ_k W J_k) F⁻¹ with
-    F = Re Σ J^H W J: (2F)⁻¹, the Fisher information's bound, when the
-    noise is white and independent between channels (M = 0), larger when
-    a random response of the mode sits under the decay (it is coloured,
-    concentrated where the frequency is decided, and common to all
-    channels). The forced ratio is Σ L_k tr(M N⁻¹) over Σ |g_k|² bᴴ N⁻¹ b
-    (N = diag(n)): the random response's power in the band over the decay's.
-    """
-    floor, matrix, shapes = _noise_model(theta, state, bands, dt)
-    z = _pole(theta[0], theta[1], dt)
-    forced_power = sum(float(shape.sum()) for shape in shapes) * float(np.sum(np.real(np.diag(matrix)) / floor))
-    decay_power = sum(float(np.sum(np.abs(_pole_column(z, band.phase, band.n_samples)) ** 2))
-                      * float(np.sum(np.abs(coef[0]) ** 2 / floor)) for band, coef in zip(bands, state.coefficients))
-    meat = np.zeros((2, 2))
-    for jac, shape in zip(state.jacobian, shapes):
-        wj = jac * weights[None, :, None]  # (m, C, 2)
-        white = np.einsum("mci,c,mcj->ij", wj.conj(), floor, wj)
-        forced = np.einsum("m,mci,cd,mdj->ij", shape, wj.conj(), matrix, wj)
-        meat += 0.5 * np.real(white + forced)
-    inverse = np.linalg.inv(jtj)
-    return inverse @ meat @ inverse, forced_power / max(decay_power, np.finfo(float).tiny)
+            f[i], v[i] = t[0], c[0, 0]
+    return f, v
 
 
 def _independent_channels(state: _State, noise_var: np.ndarray) -> float:

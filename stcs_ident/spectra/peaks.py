@@ -93,7 +93,7 @@ Why a parametric fit (measured; seeded simulations, /tmp benchmarks)
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -108,6 +108,7 @@ from .overview import Overview, ambient_overview, decay_overviews
 from .record import Record
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
+from .wander import common_wander, with_common_wander
 
 __all__ = ["Peak", "PeakResult", "find_peaks", "is_mains_hum"]
 
@@ -361,14 +362,19 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
         return fit
 
     cell_width = overview.cell * (overview.frequency[1] - overview.frequency[0])
+    fitted = refine(candidates, fit_band, resolution, BAND_MIN_BINS * resolution, 0.5 * fs, cell_width)
+    # The events' common offset, pooled over modes (a tension wander moves them all; wander.common_wander).
+    decays = [fit for _, fit in fitted if isinstance(fit, DecayFit)]
+    tau2 = common_wander([(f.frequency, f.event_frequencies, f.event_variances) for f in decays])
     peaks = []
-    for c, fit in refine(candidates, fit_band, resolution, BAND_MIN_BINS * resolution, 0.5 * fs, cell_width):
+    for c, fit in fitted:
         if fit is None:
             peaks.append(_overview_peak(c, overview, names))
         elif isinstance(fit, AmbientFit):
             peaks.append(_ambient_peak(c, fit, overview, names))
         else:
-            peaks.append(_decay_peak(c, fit, names))
+            std = with_common_wander(fit.frequency_std, fit.frequency, fit.event_variances, tau2)
+            peaks.append(_decay_peak(c, replace(fit, frequency_std=std), names))
     return peaks
 
 
