@@ -29,7 +29,7 @@ def _coverage(seed, tau_rel, pooled):
     rng = np.random.default_rng(seed)
     z = []
     for _ in range(400):
-        modes, offsets = _draw(rng, 3, tau_rel, 1e-5)
+        modes, _ = _draw(rng, 3, tau_rel, 1e-5)
         tau2 = common_wander(modes) if pooled else 0.0
         for f, fe, v in modes:
             w = 1 / v

@@ -115,6 +115,8 @@ __all__ = ["Peak", "PeakResult", "find_peaks", "is_mains_hum"]
 CHANNEL_SNR_DB = 6.0  # a channel saw a peak standing this high above its own floor
 MAX_RESIDUAL_EXCESS = 2.0  # decay-fit residual under the peak / away from it, beyond which Whittle is tried
 MAX_FORCED_RATIO = 0.3  # random response / free decay in the band beyond which the record's Whittle fit is used
+NARROW_DAMPING = 1e-3  # a decay fit below this ζ (cables: ≥ 1e-3 and rarely below 5e-4) is checked against Whittle
+BROADER_PEAK = 10.0  # ... and replaced by it when the record's peak is this many times broader (ζ)
 WHITTLE_MAX_STD = 0.25  # a Whittle fit whose 1σ exceeds this fraction of its band's half-width locates nothing
 DEDUPLICATE_MAX_STD = 0.005  # relative: a wider 1σ does not widen the window in which two peaks are one
 MAINS_FREQUENCIES = (50.0, 60.0)  # Hz
@@ -351,12 +353,17 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
 
     def fit_band(f0, half_width, poles, peak_width):
         fit = fit_decay(spectra, fs, f0, half_width, poles, max_damping=2 * MAX_DAMPING)
-        if fit is not None and fit.residual_excess > MAX_RESIDUAL_EXCESS:
+        if fit is not None and (fit.residual_excess > MAX_RESIDUAL_EXCESS or fit.damping < NARROW_DAMPING):
             # A random response under the decay: the decay fit's 1σ allows for it (decay_fit's noise model);
-            # the stationary model of the whole record is kept where it pins the mode down better.
+            # the stationary model of the whole record is kept where it pins the mode down better, and where
+            # the decay fit is far narrower than the record's peak: a pole that does not decay, fitted to
+            # one noise bin of a random response (a blow at the mode's node leaves nothing else to fit;
+            # calibrate_spectra hum60 stay seed 7 #10, mode 3: ζ 5e-5 for 0.0085, z = 76).
             other = whittle(f0, half_width, poles, peak_width)
             if _sound(other, half_width) and (
-                other.frequency_std < fit.frequency_std or fit.forced_ratio > MAX_FORCED_RATIO
+                other.frequency_std < fit.frequency_std
+                or fit.forced_ratio > MAX_FORCED_RATIO
+                or fit.damping * BROADER_PEAK < other.damping
             ):
                 return other
         return fit
