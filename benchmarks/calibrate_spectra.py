@@ -35,6 +35,7 @@ where it was imported from::
     python benchmarks/calibrate_spectra.py --records 30 --seed 1 --workers 2
     python benchmarks/calibrate_spectra.py --quick            # a few records per group
     python benchmarks/calibrate_spectra.py --group hum50 --records 10 --json /tmp/out.json
+    python benchmarks/calibrate_spectra.py --group drift_clean --by-blows
 
 Tune on one seed, report on another (``--seed`` picks disjoint streams).
 """
@@ -161,7 +162,7 @@ def run_case(case: dict) -> dict:
     true_f = truth.mean_frequencies
     scored = true_f[: c.n_modes]
     f_max = min(0.45 * c.sampling_rate, 1.15 * scored[-1])
-    out = {k: case[k] for k in ("group", "cable", "seed", "index")}
+    out = {k: case[k] for k in ("group", "cable", "seed", "index")} | {"blows": len(case["impulses"])}
     try:
         result = find_peaks(record, f_min=0.5 * scored[0], f_max=f_max)
     except Exception as exc:  # noqa: BLE001 -- a failure is a finding of the benchmark, not a crash of it
@@ -195,9 +196,13 @@ def run_case(case: dict) -> dict:
     return out
 
 
-def summarise(results: list[dict]) -> list[dict]:
+def summarise(results: list[dict], by_blows: bool = False) -> list[dict]:
+    """One row per group and cable (and number of blows if ``by_blows``: group "drift_clean/1" = one blow)."""
+    if by_blows:
+        results = [r | {"group": f"{r['group']}/{r['blows']}"} for r in results]
+    order = {g: i for i, g in enumerate(GROUPS)}
     rows = []
-    keys = sorted({(r["group"], r["cable"]) for r in results}, key=lambda k: (GROUPS.index(k[0]), k[1]))
+    keys = sorted({(r["group"], r["cable"]) for r in results}, key=lambda k: (order[k[0].split("/")[0]], k))
     for group, cable in keys:
         rs = [r for r in results if r["group"] == group and r["cable"] == cable]
         z = np.array([(fe - ft) / s for r in rs for _, ft, fe, s in r["pairs"]])
@@ -238,6 +243,9 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     parser.add_argument("--quick", action="store_true", help="3 records per group and cable")
     parser.add_argument("--json", help="write the per-record results and the table to this file")
+    parser.add_argument("--by-blows", action="store_true",
+                        help="also a table per number of blows (a single blow in a windless record cannot show a "
+                             "tension drift over the rest of it)")
     args = parser.parse_args(argv)
     n = 3 if args.quick else args.records
     print(f"stcs_ident {getattr(stcs_ident, '__version__', '?')} imported from {stcs_ident.__file__}")
@@ -252,6 +260,9 @@ def main(argv=None) -> int:
         results = [run_case(c) for c in cases]
     rows = summarise(results)
     print_table(rows)
+    if args.by_blows:
+        print("\nper number of blows (group/blows):")
+        print_table(summarise(results, by_blows=True))
     print(f"{len(cases)} records in {time.perf_counter() - t0:.0f} s")
     for r in results:
         if "error" in r:
