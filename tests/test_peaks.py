@@ -384,13 +384,13 @@ def _peak(frequency: float, uncertainty: float, snr_db: float):
 
 def test_a_wide_uncertainty_does_not_swallow_well_located_neighbours():
     """A fundamental whose fit returned σ = 5 Hz (the strongest peak) once removed modes 2–14 as its duplicates."""
-    from stcs_ident.spectra.peaks import _deduplicate
+    from stcs_ident.spectra.peak_filters import deduplicate
 
     peaks = [_peak(1.096, 5.14, 35.0)] + [_peak(1.096 * k, 0.002, 28.0) for k in range(2, 15)]
-    kept = _deduplicate(peaks)
+    kept = deduplicate(peaks)
     assert [round(p.frequency, 3) for p in kept] == [round(p.frequency, 3) for p in peaks]
     # Two fits of one mode still collapse to the stronger.
-    twin = _deduplicate([_peak(5.850, 0.002, 20.0), _peak(5.851, 0.002, 25.0)])
+    twin = deduplicate([_peak(5.850, 0.002, 20.0), _peak(5.851, 0.002, 25.0)])
     assert len(twin) == 1 and twin[0].snr_db == 25.0
 
 

@@ -26,7 +26,12 @@ Steps
        common to all channels: :mod:`.decay_fit`), and the Whittle fit of
        the whole record is taken instead when its 1σ is smaller or the
        forced response outweighs the decay in the band (the blows are then
-       too weak for the decay model). Both are maximum likelihood on the
+       too weak for the decay model), or where the decay fit does not decay
+       while the record's peak is ten times broader (a fit to one noise bin
+       of the random response). With several blows, their disagreement
+       beyond their noise widens the 1σ, mode by mode and pooled over all
+       modes (a tension wander moves them together: :mod:`.wander`), since
+       the frequency sought is the record's mean. Both are maximum likelihood on the
        band; the 1σ comes from the information of the fit under its noise
        model. Detections whose fit is not a significant, lightly
        damped mode are dropped (the overview may propose a few: on the
@@ -38,7 +43,7 @@ Steps
        resonances, too little prominent to be detected, whose neighbour's
        fit would otherwise absorb it).
     4. Mains hum: a fitted line with ζ < 5e-4 within 0.2 % of a harmonic
-       of 50 or 60 Hz is not reported (:func:`is_mains_hum`).
+       of 50 or 60 Hz is not reported (:func:`.peak_filters.is_mains_hum`).
     5. Channels: those where the peak stands at least 6 dB above the
        channel's own noise floor (free decay: the fitted mode's peak power
        per bin over the noise per bin, plus one; ambient: the Welch
@@ -105,6 +110,7 @@ from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution
 from .events import Event, detect_events, whole_record_event
 from .overview import Overview, ambient_overview, decay_overviews
+from .peak_filters import deduplicate, is_mains_hum
 from .record import Record
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
@@ -118,10 +124,6 @@ MAX_FORCED_RATIO = 0.3  # random response / free decay in the band beyond which 
 NARROW_DAMPING = 1e-3  # a decay fit below this ζ (cables: ≥ 1e-3 and rarely below 5e-4) is checked against Whittle
 BROADER_PEAK = 10.0  # ... and replaced by it when the record's peak is this many times broader (ζ)
 WHITTLE_MAX_STD = 0.25  # a Whittle fit whose 1σ exceeds this fraction of its band's half-width locates nothing
-DEDUPLICATE_MAX_STD = 0.005  # relative: a wider 1σ does not widen the window in which two peaks are one
-MAINS_FREQUENCIES = (50.0, 60.0)  # Hz
-MAINS_TOLERANCE = 0.002  # relative: grids keep within ±0.1 % of their nominal frequency, with margin
-MAX_HUM_DAMPING = 5e-4  # a line this undamped at a mains harmonic is hum (cable modes: ζ ≥ 1e-3)
 BAND_MIN_BINS = 24  # free decays: narrowest band, DFT bins of the longest event
 BAND_MIN_WELCH_BINS = 12  # ambient: narrowest band, Welch resolution cells
 KINDS = ("auto", "impulse", "ambient")
@@ -284,7 +286,7 @@ def find_peaks(
     overview = overviews[0]
     candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db)
     refine = _refine_decays if events else _refine_ambient
-    peaks = _deduplicate(refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi)))
+    peaks = deduplicate(refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi)))
     peaks = [p for p in peaks if not is_mains_hum(p)]
     if max_peaks is not None and len(peaks) > max_peaks:
         # After the fits: the overview's strongest candidates may include some that are not modes.
@@ -302,25 +304,6 @@ def find_peaks(
         channel_names=record.channel_names,
         threshold=threshold,
     )
-
-
-def is_mains_hum(peak: Peak) -> bool:
-    """Whether a peak is mains hum: a line at a harmonic of 50 or 60 Hz with no damping.
-
-    Hum is a sinusoid of constant amplitude through the whole record, so
-    its fit (free decay or ambient) gives ζ ≈ 0 (within MAX_HUM_DAMPING),
-    which no cable mode has; the frequency must also lie within
-    MAINS_TOLERANCE of h · 50 or h · 60 Hz. It stays in the fits as a
-    neighbour of the modes beside it (they were fitted with it) and is not
-    reported.
-    """
-    if peak.damping is None or peak.damping >= MAX_HUM_DAMPING:
-        return False
-    for mains in MAINS_FREQUENCIES:
-        harmonic = round(peak.frequency / mains)
-        if harmonic >= 1 and abs(peak.frequency - harmonic * mains) <= MAINS_TOLERANCE * harmonic * mains:
-            return True
-    return False
 
 
 def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple[float, float]:
@@ -508,25 +491,3 @@ def _overview_peak(c: Candidate, overview: Overview, names) -> Peak:
         snr_db=c.snr_db,
         channel_snr_db=snr,
     )
-
-
-def _deduplicate(peaks: list[Peak]) -> list[Peak]:
-    """Two detections that converged on the same mode keep the stronger one.
-
-    The same mode means within 3σ, each σ counted at most
-    DEDUPLICATE_MAX_STD of its frequency: one poor fit's wide σ must not
-    swallow its well-located neighbours (a cable's modes lie a fundamental
-    apart, several percent below mode 30).
-    """
-
-    def reach(p: Peak) -> float:
-        return min(p.uncertainty, DEDUPLICATE_MAX_STD * p.frequency)
-
-    out: list[Peak] = []
-    for p in sorted(peaks, key=lambda p: p.frequency):
-        if out and abs(p.frequency - out[-1].frequency) < 3.0 * max(reach(p), reach(out[-1])):
-            if p.snr_db > out[-1].snr_db:
-                out[-1] = p
-            continue
-        out.append(p)
-    return out
