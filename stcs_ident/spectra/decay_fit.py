@@ -276,6 +276,7 @@ def fit_decay(
     half_width: float,
     neighbours: list[tuple[float, float]] = (),
     max_damping: float = 0.2,
+    min_damping: float = 0.0,
 ) -> DecayFit | None:
     """Fit one mode (common f, σ) to the band [f_initial ± half_width] of the free-decay DFTs.
 
@@ -293,6 +294,9 @@ def fit_decay(
         Nearby modes whose tails cross the band, modelled with fixed poles.
     max_damping : float
         Upper bound on ζ during the search.
+    min_damping : float
+        Lower bound on ζ (0: a slightly growing pole is allowed, so that an
+        undamped line is fitted without a bound in the way).
 
     Returns
     -------
@@ -308,7 +312,8 @@ def fit_decay(
     n_channels = bands[0].dft.shape[1]
     n_params = bands[0].background.shape[1] + 1
     sigma_max = min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)
-    limits = ((f_initial - half_width, f_initial + half_width), (-0.05 * sigma_max, sigma_max))
+    sigma_min = min_damping * 2 * np.pi * f_initial if min_damping > 0 else -0.05 * sigma_max
+    limits = ((f_initial - half_width, f_initial + half_width), (sigma_min, sigma_max))
     weights = np.ones(n_channels)
     theta = np.array([f_initial, _initial_decay_rate(f_initial, bands, dt, weights, limits[1])])
     theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits)

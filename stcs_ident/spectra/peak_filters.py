@@ -8,9 +8,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .peaks import Peak
+    from .peak_result import Peak
 
-__all__ = ["deduplicate", "is_mains_hum"]
+__all__ = ["at_mains_harmonic", "deduplicate", "is_mains_hum"]
 
 DEDUPLICATE_MAX_STD = 0.005  # relative: a wider 1σ does not widen the window in which two peaks are one
 MAINS_FREQUENCIES = (50.0, 60.0)  # Hz
@@ -30,9 +30,14 @@ def is_mains_hum(peak: Peak) -> bool:
     """
     if peak.damping is None or peak.damping >= MAX_HUM_DAMPING:
         return False
+    return at_mains_harmonic(peak.frequency)
+
+
+def at_mains_harmonic(frequency: float) -> bool:
+    """Whether ``frequency`` lies within MAINS_TOLERANCE of a harmonic of 50 or 60 Hz."""
     for mains in MAINS_FREQUENCIES:
-        harmonic = round(peak.frequency / mains)
-        if harmonic >= 1 and abs(peak.frequency - harmonic * mains) <= MAINS_TOLERANCE * harmonic * mains:
+        harmonic = round(frequency / mains)
+        if harmonic >= 1 and abs(frequency - harmonic * mains) <= MAINS_TOLERANCE * harmonic * mains:
             return True
     return False
 

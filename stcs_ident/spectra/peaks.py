@@ -98,10 +98,9 @@ Why a parametric fit (measured; seeded simulations, /tmp benchmarks)
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
-import pandas as pd
 from scipy import fft
 
 from ..errors import InputError
@@ -110,7 +109,8 @@ from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution
 from .events import Event, detect_events, whole_record_event
 from .overview import Overview, ambient_overview, decay_overviews
-from .peak_filters import deduplicate, is_mains_hum
+from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
+from .peak_result import Peak, PeakResult
 from .record import Record
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
@@ -127,117 +127,6 @@ WHITTLE_MAX_STD = 0.25  # a Whittle fit whose 1σ exceeds this fraction of its b
 BAND_MIN_BINS = 24  # free decays: narrowest band, DFT bins of the longest event
 BAND_MIN_WELCH_BINS = 12  # ambient: narrowest band, Welch resolution cells
 KINDS = ("auto", "impulse", "ambient")
-
-
-@dataclass(frozen=True)
-class Peak:
-    """One modal peak.
-
-    Parameters
-    ----------
-    frequency : float
-        Undamped natural frequency f_n = |s|/2π of the fitted pole, Hz.
-    uncertainty : float
-        1σ of ``frequency`` (Fisher information of the fit), Hz.
-    damping : float or None
-        Damping ratio ζ (None when the fit failed and the overview peak is
-        reported instead).
-    damping_uncertainty : float or None
-        1σ of ``damping``.
-    channels : tuple of str
-        Channels whose own spectrum shows the peak ≥ 6 dB above its floor.
-    amplitude : ndarray (n_channels,)
-        Per channel, signed by the phase relative to the largest entry
-        (so it is the sampled mode shape): for free decays, the amplitude
-        of the mode at the start of the strongest event, m/s²; for ambient
-        records, the rms modal acceleration, m/s².
-    snr_db : float
-        Height of the peak above the floor of the combined spectrum, dB.
-    channel_snr_db : ndarray (n_channels,)
-        Height above each channel's floor, dB.
-    """
-
-    frequency: float
-    uncertainty: float
-    damping: float | None
-    damping_uncertainty: float | None
-    channels: tuple[str, ...]
-    amplitude: np.ndarray
-    snr_db: float
-    channel_snr_db: np.ndarray = field(repr=False)
-
-
-@dataclass(frozen=True)
-class PeakResult:
-    """Result of :func:`find_peaks`.
-
-    Parameters
-    ----------
-    peaks : list of Peak
-        Ordered by frequency.
-    kind : str
-        "impulse" or "ambient".
-    events : list of (float, float)
-        Free-decay segments used, (start, end) in s from the record start
-        (empty for ambient records).
-    frequency_axis : ndarray (n_freq,), Hz
-    combined_spectrum : ndarray (n_freq,)
-        Mean over channels of each channel's spectrum over its noise floor
-        (about 1 where there is only noise).
-    combined_floor : ndarray (n_freq,)
-        Floor of ``combined_spectrum`` (about 1).
-    channel_spectra : ndarray (n_freq, n_channels)
-        One-sided PSD, (m/s²)²/Hz (per-event periodograms averaged over
-        events for impulse records, Welch for ambient).
-    channel_floor : ndarray (n_freq, n_channels)
-        Noise floor of each channel spectrum.
-    channel_names : tuple of str
-    threshold : ndarray (n_freq,)
-        Detection threshold on combined / floor (linear; it depends on the
-        local degrees of freedom): a peak must reach floor × threshold.
-    """
-
-    peaks: list[Peak]
-    kind: str
-    events: list[tuple[float, float]]
-    frequency_axis: np.ndarray
-    combined_spectrum: np.ndarray
-    combined_floor: np.ndarray
-    channel_spectra: np.ndarray
-    channel_floor: np.ndarray
-    channel_names: tuple[str, ...]
-    threshold: np.ndarray
-
-    def to_dataframe(self) -> pd.DataFrame:
-        """One row per peak: frequency, uncertainty, damping, its 1σ, SNR, channels, amplitude per channel."""
-        rows = []
-        for p in self.peaks:
-            row = {
-                "frequency": p.frequency,
-                "uncertainty": p.uncertainty,
-                "damping": p.damping,
-                "damping_uncertainty": p.damping_uncertainty,
-                "snr_db": p.snr_db,
-                "channels": ",".join(p.channels),
-            }
-            row.update({f"amplitude[{name}]": a for name, a in zip(self.channel_names, p.amplitude)})
-            rows.append(row)
-        columns = ["frequency", "uncertainty", "damping", "damping_uncertainty", "snr_db", "channels"]
-        columns += [f"amplitude[{name}]" for name in self.channel_names]
-        return pd.DataFrame(rows, columns=columns)
-
-    def summary(self) -> dict:
-        """Plain data (JSON-serialisable): kind, events and per-peak lists, ordered by frequency."""
-        return {
-            "kind": self.kind,
-            "events": [list(e) for e in self.events],
-            "frequencies": [p.frequency for p in self.peaks],
-            "uncertainty": [p.uncertainty for p in self.peaks],
-            "damping": [p.damping for p in self.peaks],
-            "damping_uncertainty": [p.damping_uncertainty for p in self.peaks],
-            "snr_db": [p.snr_db for p in self.peaks],
-            "channels": [list(p.channels) for p in self.peaks],
-        }
 
 
 def find_peaks(
@@ -351,8 +240,17 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
                 return other
         return fit
 
+    calls: dict[int, tuple] = {}
+
+    def fit_band_noted(f0, half_width, poles, peak_width):
+        fit = fit_band(f0, half_width, poles, peak_width)
+        calls[id(fit)] = (f0, half_width, poles)
+        return fit
+
     cell_width = overview.cell * (overview.frequency[1] - overview.frequency[0])
-    fitted = refine(candidates, fit_band, resolution, BAND_MIN_BINS * resolution, 0.5 * fs, cell_width)
+    fitted = refine(candidates, fit_band_noted, resolution, BAND_MIN_BINS * resolution, 0.5 * fs, cell_width)
+    fitted, widened = _without_lines(fitted, calls, lambda f0, hw, poles, zeta: fit_decay(
+        spectra, fs, f0, hw, poles, max_damping=2 * MAX_DAMPING, min_damping=zeta))
     # The events' common offset, pooled over modes (a tension wander moves them all; wander.common_wander).
     decays = [fit for _, fit in fitted if isinstance(fit, DecayFit)]
     tau2 = common_wander([(f.frequency, f.event_frequencies, f.event_variances) for f in decays])
@@ -364,8 +262,43 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
             peaks.append(_ambient_peak(c, fit, overview, names))
         else:
             std = with_common_wander(fit.frequency_std, fit.frequency, fit.event_variances, tau2)
-            peaks.append(_decay_peak(c, replace(fit, frequency_std=std), names))
+            peak = _decay_peak(c, replace(fit, frequency_std=std), names)
+            peaks.append(replace(peak, damping=None, damping_uncertainty=None) if id(fit) in widened else peak)
     return peaks
+
+
+def _without_lines(fitted: list, calls: dict, refit: Callable) -> tuple[list, set]:
+    """Decay fits that do not decay, among modes that do: refitted, or kept with the 1σ of the mode's own width.
+
+    A pole ten times narrower than the record's other modes and below
+    NARROW_DAMPING, which the record's Whittle fit could not replace, is a
+    fit to one noise bin of the mode's random response (a blow at the
+    mode's node under wind: calibrate_spectra seed 11, four stay modes with
+    ζ 1e-5–2e-4 among modes of 0.5–1 %, z = 5–64). A cable's damping
+    changes gradually from mode to mode; hum, the one undamped line a
+    record holds, is left to be recognised and removed afterwards. The
+    mode is refitted with ζ at least a third of the modes' median; where
+    that fails (no decay to fit), it is kept where the fit put it with a
+    1σ of ζ_median · f: the random response's maximum lies anywhere
+    within about half the mode's half-power band. Returns the pairs and
+    the ids of the fits so widened (their damping is not known).
+    """
+    zetas = [fit.damping for _, fit in fitted if isinstance(fit, DecayFit)]
+    if len(zetas) < 3:
+        return fitted, set()
+    median = float(np.median(zetas))
+    out, widened = [], set()
+    for c, fit in fitted:
+        narrow = isinstance(fit, DecayFit) and fit.damping < min(NARROW_DAMPING, median / BROADER_PEAK)
+        if narrow and id(fit) in calls and not at_mains_harmonic(fit.frequency):
+            other = refit(*calls[id(fit)], 3.0 * median / BROADER_PEAK)
+            if other is not None and other.converged:
+                fit = other
+            else:
+                fit = replace(fit, frequency_std=max(fit.frequency_std, median * fit.frequency))
+                widened.add(id(fit))
+        out.append((c, fit))
+    return out, widened
 
 
 def _sound(fit: AmbientFit | None, half_width: float) -> bool:
