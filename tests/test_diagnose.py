@@ -294,3 +294,29 @@ def test_corrections_alone_win_over_a_cause_the_frequencies_cannot_tell_apart(mo
     fits[("tension",)] = _fit(("tension",), 2, 11.0, n)  # AICc 16.3: 3.9 behind
     sel = selection.select(fits, n)
     assert sel.effects == ("end_restraint",)
+
+
+def test_joint_excess_generalises_the_one_parameter_test_and_sees_a_spread_departure(monkeypatch):
+    """Δχ² to the tolerance box: (excess/σ)² for one parameter; a departure split between two parameters the
+    frequencies cannot separate (each 'not required' beyond its tolerance, σ wide) is still outside."""
+    from types import SimpleNamespace
+
+    from stcs_ident.diagnose import selection
+
+    def fake(estimate, starts, widths, cov):
+        monkeypatch.setattr(selection, "prior_widths", lambda campaign, hypothesis: widths)
+        params = tuple(SimpleNamespace(start=s) for s in starts)
+        result = SimpleNamespace(estimate=np.array(estimate), parameters=params, covariance=np.array(cov))
+        return SimpleNamespace(result=result, hypothesis=SimpleNamespace(campaign=None))
+
+    one = fake([1.05], [1.0], [0.02], [[0.01**2]])
+    assert selection.joint_excess(one) == pytest.approx(((0.05 - 0.02) / 0.01) ** 2)
+    assert selection.joint_excess(fake([1.01], [1.0], [0.02], [[0.01**2]])) == 0.0
+    # Tension ratio and length ratio: only their sum is measured (to 1e-4); the sum departs by 4 %.
+    s, big = 1e-4, 0.03
+    cov = [[big**2, -(big**2) + s**2 / 2], [-(big**2) + s**2 / 2, big**2]]
+    spread = fake([1.02, 1.02], [1.0, 1.0], [0.02, 0.002], cov)
+    assert all(abs(x - 1.0) - w < selection.BEYOND * big for x, w in zip([1.02, 1.02], [0.02, 0.002]))
+    assert selection.joint_excess(spread) > 1e3 * selection.BEYOND**2
+    # A free parameter (no tolerance) takes up what it can: nothing is beyond.
+    assert selection.joint_excess(fake([1.02, 1.02], [1.0, 1.0], [0.02, None], cov)) < 1e-6
