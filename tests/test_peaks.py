@@ -434,7 +434,7 @@ def test_blows_ringing_at_different_frequencies_widen_the_uncertainty():
     assert sigmas["same"] < 0.05 * sigmas["wander"]
 
 
-def _stay_record_at_a_node(impulse, ambient, snr_db, damping, field):
+def _stay_record_at_a_node(impulse, ambient, snr_db, damping, seed, conditions):
     """A record of calibrate_spectra's stay (120 m, 64 Hz, 600 s, 3 sensors) with one blow, and the true means."""
     import math
 
@@ -444,8 +444,7 @@ def _stay_record_at_a_node(impulse, ambient, snr_db, damping, field):
     cable = Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9, inclination=math.radians(30))
     record, truth = simulate_record_with_truth(
         cable, (Attachment("damper", 3.0, 50.0),), 4.0e6, [27.6, 60.0, 85.2], duration=600.0, sampling_rate=64.0,
-        damping=damping, impulses=(impulse,), ambient=ambient, snr_db=snr_db, seed=field.pop("seed"),
-        field=field.pop("conditions"))
+        damping=damping, impulses=(impulse,), ambient=ambient, snr_db=snr_db, seed=seed, field=conditions)
     return record, truth.mean_frequencies[:12]
 
 
@@ -457,15 +456,14 @@ def _node_case(name):
     if name == "hum60 seed 7 #10":  # mode 3, blown at 80.8 m (its node at 80 m)
         return _stay_record_at_a_node(
             Impulse(15.243027522018394, 80.8138246150208, 17.508392742420774), Ambient(0.4467884700751033),
-            32.70017052631475, 0.008505342733147469,
-            {"seed": [7, 10, 7], "conditions": FieldConditions(
-                hum=MainsHum(59.9759, (1.475e-3, 2.53e-4, 1.56e-4), relative=True))})
+            32.70017052631475, 0.008505342733147469, [7, 10, 7],
+            FieldConditions(hum=MainsHum(59.9759, (1.475e-3, 2.53e-4, 1.56e-4), relative=True)))
     # drift seed 11 #5: mode 7, blown at 34.5 m (its node at 34.3 m), light wind, a tension drift
     drift = TensionDrift(rate=-1.8445202800231834e-07, amplitude=3.8445943306435285e-05, period=66.0749029180868,
                          phase=5.120505727902901, walk=1.1549000769659634e-06)
     return _stay_record_at_a_node(
         Impulse(47.070387976612096, 34.48921426568736, 50.666290160337226), Ambient(0.05638569987563043),
-        39.93718880833344, 0.008585714641648066, {"seed": [11, 5, 7], "conditions": FieldConditions(drift=drift)})
+        39.93718880833344, 0.008585714641648066, [11, 5, 7], FieldConditions(drift=drift))
 
 
 @pytest.mark.parametrize("case", ["hum60 seed 7 #10", "drift seed 11 #5"])

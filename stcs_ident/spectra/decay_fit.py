@@ -102,7 +102,6 @@ class DecayFit:
         as far as their residuals are independent (a random response
         common to all channels is one observation, not C).
     converged : bool
-    forced_ratio : float
     event_frequencies, event_variances : ndarray (n_events,)
         Each event's own fit of the mode (f_d, Hz, and its variance, Hz²;
         NaN where the event is too short for the band or its fit failed),

@@ -76,7 +76,8 @@ def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]]) -> float:
     (Cochran's Q, n_events − 1 degrees of freedom) and measured
     (DerSimonian–Laird).
     """
-    rows = [(f0, *_aligned(fe, ve)) for f0, fe, ve in modes if np.sum(np.isfinite(fe) & np.isfinite(ve)) >= 2]
+    rows = [(f0, *_aligned(fe, ve)) for f0, fe, ve in modes]
+    rows = [r for r in rows if np.sum(np.isfinite(r[1])) >= 2]
     if len(rows) < 2:
         return 0.0
     n_events = len(rows[0][1])
@@ -84,7 +85,7 @@ def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]]) -> float:
         return 0.0
     num, den = np.zeros(n_events), np.zeros(n_events)
     for f0, fe, ve in rows:
-        ok = np.isfinite(fe) & np.isfinite(ve)
+        ok = np.isfinite(fe)
         # Centred per mode on its events' weighted mean (what the joint fit is, near enough).
         centre = np.sum(fe[ok] / ve[ok]) / np.sum(1.0 / ve[ok])
         rel = (fe - centre) / f0
