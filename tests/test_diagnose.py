@@ -320,3 +320,70 @@ def test_joint_excess_generalises_the_one_parameter_test_and_sees_a_spread_depar
     assert selection.joint_excess(spread) > 1e3 * selection.BEYOND**2
     # A free parameter (no tolerance) takes up what it can: nothing is beyond.
     assert selection.joint_excess(fake([1.02, 1.02], [1.0, 1.0], [0.02, None], cov)) < 1e-6
+
+
+def test_an_unmodeled_effect_must_have_a_significant_size(monkeypatch):
+    """Step 2: an amplitude without a finite σ, or within 2 σ of zero, is not a cause; one at its bound is."""
+    from types import SimpleNamespace
+
+    from stcs_ident.diagnose import selection
+
+    def support(x, sigma, upper=1e6):
+        param = SimpleNamespace(kind="stiffness", start=0.0, upper=upper)
+        result = SimpleNamespace(parameters=(param,), estimate=np.array([x]), uncertainty=np.array([sigma]))
+        return SimpleNamespace(result=result, hypothesis=SimpleNamespace(owners=("unmodeled_support",),
+                                                                        campaign=None))
+
+    monkeypatch.setattr(selection, "prior_widths", lambda campaign, hypothesis: [None])
+    assert selection.insignificant(support(452.0, float("nan"))) == ("unmodeled_support",)
+    assert selection.insignificant(support(452.0, 300.0)) == ("unmodeled_support",)
+    assert selection.insignificant(support(452.0, 133.0)) == ()
+    assert selection.insignificant(support(1e6, float("nan"))) == ()  # pushed to its bound
+
+
+def test_an_unmodeled_effect_whose_gain_rests_on_one_frequency_is_not_chosen(monkeypatch):
+    """validate_diagnosis stay seed 1501 (EI × 1.45): a mid-span support lowered χ² by 18.0, 17.4 of it at
+    one test's mode 1 (4.1 σ off); spread over the modes the same gain names the support."""
+    from types import SimpleNamespace
+
+    from stcs_ident.diagnose import selection
+
+    monkeypatch.setattr(selection, "prior_widths", lambda campaign, hypothesis: [0.02, 0.3, None, None])
+    owners = ("tension", "bending_stiffness", "unmodeled_support", "unmodeled_support")
+    base = np.full(29, 1.9)
+    base[14] = 17.9
+
+    def fit(effects, terms):
+        return SimpleNamespace(effects=effects, terms=terms, hypothesis=SimpleNamespace(owners=owners, campaign=None))
+
+    lumped = base.copy()
+    lumped[14] = 0.5
+    lumped[:3] -= 0.2
+    rest = ("tension", "bending_stiffness")
+    fits = {rest: fit(rest, base)}
+    assert selection.single_frequency(fit((*rest, "unmodeled_support"), lumped), fits) == ("unmodeled_support",)
+    spread = base - 18.0 / 29
+    assert selection.single_frequency(fit((*rest, "unmodeled_support"), spread), fits) == ()
+
+
+def test_a_gross_error_of_a_recorded_attachment_costs_no_more_than_an_unrecorded_one():
+    """A recorded position or mass far off its record is priced as the same attachment found unrecorded
+    (the search cost of its position), when that is less than its tolerance's Cauchy prior."""
+    import math
+
+    from stcs_ident.diagnose.fitting import prior_penalty, search_cost
+    from stcs_ident.diagnose.hypotheses import build
+
+    cable = Cable(length=120.0, mass_per_length=60.0, EI=2.0e6)
+    campaign = Campaign("stay", cable, (Setup("S", (Attachment("damper", 3.0, 50.0),)),), (Test("T1", "S", 4e6),))
+    moved = build(campaign, campaign.tests, ["attachment_position"])
+    cauchy = 2 * math.log1p(((4.2 - 1.0) * 3.0 / 0.02) ** 2)  # 12.6 m for 3 m, tolerance 2 cm: 24.7
+    assert prior_penalty(moved, np.array([4.2]), np.array([0.05 / 3])) == pytest.approx(search_cost(120.0, 0.05))
+    assert search_cost(120.0, 0.05) < cauchy - 10
+    near = 3.01 / 3  # 1 cm off: the tolerance's prior is the cheaper
+    assert prior_penalty(moved, np.array([near]), np.array([0.05 / 3])) == pytest.approx(2 * math.log1p(0.25))
+    heavier = build(campaign, campaign.tests, ["attachment_mass"])
+    assert prior_penalty(heavier, np.array([1.6]), np.array([0.01])) == pytest.approx(2 * math.log1p(30.0**2))
+    assert prior_penalty(heavier, np.array([1.6]), np.array([0.01]), {"damper": 0.1}) == pytest.approx(
+        search_cost(120.0, 0.1))
+    assert math.isinf(search_cost(120.0, float("nan"))) and search_cost(120.0, 1e3) == 0.0

@@ -40,7 +40,7 @@ from ..identify.problem import Measurement, Problem
 from ..identify.result import IdentificationResult
 from ..model import Attachment, Campaign, Test
 from ..notes import Assignment, Note
-from .hypotheses import Hypothesis, build, clear_position, free_positions, unmodeled_name
+from .hypotheses import Hypothesis, applicable, build, clear_position, free_positions, unmodeled_name
 
 #: Unmodeled attachments kept from the profile scan as starts of the full fit.
 PROFILE_STARTS = 3
@@ -92,6 +92,9 @@ class HypothesisFit:
     minima : list of dict
         The best distinct points of the profile scan (SI values by (kind,
         member)): the starts of pairs that contain this effect.
+    terms : ndarray or None
+        Each measured frequency's term of χ² (its squared normalised
+        residual), tests in order; None when the fit failed.
     """
 
     hypothesis: Hypothesis
@@ -107,6 +110,7 @@ class HypothesisFit:
     failure: str | None = None
     penalty: float = 0.0
     epsilon: float = 0.0
+    terms: np.ndarray | None = None
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -141,7 +145,17 @@ def hypothesis_problem(hypothesis: Hypothesis, measurements: Sequence[Measuremen
     return Problem(hypothesis.campaign, measurements, chosen, tension_model)
 
 
-def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray, uncertainty: np.ndarray | None = None) -> float:
+def search_cost(length: float, sigma_x: float) -> float:
+    """The Occam factor of finding an attachment's position on a span of ``length`` to ``sigma_x`` (m):
+    2 ln(l / (√(2π) σ_x)) − 2 (the 2 that AICc already charges for the parameter taken off), never below 0;
+    inf when ``sigma_x`` is not a positive number."""
+    if not (math.isfinite(sigma_x) and sigma_x > 0):
+        return math.inf
+    return max(0.0, 2.0 * math.log(length / (math.sqrt(2 * math.pi) * sigma_x)) - 2.0)
+
+
+def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray, uncertainty: np.ndarray | None = None,
+                  located: Mapping[str, float] | None = None) -> float:
     """How implausible the departures a hypothesis needs are, at ``estimate`` (−2 log of their prior).
 
     - A parameter whose nominal value has a tolerance t: 2 ln(1 + ((x − nominal)/t)²), a Cauchy prior of
@@ -150,21 +164,58 @@ def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray, uncertainty: np.
       still win over a recorded value, while of hypotheses they cannot separate the one with the smaller
       departures does.
     - The position of an unmodeled attachment, known only to lie on the span: the Occam factor of a
-      search, 2 ln(l / (√(2π) σ_x)) − 2 (σ_x its standard deviation; the 2 that AICc already charges for
-      the parameter taken off; never below 0). A position the data pin down to 1 cm on a 120 m stay costs
-      about 15: a point attachment found anywhere has to earn its place.
+      search (:func:`search_cost`, σ_x its standard deviation). A position the data pin down to 1 cm on a
+      120 m stay costs about 15: a point attachment found anywhere has to earn its place. Without a
+      finite σ_x the search is not charged: such a fit is not significant (:mod:`.selection`).
+    - A recorded attachment's position or mass far off its record (a gross error: a position measured
+      from the wrong end, a bracket left out of the mass) costs at most what an unrecorded attachment
+      found at the same place would: the search cost of its position (``located``: the σ_x, m, that the
+      data give the position of each recorded attachment whose mass is free). A recorded damper found
+      9.6 m from its record is no less plausible than an unknown mass of the damper's size found there.
     """
     total = 0.0
     length = hypothesis.campaign.cable.length
+    located = located or {}
     sigma = np.full(len(hypothesis.parameters), np.nan) if uncertainty is None else np.asarray(uncertainty, float)
     for p, x, s, width in zip(hypothesis.parameters, estimate, sigma,
                               prior_widths(hypothesis.campaign, hypothesis)):
         if width is not None:
-            total += 2.0 * math.log1p(((float(x) - p.start) / width) ** 2)
+            cost = 2.0 * math.log1p(((float(x) - p.start) / width) ** 2)
+            if p.kind == "position" and not p.slots and math.isfinite(s) and s > 0:
+                cost = min(cost, search_cost(length, float(p.value_uncertainty(x, s))))
+            elif p.kind == "mass" and not p.slots and p.member in located:
+                cost = min(cost, search_cost(length, located[p.member]))
+            total += cost
         elif p.kind == "position" and p.slots and math.isfinite(s) and s > 0:
-            sigma_x = float(p.value_uncertainty(x, s))
-            total += max(0.0, 2.0 * math.log(length / (math.sqrt(2 * math.pi) * sigma_x)) - 2.0)
+            total += search_cost(length, float(p.value_uncertainty(x, s)))
     return total
+
+
+def position_uncertainty(campaign: Campaign, measurements: Sequence[Measurement], hypothesis: Hypothesis,
+                         values: Mapping[tuple[str, str | None], float], tension_model: str) -> dict[str, float]:
+    """σ (m) that the data give the position of each recorded attachment whose mass ``hypothesis`` frees,
+    at the fitted ``values`` (SI, by (kind, member)) with that position freed as well: first order, from
+    the Jacobian; inf where the data cannot place it. Empty when positions are exact (a tolerance of 0)."""
+    members = {p.member for p in hypothesis.parameters if p.kind == "mass" and not p.slots}
+    tests = [m.test for m in measurements]
+    if not members or "attachment_position" in hypothesis.effects or applicable(campaign, tests,
+                                                                                 "attachment_position"):
+        return {}
+    positions = {e: values[("position", unmodeled_name(e))] for e in hypothesis.effects
+                 if unmodeled_name(e) and ("position", unmodeled_name(e)) in values}
+    wider = build(campaign, tests, registry.in_order((*hypothesis.effects, "attachment_position")), positions)
+    problem = hypothesis_problem(wider, measurements, tension_model)
+    x = _starts_from(problem, [values], nominal=False)[0]
+    J = problem.jacobian(x)
+    if not np.all(np.isfinite(J)):
+        return {}
+    cov = np.linalg.pinv(J.T @ J)
+    out = {}
+    for j, q in enumerate(problem.parameters):
+        if q.kind == "position" and not q.slots and q.member in members:
+            var = cov[j, j]
+            out[q.member] = float(q.value_uncertainty(x[j], math.sqrt(var))) if var > 0 else math.inf
+    return out
 
 
 def failed_fit(campaign: Campaign, measurements: Sequence[Measurement], effects: Sequence[str], reason: str,
@@ -202,10 +253,11 @@ def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension
     measured = np.concatenate([m.frequencies for m in measurements])
     sigma = np.concatenate([m.uncertainty for m in measurements])
     f = nominal_prediction(campaign, measurements, tension_model)
-    chi2 = float(np.sum(((f - measured) / sigma) ** 2))
+    terms = ((f - measured) / sigma) ** 2
+    chi2 = float(np.sum(terms))
     rms = rms_percent(f, measured)
     hyp = Hypothesis((), campaign, (), ())
-    return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms)
+    return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms, terms=terms)
 
 
 def _quiet(fn, notes: list[Note]):
@@ -344,11 +396,15 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     notes = [in_si_units(note, problem.parameters) for note in notes]
     n = problem.n_data
     predicted = problem.predict(result.estimate)
-    chi2 = float(np.sum(((predicted - problem.measured) / problem.sigma) ** 2))
-    penalty = prior_penalty(hyp, result.estimate, result.uncertainty)
+    terms = ((predicted - problem.measured) / problem.sigma) ** 2
+    chi2 = float(np.sum(terms))
+    located = position_uncertainty(campaign, measurements, hyp,
+                                   {(p.kind, p.member): float(p.to_value(v))
+                                    for p, v in zip(problem.parameters, result.estimate)}, tension_model)
+    penalty = prior_penalty(hyp, result.estimate, result.uncertainty, located)
     fit = HypothesisFit(hyp, result, predicted, chi2, aicc(chi2 + penalty, n, len(hyp.parameters)),
                         rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
-                        minima=minima, penalty=penalty)
+                        minima=minima, penalty=penalty, terms=terms)
     return fit
 
 

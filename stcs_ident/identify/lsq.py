@@ -104,7 +104,8 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
         if scale_note:
             notes.insert(0, scale_note)
     J = problem.jacobian(x)
-    cov, corr = covariance(J, scale)
+    typical = problem.typical(x)
+    cov, corr = covariance(J, scale, typical)
     sigma = np.sqrt(np.diag(cov))
     span = problem.upper - problem.lower
     at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
@@ -112,7 +113,8 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     if at_bound:
         notes.append(Note.make("at_bound", "at a bound (the standard deviation there is only indicative): "
                                "{parameters}", parameters=at_bound))
-    notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper),
+    notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper,
+                                                  typical),
                                   stacklevel=4)
     before = problem.predict(problem.start)
     after = problem.predict(x)
@@ -160,25 +162,56 @@ def local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-1
     return res.x, float(2 * res.cost)
 
 
+def scan_fractions(problem: Problem) -> np.ndarray:
+    """Candidate positions of the multi-start scan (fractions of the length): :data:`SCAN_FRACTIONS`, or two
+    per half-wave of the highest measured mode when that is finer (an attachment's effect on mode k varies
+    as sin²(kπx/l): a coarser grid can miss the basin of the true position)."""
+    highest = max((int(np.max(m.modes)) for m in problem.measurements if len(m.modes)), default=0)
+    n = max(SCAN_FRACTIONS.size, 2 * highest + 1)
+    return np.linspace(SCAN_FRACTIONS[0], SCAN_FRACTIONS[-1], n)
+
+
+def scaled_chi2(problem: Problem, X: np.ndarray) -> np.ndarray:
+    """χ² at the rows of ``X`` after scaling each test's predicted frequencies by its best factor.
+
+    The scan ranks candidate positions with the other variables at their nominal values; a stated tension
+    a percent off (a factor on every frequency of its test) would otherwise outweigh what the position
+    changes, and the scan would rank the candidates at random.
+    """
+    F = problem.predict(np.atleast_2d(X))
+    out = np.zeros(F.shape[0])
+    k = 0
+    for m in problem.measurements:
+        f = F[:, k:k + m.modes.size]
+        w = 1.0 / m.uncertainty**2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            scale = np.sum(w * f * m.frequencies, axis=1) / np.sum(w * f * f, axis=1)
+            out += np.sum(w * (scale[:, None] * f - m.frequencies) ** 2, axis=1)
+        k += m.modes.size
+    return np.where(np.isfinite(out), out, np.inf)
+
+
 def _starts(problem: Problem, n_starts: int, seed: int) -> np.ndarray:
-    """The nominal point, plus the best distinct points of a scan over the span for positions."""
+    """The nominal point, plus the best distinct points of a scan over the span for positions (ranked by
+    :func:`scaled_chi2`)."""
     start = problem.start
     pos = [j for j, q in enumerate(problem.parameters) if q.kind == "position"]
     if not pos or n_starts <= 0:
         return start[None, :]
     length = problem.campaign.cable.length
     nominal = np.array([problem.parameters[j].nominal for j in pos])
+    grid = scan_fractions(problem)
     if len(pos) <= 2:
-        grids = np.meshgrid(*([SCAN_FRACTIONS] * len(pos)), indexing="ij")
+        grids = np.meshgrid(*([grid] * len(pos)), indexing="ij")
         fractions = np.stack([g.ravel() for g in grids], axis=1)
     else:
-        fractions = np.random.default_rng(seed).uniform(SCAN_FRACTIONS[0], SCAN_FRACTIONS[-1], (400, len(pos)))
+        fractions = np.random.default_rng(seed).uniform(grid[0], grid[-1], (400, len(pos)))
     candidates = np.repeat(start[None, :], len(fractions), axis=0)
     candidates[:, pos] = fractions * length / nominal
     candidates = np.clip(candidates, problem.lower, problem.upper)
-    chi2 = problem.chi2(candidates)
+    chi2 = scaled_chi2(problem, candidates)
     chosen = [start]
-    spacing = 1.5 * (SCAN_FRACTIONS[1] - SCAN_FRACTIONS[0]) * length
+    spacing = 1.5 * (grid[1] - grid[0]) * length
     for i in np.argsort(chi2):
         if not np.isfinite(chi2[i]) or len(chosen) > n_starts:
             break

@@ -272,13 +272,19 @@ class Problem:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""
         return (self.predict(x) - self.measured) / self.sigma
 
+    def typical(self, x) -> np.ndarray:
+        """The size of each variable at ``x`` that its Jacobian step is a fraction of: |x|, at least 1 (1 for
+        an end fixity). A column times it is the data's change for a relative change of the variable, which
+        compares across variables of different units (a tension ratio, a stiffness in N/m)."""
+        x = np.asarray(x, float)
+        size = np.maximum(np.abs(x), 1.0)
+        return np.where([q.kind == "end_stiffness" for q in self.parameters], 1.0, size)
+
     def jacobian(self, x) -> np.ndarray:
         """d residuals / d variables by central differences (one-sided at a bound), one batch."""
         x = np.asarray(x, float)
         p = x.size
-        h = JACOBIAN_STEP * np.maximum(np.abs(x), 1.0)
-        if any(q.kind == "end_stiffness" for q in self.parameters):
-            h = np.where([q.kind == "end_stiffness" for q in self.parameters], JACOBIAN_STEP, h)
+        h = JACOBIAN_STEP * self.typical(x)
         up = np.minimum(x + h, self.upper)
         down = np.maximum(x - h, self.lower)
         rows = np.repeat(x[None, :], 2 * p + 1, axis=0)

@@ -75,9 +75,13 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, 
                               dof=int(dof))
 
 
-def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def covariance(J: np.ndarray, scale: float = 1.0, typical: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Covariance (JᵀJ)⁻¹ × scale and the correlation matrix (pseudo-inverse: a
     direction the data do not see gets infinite variance).
+
+    ``typical``: the size of each variable (:meth:`Problem.typical`, default 1); a column without effect is
+    one whose change of the data for a relative change of its variable is negligible (:data:`NO_EFFECT`),
+    whatever the variable's unit.
 
     A column that is not finite (the model could not be evaluated on either
     side of the estimate) gets infinite variance and NaN covariances; the
@@ -90,12 +94,13 @@ def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarra
         corr = np.full_like(cov, np.nan)
         keep = np.flatnonzero(~lost)
         if keep.size:
-            sub_cov, sub_corr = covariance(J[:, keep], scale)
+            sub_cov, sub_corr = covariance(J[:, keep], scale, None if typical is None else np.asarray(typical)[keep])
             cov[np.ix_(keep, keep)], corr[np.ix_(keep, keep)] = sub_cov, sub_corr
         cov[np.flatnonzero(lost), np.flatnonzero(lost)] = np.inf
         np.fill_diagonal(corr, 1.0)
         return cov, corr
     norms = np.linalg.norm(J, axis=0)
+    effect = norms * (1.0 if typical is None else np.asarray(typical, float))
     safe = np.where(norms > 0, norms, 1.0)
     Jn = J / safe
     _U, s, Vt = np.linalg.svd(Jn, full_matrices=False)
@@ -103,7 +108,7 @@ def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarra
     inv = np.where(small, 0.0, 1.0 / np.where(small, 1.0, s) ** 2)
     cov_n = (Vt.T * inv) @ Vt
     cov = cov_n / np.outer(safe, safe) * scale
-    blind = (norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)) | (np.abs(Vt[small]) > 0.1).any(axis=0)
+    blind = (effect <= NO_EFFECT * max(effect.max(initial=0.0), 1e-300)) | (np.abs(Vt[small]) > 0.1).any(axis=0)
     for i in np.flatnonzero(blind):
         cov[i, :] = np.nan
         cov[:, i] = np.nan
@@ -116,7 +121,7 @@ def covariance(J: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, np.ndarra
 
 
 def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma: np.ndarray,
-                    lower: np.ndarray, upper: np.ndarray) -> list[Note]:
+                    lower: np.ndarray, upper: np.ndarray, typical: np.ndarray | None = None) -> list[Note]:
     """Problems that make parameters not identifiable, as notes naming the parameters.
 
     - ``no_effect``: a parameter that does not change any measured frequency;
@@ -136,7 +141,8 @@ def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma
                                   "estimate (its derivative is unknown)", parameters=(names[i],)))
     J = np.where(lost, 0.0, J)
     norms = np.linalg.norm(J, axis=0)
-    dead = (norms <= NO_EFFECT * max(norms.max(initial=0.0), 1e-300)) & ~lost
+    effect = norms * (1.0 if typical is None else np.asarray(typical, float))
+    dead = (effect <= NO_EFFECT * max(effect.max(initial=0.0), 1e-300)) & ~lost
     for i in np.flatnonzero(dead):
         problems.append(Note.make("no_effect", "{parameter} does not change any measured frequency",
                                   parameters=(names[i],)))
