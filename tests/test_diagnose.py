@@ -353,8 +353,12 @@ def test_an_unmodeled_effect_whose_gain_rests_on_one_frequency_is_not_chosen(mon
     base = np.full(29, 1.9)
     base[14] = 17.9
 
-    def fit(effects, terms):
-        return SimpleNamespace(effects=effects, terms=terms, hypothesis=SimpleNamespace(owners=owners, campaign=None))
+    from stcs_ident.diagnose.fitting import HypothesisFit
+
+    def fit(effects, terms, epsilon=0.0):
+        hyp = SimpleNamespace(effects=effects, owners=owners, campaign=None)
+        return HypothesisFit(hyp, None, np.full(29, 10.0), float(np.sum(terms)), 0.0, 0.0, terms=terms,
+                             sigma=np.full(29, 0.01), epsilon=epsilon)
 
     lumped = base.copy()
     lumped[14] = 0.5
@@ -364,6 +368,8 @@ def test_an_unmodeled_effect_whose_gain_rests_on_one_frequency_is_not_chosen(mon
     assert selection.single_frequency(fit((*rest, "unmodeled_support"), lumped), fits) == ("unmodeled_support",)
     spread = base - 18.0 / 29
     assert selection.single_frequency(fit((*rest, "unmodeled_support"), spread), fits) == ()
+    # With a model error of 1 % per frequency (ε f = 10 σ) the same spread gain is 101 times smaller.
+    assert selection.single_frequency(fit((*rest, "unmodeled_support"), spread, 1e-2), fits) == ("unmodeled_support",)
 
 
 def test_a_gross_error_of_a_recorded_attachment_costs_no_more_than_an_unrecorded_one():

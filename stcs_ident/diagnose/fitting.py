@@ -95,6 +95,8 @@ class HypothesisFit:
     terms : ndarray or None
         Each measured frequency's term of χ² (its squared normalised
         residual), tests in order; None when the fit failed.
+    sigma : ndarray or None
+        The measured frequencies' uncertainties the terms are normalised by.
     """
 
     hypothesis: Hypothesis
@@ -111,6 +113,13 @@ class HypothesisFit:
     penalty: float = 0.0
     epsilon: float = 0.0
     terms: np.ndarray | None = None
+    sigma: np.ndarray | None = None
+
+    def terms_with(self, epsilon: float) -> np.ndarray | None:
+        """The terms with a relative model error ε per frequency: r² σ² / (σ² + (ε f)²)."""
+        if self.terms is None or self.sigma is None or epsilon <= 0:
+            return self.terms
+        return self.terms * self.sigma**2 / (self.sigma**2 + (epsilon * self.predicted) ** 2)
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -257,7 +266,8 @@ def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension
     chi2 = float(np.sum(terms))
     rms = rms_percent(f, measured)
     hyp = Hypothesis((), campaign, (), ())
-    return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms, terms=terms)
+    return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms, terms=terms,
+                         sigma=sigma)
 
 
 def _quiet(fn, notes: list[Note]):
@@ -404,7 +414,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     penalty = prior_penalty(hyp, result.estimate, result.uncertainty, located)
     fit = HypothesisFit(hyp, result, predicted, chi2, aicc(chi2 + penalty, n, len(hyp.parameters)),
                         rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
-                        minima=minima, penalty=penalty, terms=terms)
+                        minima=minima, penalty=penalty, terms=terms, sigma=problem.sigma)
     return fit
 
 

@@ -267,6 +267,7 @@ def single_frequency(fit: HypothesisFit, fits: dict[tuple[str, ...], HypothesisF
 
     A 452 N/m support at mid-span of a 4 MN stay lowered χ² by 18.0, 17.4 of it at mode 1 of one test
     (z = 4.1 against the truth), and was named beside an EI change (validate_diagnosis stay seed 1501).
+    With a model error (step 2) the terms are those of its likelihood, at the larger ε of the two fits.
     """
     if fit.terms is None:
         return ()
@@ -280,7 +281,8 @@ def single_frequency(fit: HypothesisFit, fits: dict[tuple[str, ...], HypothesisF
         other = fits.get(tuple(e for e in fit.effects if e != effect))
         if other is None or other.terms is None or other.terms.shape != fit.terms.shape:
             continue
-        gain = other.terms - fit.terms
+        epsilon = max(fit.epsilon, other.epsilon)  # with a model error, both at the larger one
+        gain = other.terms_with(epsilon) - fit.terms_with(epsilon)
         if float(np.sum(gain) - np.max(gain)) <= 2.0 * k:
             out.append(effect)
     return tuple(out)
