@@ -395,18 +395,21 @@ def test_a_gross_error_of_a_recorded_attachment_costs_no_more_than_an_unrecorded
     assert math.isinf(search_cost(120.0, float("nan"))) and search_cost(120.0, 1e3) == 0.0
 
 
-def test_a_simpler_hypothesis_within_the_noise_is_preferred_nested_or_not():
+def test_the_nested_rule_does_not_stop_at_a_hypothesis_a_simpler_one_beats():
     """Step 3 (validate_diagnosis stay seed 9503): of a best fit with five parameters, the nested
     hypothesis within the noise has four, but a hypothesis that is not nested explains the data within
-    the noise with three: that one is named."""
+    the noise with three and an AICc more than 2 lower: that one is named. One with two parameters,
+    within the noise too but far behind in AICc, is not."""
     from stcs_ident.diagnose.selection import select
 
     n = 30
     best = ("tension", "bending_stiffness", "unmodeled_mass")
     fits = {(): _fit((), 0, 1.4e5, n), best: _fit(best, 5, 22.4, n),
             ("tension", "unmodeled_mass"): _fit(("tension", "unmodeled_mass"), 4, 42.2, n),
-            ("tension", "attachment_mass"): _fit(("tension", "attachment_mass"), 3, 28.4, n)}
+            ("tension", "attachment_mass"): _fit(("tension", "attachment_mass"), 3, 28.4, n),
+            ("attachment_mass", "length"): _fit(("attachment_mass", "length"), 2, 42.4, n)}
     assert select(fits, n).fitted == ("tension", "attachment_mass")
-    # when the three-parameter one fails (chi2 80 for 27 dof), the nested four-parameter one is taken
+    # when the simpler ones fail (chi2 80), the nested four-parameter one is taken
     fits[("tension", "attachment_mass")] = _fit(("tension", "attachment_mass"), 3, 80.0, n)
+    fits[("attachment_mass", "length")] = _fit(("attachment_mass", "length"), 2, 80.0, n)
     assert select(fits, n).fitted == ("tension", "unmodeled_mass")
