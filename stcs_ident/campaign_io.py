@@ -109,6 +109,10 @@ def _read_toml(file: Path) -> dict[str, Any]:
         raise CampaignError(f"not a TOML file: not UTF-8 text ({err.reason})", file=str(file)) from err
     except tomllib.TOMLDecodeError as err:
         raise CampaignError(f"not a valid TOML file: {_one_line(err)}", file=str(file)) from err
+    except RecursionError:
+        raise CampaignError("not a valid TOML file: arrays or tables nested too deeply", file=str(file)) from None
+    except ValueError as err:  # an integer literal beyond Python's digit limit, and the like
+        raise CampaignError(f"not a valid TOML file: {_one_line(err)}", file=str(file)) from None
 
 
 def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
@@ -315,12 +319,25 @@ def _is_number(value: Any) -> bool:
 def _number(value: Any, field: str) -> int | float:
     if not _is_number(value):
         raise CampaignError(f"must be a number, got {_show(value)}", field=field)
+    _in_float_range(value, field)
     return value
+
+
+def _in_float_range(value: float, field: str) -> None:
+    """Refuse an integer too large for a float (TOML integers are unbounded)."""
+    if isinstance(value, int):
+        try:
+            float(value)
+        except OverflowError:
+            raise CampaignError(f"is too large: an integer of {len(str(abs(value)))} digits is beyond the range "
+                                "of a float (about 1.8e308)", field=field) from None
 
 
 def _numbers(value: Any, field: str) -> tuple[int | float, ...]:
     if not isinstance(value, list) or not all(_is_number(v) for v in value):
         raise CampaignError(f"must be a list of numbers, got {_show(value)}", field=field)
+    for v in value:
+        _in_float_range(v, field)
     return tuple(value)
 
 

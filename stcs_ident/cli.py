@@ -11,9 +11,10 @@ import argparse
 import os
 import sys
 import traceback
+import warnings
 
 from . import __version__, effects
-from .errors import ComputationError, InputError
+from .errors import ComputationError, InputError, StcsWarning, one_line
 
 DESCRIPTION = """\
 stcs-ident: cable force, bending stiffness and model diagnosis from the
@@ -36,6 +37,10 @@ class _Parser(argparse.ArgumentParser):
         formatter.add_text(self.epilog)
         return formatter.format_help()
 
+    def error(self, message: str):
+        """A bad option: one line on standard error (what is wrong and where help is), exit status 2."""
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see {self.prog} --help)\n")
+
 #: One real example per command (the shipped campaigns), shown in --help.
 EXAMPLES = {
     "forward": "stcs-ident forward campaigns/han2020 --test case1-L4 --modes 8",
@@ -44,6 +49,20 @@ EXAMPLES = {
     "identify": "stcs-ident identify campaigns/han2020 --test case1-L4 --params tension,EI --method contour --plot figures/",
     "diagnose": "stcs-ident diagnose campaigns/han2020 --out report/",
 }
+
+
+#: Option strings of each command (to name an option in a message about its value).
+_OPTIONS: dict[str, set[str]] = {}
+
+
+def _mode_count(text: str) -> int:
+    """``--modes``: a mode number 1 … MAX_MODE (argparse reports a refusal as a bad option)."""
+    from .model import mode_number
+
+    try:
+        return mode_number(int(text), "--modes")
+    except ValueError as err:  # not an integer, or out of range (ModelError is a ValueError)
+        raise argparse.ArgumentTypeError(getattr(err, "message", f"must be an integer, got {text!r}")) from None
 
 
 def _epilog(*commands: str) -> str:
@@ -60,7 +79,8 @@ def build_parser() -> argparse.ArgumentParser:
     fwd = sub.add_parser("forward", epilog=_epilog("forward"), formatter_class=argparse.RawDescriptionHelpFormatter, help="nominal model against measured and published frequencies")
     fwd.add_argument("campaign", help="campaign directory or its campaign.toml")
     fwd.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
-    fwd.add_argument("--modes", type=int, metavar="N", help="modes to compute (default: measured, at least 6)")
+    fwd.add_argument("--modes", type=_mode_count, metavar="N",
+                     help="modes to compute (default: measured, at least 6)")
     fwd.add_argument("--tension-model", choices=("uniform", "per-segment", "none"), default="uniform",
                      help="additional tension from sag-extensibility (default uniform)")
     fwd.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
@@ -72,6 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
     spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
     spe.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     _simulate_parser(sub)
+    for name, command in sub.choices.items():
+        _OPTIONS[name] = {o for action in command._actions for o in action.option_strings}
     idf = sub.add_parser("identify", epilog=_epilog("identify"), formatter_class=argparse.RawDescriptionHelpFormatter, help="correct tension, EI, attachment positions... from measured frequencies")
     idf.add_argument("campaign", help="campaign directory or its campaign.toml")
     idf.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
@@ -144,12 +166,15 @@ def _simulate_parser(sub) -> None:
 
 
 def _simulate(args) -> int:
-    from .campaign_io import load_campaign
+    from .campaign_io import campaign_file, load_campaign
+    from .files import check_outputs
     from .simulate.effects import Effects
     from .simulate.simulate import Ambient, Impulse
     from .simulate.simulate_campaign import simulate_campaign
 
     campaign = load_campaign(args.campaign)
+    file = str(campaign_file(args.campaign))
+    check_outputs([("--out", args.out, True)], _inputs(campaign, file))
     try:
         fractions = [float(x) for x in args.sensors.split(",")]
     except ValueError:
@@ -162,8 +187,8 @@ def _simulate(args) -> int:
         given = getattr(args, f"effect_{effect.name}", None)
         if effect.option is not None and given is not None:
             hidden[effect.truth_key] = effect.parse_option(given)
-    impulses = [Impulse(1.0 + i * max(args.duration / max(args.impulses, 1), 1.0), 0.17 * length, 50.0)
-                for i in range(args.impulses)]
+    impulses = (Impulse(1.0 + i * max(args.duration / max(args.impulses, 1), 1.0), 0.17 * length, 50.0)
+                for i in range(args.impulses))  # lazily: simulate refuses more than it can take
     ambient = Ambient(args.ambient) if args.ambient else None
     if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
         raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
@@ -172,11 +197,17 @@ def _simulate(args) -> int:
     except (TypeError, ValueError) as err:
         raise InputError(str(err), field="effects") from None
     field = _field_conditions(args, campaign, len(fractions))
-    out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions], duration=args.duration,
-                            sampling_rate=args.sampling_rate, tests=args.test, damping=args.damping,
-                            impulses=impulses, ambient=ambient, snr_db=args.snr, effects=effect, seed=args.seed,
-                            overwrite=args.overwrite, field=field,
-                            progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
+    try:
+        out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions],
+                                duration=args.duration, sampling_rate=args.sampling_rate, tests=args.test,
+                                damping=args.damping, impulses=impulses, ambient=ambient, snr_db=args.snr,
+                                effects=effect, seed=args.seed, overwrite=args.overwrite, field=field,
+                                progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
+    except InputError as err:  # an option's value refused by the simulator: name the option
+        option = "--" + str(err.field).replace("_", "-")
+        if err.file is None and err.field and option in _OPTIONS["simulate"]:
+            raise InputError(err.message, field=option) from None
+        raise
     print(f"wrote {out}")
     return 0
 
@@ -266,17 +297,24 @@ def _picked(campaign, tests, file):
     return analyse_campaign(campaign, tests, progress=_progress)
 
 
+def _inputs(campaign, file: str) -> list[str]:
+    """The files a command on ``campaign`` reads: its campaign file and every test's record."""
+    from .spectra.pipeline import record_path
+
+    return [file] + [record_path(campaign, t) for t in campaign.tests if t.record is not None]
+
+
 def _prepare(args):
     """Load the campaign and check the selection and the outputs before any work."""
     from .campaign_io import campaign_file, load_campaign
+    from .files import check_outputs
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
     tests = _selected_tests(campaign, args.test, file)
+    check_outputs([("--json", args.json, False), ("--plot", getattr(args, "plot", None), True),
+                   ("--out", getattr(args, "out", None), True)], _inputs(campaign, file))
     _check_output(args.json)
-    plot = getattr(args, "plot", None)
-    if plot is not None and os.path.exists(plot) and not os.path.isdir(plot):
-        raise InputError("exists and is not a directory", field="--plot", file=plot)
     return campaign, file, tests
 
 
@@ -316,7 +354,7 @@ def _identify(args) -> int:
         except InputError as err:
             raise InputError(err.message, field=err.field, file=err.file or file) from None
     for w in caught:
-        print(f"stcs-ident: warning: {w.message}", file=sys.stderr)
+        _show_warning(w.message, w.category, w.filename, w.lineno)
     from .identify.published import published_comparison
 
     summary = result.summary()
@@ -341,8 +379,6 @@ def _diagnose(args) -> int:
     from .report import to_json
 
     campaign, file, tests = _prepare(args)
-    if args.out is not None and os.path.exists(args.out) and not os.path.isdir(args.out):
-        raise InputError("exists and is not a directory", field="--out", file=args.out)
     spectra = _picked(campaign, tests, file)
     picked = {r.name: r for r in spectra}
     try:
@@ -370,8 +406,6 @@ def _forward(args) -> int:
     from .compare import compare_forward
     from .report import forward_text, to_json
 
-    if args.modes is not None and args.modes < 1:
-        raise InputError(f"must be >= 1, got {args.modes}", field="--modes")
     campaign, file, tests = _prepare(args)
     picked = {r.name: (r.modes, r.frequencies) for r in _picked(campaign, tests, file)}
     result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked)
@@ -383,10 +417,28 @@ def _forward(args) -> int:
     return 0
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on standard error: the toolkit's own as ``stcs-ident: warning: ...``; numerical
+    ones from the libraries (overflow in a square, a division by zero on a dead channel) are internal and
+    shown only with --debug."""
+    if not issubclass(category, StcsWarning):
+        return
+    print(f"stcs-ident: warning: {one_line(str(message))}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if not args.debug:
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts a command
+            warnings.showwarning = _show_warning
+            return _run(args)
+    return _run(args)
+
+
+def _run(args) -> int:
     try:
         return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,
                 "identify": _identify, "diagnose": _diagnose}[args.command](args)
@@ -398,7 +450,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ComputationError, FloatingPointError) as err:
         if args.debug:
             traceback.print_exc()
-        print(f"stcs-ident: computation failed: {err}", file=sys.stderr)
+        print(f"stcs-ident: computation failed: {one_line(str(err))}", file=sys.stderr)
         return 1
 
 

@@ -35,11 +35,18 @@ class InputError(ValueError):
         if self.field:
             parts.append(f"field '{self.field}'")
         head = ": ".join(parts)
-        return f"{head}: {self.message}" if head else self.message
+        return one_line(f"{head}: {self.message}" if head else self.message)
 
     def with_file(self, file: str) -> InputError:
         """Return the same error, attributed to ``file``."""
         return type(self)(self.message, field=self.field, file=file)
+
+
+def one_line(text: str, limit: int = 2000) -> str:
+    """``text`` as one printable line: control characters (a newline in a test's name, an escape
+    sequence) shown escaped, and at most ``limit`` characters (the rest elided)."""
+    out = "".join(c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in text)
+    return out if len(out) <= limit else out[:limit - 3] + "..."
 
 
 class CampaignError(InputError):

@@ -13,7 +13,7 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
@@ -118,3 +118,36 @@ def whole_directory(out: Path) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
+                  inputs: Iterable[str | os.PathLike]) -> None:
+    """Refuse, before any work, an output that would replace or be written inside an input.
+
+    ``outputs`` are (option, path, is_directory) (a path None or "-" is skipped); ``inputs`` the files
+    the command reads. A file output may not be an input (also through a link); a directory output may not
+    be an input, hold one (it is replaced as a whole, or written into), or lie below a file. Raises
+    :class:`~stcs_ident.errors.InputError` naming the option.
+    """
+    from .errors import InputError
+
+    read = [os.path.realpath(p) for p in inputs]
+    for option, path, is_directory in outputs:
+        if path is None or str(path) == "-":
+            continue
+        real = os.path.realpath(path)
+        for file in read:
+            if real == file:
+                raise InputError(f"is an input of this command ({file}): outputs never replace inputs",
+                                 field=option, file=str(path))
+            if is_directory and file.startswith(real.rstrip(os.sep) + os.sep):
+                raise InputError(f"holds an input of this command ({file}): outputs are never written where "
+                                 "inputs are", field=option, file=str(path))
+        parent = Path(real)
+        if os.path.exists(real) and is_directory and not os.path.isdir(real):
+            raise InputError("exists and is not a directory", field=option, file=str(path))
+        for above in (parent, *parent.parents) if is_directory else parent.parents:
+            if above.exists():
+                if not above.is_dir():
+                    raise InputError(f"lies below {above}, which is a file", field=option, file=str(path))
+                break

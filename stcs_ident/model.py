@@ -16,6 +16,40 @@ from dataclasses import dataclass, field
 
 from .errors import ModelError
 
+#: Most attachments in one setup. Every frequency evaluation solves the cable with a segment per attachment,
+#: and its time grows steeply with their number (6 modes of an 8 m hanger: 5 ms with 20, 1 s with 50,
+#: 94 s with 200): beyond this an identification or a diagnosis, hundreds of evaluations, would take hours.
+MAX_ATTACHMENTS = 50
+#: Highest mode number computed or measured. The solver brackets every mode up to the highest (10000
+#: modes of a hanger: 0.04 s); a record resolves tens, so a larger number is a mistake, not a need.
+MAX_MODE = 10000
+
+
+#: Measured frequencies lie in this band (Hz): below, a period of hours; above, beyond what any
+#: accelerometer records. A value outside is a typing or unit mistake (and 1e300 would overflow χ²).
+FREQUENCY_BAND = (1e-4, 1e6)
+
+
+def frequency(value, name: str) -> float:
+    """``value`` as a measured frequency in :data:`FREQUENCY_BAND`; ModelError naming ``name`` otherwise."""
+    f = _positive(value, name)
+    low, high = FREQUENCY_BAND
+    if not low <= f <= high:
+        raise ModelError(f"must lie between {low:g} and {high:g} Hz (a period of hours to beyond any "
+                         f"accelerometer), got {value!r}", field=name)
+    return f
+
+
+def mode_number(value, name: str) -> int:
+    """``value`` as a mode number 1 … :data:`MAX_MODE`; ModelError naming ``name`` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ModelError(f"mode numbers must be integers >= 1, got {value!r}", field=name)
+    if value > MAX_MODE:
+        shown = value if value < 10**12 else f"an integer of {len(str(value))} digits"
+        raise ModelError(f"mode numbers are at most {MAX_MODE} (a record resolves tens of modes; the solver "
+                         f"computes every mode up to the highest), got {shown}", field=name)
+    return value
+
 
 def finite_number(value, name: str) -> float:
     """``value`` as a finite float (a bool is not a number); ModelError naming ``name`` otherwise."""
@@ -186,6 +220,10 @@ class Setup:
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="setup.name")
         atts = tuple(self.attachments)
+        if len(atts) > MAX_ATTACHMENTS:
+            raise ModelError(f"has {len(atts)} attachments; at most {MAX_ATTACHMENTS} per setup (every frequency "
+                             "evaluation solves a segment per attachment, and the time grows steeply with their "
+                             "number: an identification would take hours)", field=f"setup[{self.name}].attachment")
         for a in atts:
             if not isinstance(a, Attachment):
                 raise ModelError("must hold Attachment objects", field=f"setup[{self.name}].attachment")
@@ -249,7 +287,7 @@ class Test:
         where = f"test[{self.name}]"
         object.__setattr__(self, "tension", _positive(self.tension, f"{where}.tension"))
         if self.frequencies is not None:
-            freqs = tuple(_positive(f, f"{where}.frequencies") for f in self.frequencies)
+            freqs = tuple(frequency(f, f"{where}.frequencies") for f in self.frequencies)
             if not freqs:
                 raise ModelError("must not be empty", field=f"{where}.frequencies")
             object.__setattr__(self, "frequencies", freqs)
@@ -260,8 +298,7 @@ class Test:
                     f"has {len(modes)} entries but frequencies has {len(freqs)}", field=f"{where}.modes"
                 )
             for k in modes:
-                if isinstance(k, bool) or not isinstance(k, int) or k < 1:
-                    raise ModelError(f"mode numbers must be integers >= 1, got {k!r}", field=f"{where}.modes")
+                mode_number(k, f"{where}.modes")
             if len(set(modes)) != len(modes):
                 raise ModelError("mode numbers must be distinct", field=f"{where}.modes")
             object.__setattr__(self, "modes", modes)
@@ -275,7 +312,7 @@ class Test:
             if len(values) != len(self.modes):
                 raise ModelError(f"has {len(values)} values but modes has {len(self.modes)}", field=field_name)
             for f in values:
-                _positive(f, field_name)
+                frequency(f, field_name)
         object.__setattr__(self, "reference", tuple((k, tuple(float(f) for f in v)) for k, v in reference))
 
 

@@ -8,6 +8,7 @@ directory, then an atomic rename).
 from __future__ import annotations
 
 import json
+import math
 import os
 
 from .compare import ForwardResult
@@ -51,7 +52,21 @@ def forward_text(result: ForwardResult) -> str:
 
 
 def to_json(data) -> str:
-    return json.dumps(data, indent=2, allow_nan=False, default=_json_default) + "\n"
+    """``data`` as standard JSON: a value that is not a finite number (a σ the data cannot give, an error
+    against a reference of 0) is written as null, never as NaN or Infinity, which JSON does not have."""
+    return json.dumps(_finite_or_null(data), indent=2, allow_nan=False, default=_json_default) + "\n"
+
+
+def _finite_or_null(value):
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite_or_null(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_null(v) for v in value]
+    if hasattr(value, "tolist") and not isinstance(value, str):
+        return _finite_or_null(value.tolist())
+    return value
 
 
 def _json_default(value):

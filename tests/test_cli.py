@@ -29,7 +29,10 @@ frequencies = [2.5, 5.0]
 
 
 def run(argv, capsys):
-    code = main([str(a) for a in argv])
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exit_:  # a bad option, refused by argparse as the console script would exit
+        code = exit_.code
     out, err = capsys.readouterr()
     return code, out, err
 
@@ -92,7 +95,9 @@ def test_unknown_test_exits_2(tmp_path, capsys):
 
 def test_bad_modes_exits_2(tmp_path, capsys):
     code, _, err = run(["forward", _write(tmp_path, GOOD), "--modes", "0"], capsys)
-    assert code == 2 and "--modes" in err
+    assert code == 2 and "--modes" in err and len(err.splitlines()) == 1
+    code, _, err = run(["forward", _write(tmp_path, GOOD), "--modes", str(10**8)], capsys)
+    assert code == 2 and "at most 10000" in err and len(err.splitlines()) == 1
 
 
 def test_missing_campaign_exits_2(tmp_path, capsys):

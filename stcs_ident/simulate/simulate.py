@@ -27,6 +27,7 @@ record is exactly what it was before they existed.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -60,6 +61,11 @@ __all__ = [
 NYQUIST_FRACTION = 0.45
 #: Uncorrelated pressure: ``rms_pressure`` is the rms of its mean over this length (m).
 UNCORRELATED_LENGTH = 1.0
+#: Most samples of one simulated record (23 h at 200 Hz; 400 MB for 3 channels as float64, and several
+#: times that while the modal responses are summed): a longer record is refused before anything is allocated.
+MAX_SAMPLES = 2**24
+#: Most hand blows in one record: each adds its free decay to every sample after it.
+MAX_IMPULSES = 1000
 
 Progress = Callable[[int, int], None]
 
@@ -204,8 +210,8 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
     every sample, each mode's sensitivity to it, the instantaneous and the
     time-averaged frequencies.
     """
-    fs, n_samples = _check_timing(duration, sampling_rate)
-    impulses = _check_impulses(impulses)
+    fs, n_samples = check_timing(duration, sampling_rate)
+    impulses = check_impulses(impulses)
     if snr_db is not None:
         snr_db = _finite(snr_db, "snr_db")
     if not impulses and ambient is None:
@@ -329,17 +335,25 @@ def _finite(value, name: str, *, positive: bool = False) -> float:
     return v
 
 
-def _check_timing(duration, sampling_rate) -> tuple[float, int]:
+def check_timing(duration, sampling_rate) -> tuple[float, int]:
     duration = _finite(duration, "duration", positive=True)
     fs = _finite(sampling_rate, "sampling_rate", positive=True)
-    n = round(duration * fs)
+    n = duration * fs
+    if n > MAX_SAMPLES:
+        raise ModelError(f"gives {n:.3g} samples at {fs:g} Hz; a simulated record has at most {MAX_SAMPLES} "
+                         f"({MAX_SAMPLES / fs:.4g} s at this rate: memory grows with the samples)", field="duration")
+    n = round(n)
     if n < 2:
         raise ModelError(f"gives {n} samples at {fs:g} Hz: at least 2 needed", field="duration")
     return fs, n
 
 
-def _check_impulses(impulses) -> tuple[Impulse, ...]:
-    out = tuple(impulses)
+def check_impulses(impulses) -> tuple[Impulse, ...]:
+    """The impulses (any iterable, read no further than one past the limit) as a checked tuple."""
+    out = tuple(itertools.islice(impulses, MAX_IMPULSES + 1))
+    if len(out) > MAX_IMPULSES:
+        raise ModelError(f"more than {MAX_IMPULSES} hand blows; at most {MAX_IMPULSES} per record (each adds its "
+                         "decay to every sample after it)", field="impulses")
     for imp in out:
         if not isinstance(imp, Impulse):
             raise ModelError(f"must hold Impulse objects, got {type(imp).__name__}", field="impulses")

@@ -29,7 +29,16 @@ from ..model import Cable, Campaign, Test
 from .conditions import FieldConditions
 from .disturbances import write_record_as
 from .effects import Effects, true_model
-from .simulate import Ambient, Impulse, Progress, modal_basis, modal_damping, simulate_record_with_truth
+from .simulate import (
+    Ambient,
+    Impulse,
+    Progress,
+    check_impulses,
+    check_timing,
+    modal_basis,
+    modal_damping,
+    simulate_record_with_truth,
+)
 
 __all__ = ["TRUTH_FILE", "simulate_campaign"]
 
@@ -99,6 +108,10 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
     """
     out = Path(out_dir)
     _check_target(out, overwrite)
+    check_timing(duration, sampling_rate)  # sizes before anything is allocated
+    impulses = check_impulses(impulses)
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ModelError(f"must be an integer >= 0, got {seed!r}", field="seed")
     selected = _select_tests(campaign, tests)
     per_test = _effects_per_test(effects, selected)
     field_per_test = _field_per_test(field, selected)

@@ -272,7 +272,14 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, 
     for _ in range(MAX_ITERATIONS):
         score = grad.T @ ((problem.periodogram - mean) / mean**2)
         fisher = _fisher(grad, mean)
-        step = _scoring_step(theta, score, fisher, problem.nonnegative)
+        if not (np.all(np.isfinite(fisher)) and np.all(np.isfinite(score))):
+            return theta, False, mean, grad
+        try:
+            step = _scoring_step(theta, score, fisher, problem.nonnegative)
+        except np.linalg.LinAlgError:  # an information matrix LAPACK cannot solve (a band of Nyquist-alternating
+            return theta, False, mean, grad  # samples): not converged, and the caller's checks reject the fit
+        if not np.all(np.isfinite(step)):
+            return theta, False, mean, grad
         if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], _TINY)) < 1e-4):
             return theta, True, mean, grad
         for _ in range(30):

@@ -29,6 +29,8 @@ __all__ = ["FORMAT", "VERSION", "read_record", "write_record"]
 
 FORMAT = "stcs-record"
 VERSION = 1
+#: Most values of one dataset read into memory (4 GiB as float64).
+MAX_VALUES = 2**29
 
 
 def read_record(path: str | os.PathLike) -> Record:
@@ -46,6 +48,15 @@ def read_record(path: str | os.PathLike) -> Record:
         missing or invalid; ``.file`` and ``.field`` say where.
     """
     file = str(path)
+    try:
+        return _read(file)
+    except InputError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # h5py on a corrupt file
+        raise InputError(f"cannot read the record (a corrupt HDF5 file?): {one_line(err)}", file=file) from None
+
+
+def _read(file: str) -> Record:
     with _open_hdf5(file) as h5:
         if (fmt := _attr(h5.attrs, "format", str, file)) != FORMAT:
             raise InputError(f"is {fmt!r}, expected {FORMAT!r}", field="format", file=file)
@@ -104,9 +115,14 @@ def _open_hdf5(file: str) -> h5py.File:
 
 def _attr(attrs: h5py.AttributeManager, key: str, kind: type, file: str) -> Any:
     """Root attribute ``key`` as a Python ``str`` or ``float`` (``kind``)."""
-    if key not in attrs:
-        raise InputError("missing root attribute", field=key, file=file)
-    value = attrs[key]
+    try:
+        if key not in attrs:
+            raise InputError("missing root attribute", field=key, file=file)
+        value = attrs[key]
+    except InputError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:
+        raise InputError(f"cannot read the attribute: {one_line(err)}", field=key, file=file) from None
     if isinstance(value, np.ndarray) and value.size == 1:
         value = value.reshape(())[()]
     if isinstance(value, np.generic):
@@ -121,15 +137,31 @@ def _attr(attrs: h5py.AttributeManager, key: str, kind: type, file: str) -> Any:
 
 
 def _read_dataset(h5: h5py.File, name: str, file: str) -> np.ndarray:
-    """Dataset ``name`` as an array; strings are decoded from UTF-8."""
-    if name not in h5:
-        raise InputError("missing dataset", field=name, file=file)
-    node = h5[name]
-    if not isinstance(node, h5py.Dataset):
-        raise InputError("must be a dataset, found a group", field=name, file=file)
+    """Dataset ``name`` as an array; strings are decoded from UTF-8.
+
+    A soft or external link in its place is refused: a record is read from the datasets stored in its own
+    file (an external link can name any file of the machine, a soft link can dangle or point to itself).
+    """
     try:
+        link = h5.get(name, getlink=True)
+        if link is None:
+            raise InputError("missing dataset", field=name, file=file)
+        if isinstance(link, h5py.ExternalLink):
+            raise InputError(f"must be a dataset stored in the record, found an external link to "
+                             f"{link.filename}:{link.path}", field=name, file=file)
+        if isinstance(link, h5py.SoftLink):
+            raise InputError(f"must be a dataset stored in the record, found a link to {link.path}", field=name,
+                             file=file)
+        node = h5[name]
+        if not isinstance(node, h5py.Dataset):
+            raise InputError("must be a dataset, found a group", field=name, file=file)
+        if node.size > MAX_VALUES:
+            raise InputError(f"holds {node.size} values; at most {MAX_VALUES} ({MAX_VALUES * 8 // 2**30} GiB as "
+                             "float64) are read", field=name, file=file)
         if h5py.check_string_dtype(node.dtype) is not None:
             return np.asarray(node.asstr("utf-8")[()], dtype=object)
         return np.asarray(node[()])
-    except (OSError, ValueError) as err:  # UnicodeDecodeError is a ValueError
-        raise InputError(f"cannot read the dataset: {one_line(err)}", field=name, file=file) from err
+    except InputError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # UnicodeDecodeError is a ValueError
+        raise InputError(f"cannot read the dataset: {one_line(err)}", field=name, file=file) from None
