@@ -207,12 +207,12 @@ def position_uncertainty(campaign: Campaign, measurements: Sequence[Measurement]
     the Jacobian; inf where the data cannot place it. Empty when positions are exact (a tolerance of 0)."""
     members = {p.member for p in hypothesis.parameters if p.kind == "mass" and not p.slots}
     tests = [m.test for m in measurements]
-    if not members or "attachment_position" in hypothesis.effects or applicable(campaign, tests,
-                                                                                 "attachment_position"):
+    moving = next((e.name for e in registry.effects() if e.parameter_kind == "position" and not e.unmodeled), None)
+    if not members or moving is None or moving in hypothesis.effects or applicable(campaign, tests, moving):
         return {}
     positions = {e: values[("position", unmodeled_name(e))] for e in hypothesis.effects
                  if unmodeled_name(e) and ("position", unmodeled_name(e)) in values}
-    wider = build(campaign, tests, registry.in_order((*hypothesis.effects, "attachment_position")), positions)
+    wider = build(campaign, tests, registry.in_order((*hypothesis.effects, moving)), positions)
     problem = hypothesis_problem(wider, measurements, tension_model)
     x = _starts_from(problem, [values], nominal=False)[0]
     J = problem.jacobian(x)
