@@ -23,8 +23,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-import stcs_ident  # noqa: E402
-from fuzz_inputs import FINDINGS, KINDS, run  # noqa: E402
+from fuzz_inputs import FINDINGS, KINDS, run
+
+import stcs_ident
 
 
 def main(argv=None) -> int:

@@ -26,6 +26,7 @@ Used by tests/test_fuzz.py (a bounded seeded run) and benchmarks/fuzz.py
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import io
 import json
@@ -112,7 +113,9 @@ class Outcome:
     stderr: str
 
 
+@functools.lru_cache(maxsize=1)
 def _frequencies() -> str:
+    """The base campaign's first test: 5 frequencies of the nominal model."""
     from stcs_ident.forward import batch_frequencies
     from stcs_ident.model import Attachment, Cable
 
@@ -314,7 +317,7 @@ def make_case(seed: int, index: int, root: Path, kind: str | None = None) -> Cas
     if out.exists():
         shutil.rmtree(out)
     out.mkdir()
-    text = BASE_TOML.format(f=_FREQUENCIES())
+    text = BASE_TOML.format(f=_frequencies())
     _record(directory / "records" / "T2.h5", np.random.default_rng(index))
     command = rng.choice(("forward", "spectra", "identify"))
     if kind in TOML_KINDS:
@@ -332,15 +335,6 @@ def make_case(seed: int, index: int, root: Path, kind: str | None = None) -> Cas
     if kind in TOML_KINDS and rng.random() < 0.3:
         argv += ["--json", str(out / "result.json")]
     return Case(seed, index, kind, directory, argv)
-
-
-_FREQ_CACHE: list[str] = []
-
-
-def _FREQUENCIES() -> str:
-    if not _FREQ_CACHE:
-        _FREQ_CACHE.append(_frequencies())
-    return _FREQ_CACHE[0]
 
 
 def _digest(directory: Path) -> dict[str, str]:

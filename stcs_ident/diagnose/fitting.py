@@ -175,7 +175,7 @@ def prior_penalty(hypothesis: Hypothesis, estimate: np.ndarray, uncertainty: np.
     - The position of an unmodeled attachment, known only to lie on the span: the Occam factor of a
       search (:func:`search_cost`, σ_x its standard deviation). A position the data pin down to 1 cm on a
       120 m stay costs about 15: a point attachment found anywhere has to earn its place. Without a
-      finite σ_x the search is not charged: such a fit is not significant (:mod:`.selection`).
+      finite σ_x the search is not charged.
     - A recorded attachment's position or mass far off its record (a gross error: a position measured
       from the wrong end, a bracket left out of the mass) costs at most what an unrecorded attachment
       found at the same place would: the search cost of its position (``located``: the σ_x, m, that the
@@ -204,7 +204,8 @@ def position_uncertainty(campaign: Campaign, measurements: Sequence[Measurement]
                          values: Mapping[tuple[str, str | None], float], tension_model: str) -> dict[str, float]:
     """σ (m) that the data give the position of each recorded attachment whose mass ``hypothesis`` frees,
     at the fitted ``values`` (SI, by (kind, member)) with that position freed as well: first order, from
-    the Jacobian; inf where the data cannot place it. Empty when positions are exact (a tolerance of 0)."""
+    the Jacobian; inf where the data cannot place it. Empty when positions are exact (a tolerance of 0) or
+    when the hypothesis frees them already."""
     members = {p.member for p in hypothesis.parameters if p.kind == "mass" and not p.slots}
     tests = [m.test for m in measurements]
     moving = next((e.name for e in registry.effects() if e.parameter_kind == "position" and not e.unmodeled), None)
