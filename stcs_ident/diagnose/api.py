@@ -24,11 +24,10 @@ from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
 from ..notes import Note
 from ..settings import Settings
+from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
     HypothesisFit,
     aicc,
-    cross_validate,
-    cross_validate_tests,
     failed_fit,
     fit_hypothesis,
     fit_nominal,
