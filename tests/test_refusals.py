@@ -1,0 +1,103 @@
+"""Each bad input of the reliability findings, built by hand: exit 2 and one line naming the file and the field.
+
+tests/test_fuzz.py checks that no input ends in a traceback, a hang or a
+modified input; these check what the one line says for each finding.
+"""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+from fuzz_inputs import BASE_TOML, _frequencies, _record
+
+from stcs_ident.cli import main
+
+
+@pytest.fixture
+def campaign(tmp_path):
+    """The fuzzer's base campaign (a hanger with a clamp; T1 a table, T2 a record)."""
+    directory = tmp_path / "c"
+    (directory / "records").mkdir(parents=True)
+    (directory / "campaign.toml").write_text(BASE_TOML.format(f=_frequencies()), encoding="utf-8")
+    _record(directory / "records" / "T2.h5", np.random.default_rng(0))
+    return directory
+
+
+def refusal(argv, capsys) -> str:
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exit_:  # argparse's refusals
+        code = exit_.code
+    err = [line for line in capsys.readouterr().err.splitlines() if not line.startswith(("spectra: ", "simulate: "))]
+    assert code == 2 and len(err) == 1, (code, err)
+    return err[0]
+
+
+def edit(campaign, old, new):
+    toml = campaign / "campaign.toml"
+    text = toml.read_text(encoding="utf-8")
+    assert old in text
+    toml.write_text(text.replace(old, new, 1), encoding="utf-8")
+    return str(toml)
+
+
+@pytest.mark.parametrize("old, new, field", [
+    ("tension = 0.02", "tension = 1" + "0" * 400, "field 'tolerance.tension'"),
+    ('  mass = 15.0\n', "  mass = 15.0\n" + "".join(f'  [[setup.attachment]]\n  name = "M{k}"\n  position = '
+                                                   f"{0.1 + 0.1 * k:.1f}\n" for k in range(51)),
+     "field 'setup[S].attachment'"),
+    ("frequencies = [", f"modes = [1, 2, 3, 4, {2**62}]\nfrequencies = [", "field 'test[T1].modes'"),
+    ("frequencies = [", "frequencies = [1e300, ", "field 'test[T1].frequencies'"),
+    ("frequencies = [", "reference = {paper = [1e300, 1, 1, 1, 1]}\nfrequencies = [",
+     "field 'test[T1].reference.paper'"),
+])
+def test_a_campaign_value_out_of_range_names_the_file_and_the_field(campaign, capsys, old, new, field):
+    toml = edit(campaign, old, new)
+    line = refusal(["forward", campaign], capsys)
+    assert toml in line and field in line
+
+
+@pytest.mark.parametrize("literal", ["1" * 5000, "[" * 5000 + "1" + "]" * 5000])
+def test_a_campaign_file_past_the_parser_s_limits_is_refused_naming_it(campaign, capsys, literal):
+    toml = edit(campaign, "EI = 2.0e5", f"EI = {literal}")
+    line = refusal(["forward", campaign], capsys)
+    assert toml in line and "not a valid TOML file" in line
+
+
+def test_a_name_with_a_newline_stays_on_one_line(campaign, capsys):
+    edit(campaign, 'name = "T1"', 'name = "T1\\nsecond line"')
+    line = refusal(["forward", campaign, "--test", "T1"], capsys)
+    assert "T1\\nsecond line" in line and "field 'test'" in line
+
+
+@pytest.mark.parametrize("dataset, link, field", [
+    ("acceleration", h5py.SoftLink("/nowhere"), "field 'acceleration'"),
+    ("channel_position", h5py.SoftLink("/channel_position"), "field 'channel_position'"),
+    ("acceleration", h5py.ExternalLink("/etc/passwd", "/acceleration"), "field 'acceleration'"),
+])
+def test_a_link_in_a_record_is_refused_naming_the_record_and_the_dataset(campaign, capsys, dataset, link, field):
+    record = campaign / "records" / "T2.h5"
+    with h5py.File(record, "r+") as h5:
+        del h5[dataset]
+        h5[dataset] = link
+    line = refusal(["spectra", campaign], capsys)
+    assert str(record) in line and field in line
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["forward", "{c}", "--json", "{c}/campaign.toml"], "--json"),
+    (["spectra", "{c}", "--json", "{c}/records/T2.h5"], "--json"),
+    (["spectra", "{c}", "--plot", "{c}/records"], "--plot"),
+    (["simulate", "{c}", "--out", "{c}", "--overwrite"], "--out"),
+    (["simulate", "{c}", "--out", "{c}/campaign.toml/below"], "--out"),
+    (["simulate", "{c}", "--out", "{c}/../sim", "--duration", "1e9"], "--duration"),
+    (["simulate", "{c}", "--out", "{c}/../sim", "--impulses", "1000000"], "--impulses"),
+    (["simulate", "{c}", "--out", "{c}/../sim", "--seed", "-1"], "--seed"),
+    (["forward", "{c}", "--modes", str(2**62)], "--modes"),
+])
+def test_an_option_that_would_harm_or_cannot_be_done_names_the_option(campaign, capsys, argv, option):
+    before = {p: p.read_bytes() for p in campaign.rglob("*") if p.is_file()}
+    line = refusal([a.format(c=campaign) for a in argv], capsys)
+    assert option in line
+    assert {p: p.read_bytes() for p in campaign.rglob("*") if p.is_file()} == before
