@@ -64,6 +64,34 @@ def finite_number(value, name: str) -> float:
     return v
 
 
+#: Bands of the model's quantities (SI units), each far wider than any cable built (spans of 2 km, tensions
+#: of 1 GN, tonnes per metre): a value outside is a unit or typing mistake, and the solver, which squares
+#: and multiplies these, cannot carry it in floating point (a tension of 1e-320 N or an EI of 1e-300 N m^2
+#: left every root search without convergence). Zero stays allowed where it means "none" (EI of a string,
+#: an attachment without mass or spring, no gravity).
+BANDS = {
+    "length": (1e-3, 1e5, "m"),
+    "mass_per_length": (1e-6, 1e6, "kg/m"),
+    "EI": (1e-9, 1e15, "N m^2"),
+    "EA": (1e-3, 1e15, "N"),
+    "gravity": (1e-3, 1e3, "m/s^2"),
+    "tension": (1e-3, 1e12, "N"),
+    "mass": (1e-9, 1e9, "kg"),
+    "stiffness": (1e-9, 1e15, "N/m"),
+}
+
+
+def in_band(value, name: str, quantity: str, zero: bool = False) -> float:
+    """``value`` as a number within ``BANDS[quantity]`` (or 0 when ``zero``); ModelError naming ``name``."""
+    v = _non_negative(value, name) if zero else _positive(value, name)
+    low, high, unit = BANDS[quantity]
+    if v != 0 and not low <= v <= high:
+        allowed = f"0 or between {low:g} and {high:g}" if zero else f"between {low:g} and {high:g}"
+        raise ModelError(f"must be {allowed} {unit} (far beyond any cable: a unit or typing mistake), "
+                         f"got {value!r}", field=name)
+    return v
+
+
 def _positive(value, name: str) -> float:
     v = finite_number(value, name)
     if v <= 0:
@@ -160,16 +188,15 @@ class Cable:
 
     def __post_init__(self):
         set_ = object.__setattr__
-        set_(self, "length", _positive(self.length, "cable.length"))
-        set_(self, "mass_per_length", _positive(self.mass_per_length, "cable.mass_per_length"))
-        set_(self, "EI", _non_negative(self.EI, "cable.EI"))
+        for quantity, zero in (("length", False), ("mass_per_length", False), ("EI", True)):
+            set_(self, quantity, in_band(getattr(self, quantity), f"cable.{quantity}", quantity, zero))
         if self.EA is not None:
-            set_(self, "EA", _positive(self.EA, "cable.EA"))
+            set_(self, "EA", in_band(self.EA, "cable.EA", "EA"))
         theta = finite_number(self.inclination, "cable.inclination")
         if abs(theta) >= math.pi / 2:
             raise ModelError("must satisfy |inclination| < 90 degrees", field="cable.inclination")
         set_(self, "inclination", theta)
-        set_(self, "gravity", _non_negative(self.gravity, "cable.gravity"))
+        set_(self, "gravity", in_band(self.gravity, "cable.gravity", "gravity", zero=True))
         for name in ("boundary_a", "boundary_b"):
             if not isinstance(getattr(self, name), Boundary):
                 raise ModelError("must be a Boundary", field=f"cable.{name}")
@@ -205,8 +232,8 @@ class Attachment:
             raise ModelError("must be a non-empty string", field="attachment.name")
         where = f"attachment[{self.name}]"
         object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
-        object.__setattr__(self, "mass", _non_negative(self.mass, f"{where}.mass"))
-        object.__setattr__(self, "stiffness", _non_negative(self.stiffness, f"{where}.stiffness"))
+        object.__setattr__(self, "mass", in_band(self.mass, f"{where}.mass", "mass", zero=True))
+        object.__setattr__(self, "stiffness", in_band(self.stiffness, f"{where}.stiffness", "stiffness", zero=True))
 
 
 @dataclass(frozen=True)
@@ -285,7 +312,7 @@ class Test:
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="test.name")
         where = f"test[{self.name}]"
-        object.__setattr__(self, "tension", _positive(self.tension, f"{where}.tension"))
+        object.__setattr__(self, "tension", in_band(self.tension, f"{where}.tension", "tension"))
         if self.frequencies is not None:
             freqs = tuple(frequency(f, f"{where}.frequencies") for f in self.frequencies)
             if not freqs:

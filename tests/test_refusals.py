@@ -58,6 +58,21 @@ def test_a_campaign_value_out_of_range_names_the_file_and_the_field(campaign, ca
     assert toml in line and field in line
 
 
+@pytest.mark.parametrize("old, new, field", [
+    ("tension = 4.0e5", "tension = 1e-320", "field 'test[T1].tension'"),
+    ("EI = 2.0e5", "EI = 1e-300", "field 'cable.EI'"),
+    ("length = 8.0", "length = 1e308", "field 'cable.length'"),
+    ("mass_per_length = 30.0", "mass_per_length = 2e-308", "field 'cable.mass_per_length'"),
+    ("EA = 3.0e8", "EA = 1e-300", "field 'cable.EA'"),
+    ("  mass = 15.0", "  mass = 1e300", "field 'setup[S].attachment[W1].mass'"),
+])
+def test_a_cable_value_beyond_any_cable_is_refused_not_left_to_the_solver(campaign, capsys, old, new, field):
+    """These reached the solver and ended as 'natural frequencies did not converge' (exit 1)."""
+    toml = edit(campaign, old, new)
+    line = refusal(["forward", campaign], capsys)
+    assert toml in line and field in line and "between" in line
+
+
 @pytest.mark.parametrize("literal", ["1" * 5000, "[" * 5000 + "1" + "]" * 5000])
 def test_a_campaign_file_past_the_parser_s_limits_is_refused_naming_it(campaign, capsys, literal):
     toml = edit(campaign, "EI = 2.0e5", f"EI = {literal}")

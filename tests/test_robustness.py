@@ -117,3 +117,27 @@ def test_a_hypothesis_whose_fit_fails_is_reported_and_the_diagnosis_goes_on(monk
     assert s["cause"]["effects"] == ["tension"]
     table = ranking_table(d)
     assert table["parameters"].str.startswith("failed: LinAlgError").sum() == 4
+
+
+def test_every_cable_within_the_model_s_bands_solves():
+    """Random cables across the model's value bands (log-uniform, half of them at the bands' corners): every
+    solve ends with positive, finite, increasing frequencies. Together with the bands' refusal of what lies
+    outside (tests/test_refusals.py), no campaign value reaches the solver that it cannot carry."""
+    from stcs_ident.model import BANDS, Boundary
+
+    rng = np.random.default_rng(11)
+
+    def pick(quantity, corner):
+        low, high, _ = BANDS[quantity]
+        return (low, high)[corner] if corner is not None else 10 ** rng.uniform(np.log10(low), np.log10(high))
+
+    for i in range(400):
+        corner = [int(c) for c in rng.integers(0, 2, 8)] if i % 2 else [None] * 8
+        length = pick("length", corner[0])
+        cable = Cable(length, pick("mass_per_length", corner[1]), 0.0 if i % 5 == 0 else pick("EI", corner[2]),
+                      EA=None if i % 3 == 0 else pick("EA", corner[3]),
+                      gravity=0.0 if i % 7 == 0 else pick("gravity", corner[4]), inclination=0.3,
+                      boundary_a=Boundary(float(rng.choice([0.0, np.inf, 1e-300, 1e300, 1.0]))))
+        attachments = (Attachment("W", 0.3 * length, pick("mass", corner[6]), pick("stiffness", corner[7])),)
+        f = np.asarray(batch_frequencies(cable, attachments if i % 4 else (), pick("tension", corner[5]), 4)).ravel()
+        assert np.all(np.isfinite(f)) and np.all(f > 0) and np.all(np.diff(f) >= 0), (i, cable, f)
