@@ -92,8 +92,6 @@ def build_parser() -> argparse.ArgumentParser:
     spe.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
     spe.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     _simulate_parser(sub)
-    for name, command in sub.choices.items():
-        _OPTIONS[name] = {o for action in command._actions for o in action.option_strings}
     idf = sub.add_parser("identify", epilog=_epilog("identify"), formatter_class=argparse.RawDescriptionHelpFormatter, help="correct tension, EI, attachment positions... from measured frequencies")
     idf.add_argument("campaign", help="campaign directory or its campaign.toml")
     idf.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
@@ -119,6 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
     dia.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     dia.add_argument("--out", metavar="DIR", help="write the report (report.md, figures, CSV tables) into DIR")
     dia.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    for name, command in sub.choices.items():
+        _OPTIONS[name] = {o for action in command._actions for o in action.option_strings}
     return parser
 
 
@@ -192,22 +192,13 @@ def _simulate(args) -> int:
     ambient = Ambient(args.ambient) if args.ambient else None
     if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
         raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
-    try:
-        effect = Effects(**hidden) if hidden else None
-    except (TypeError, ValueError) as err:
-        raise InputError(str(err), field="effects") from None
+    effect = Effects(**hidden) if hidden else None  # a refusal names effects.<key>, shown as its option
     field = _field_conditions(args, campaign, len(fractions))
-    try:
-        out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions],
-                                duration=args.duration, sampling_rate=args.sampling_rate, tests=args.test,
-                                damping=args.damping, impulses=impulses, ambient=ambient, snr_db=args.snr,
-                                effects=effect, seed=args.seed, overwrite=args.overwrite, field=field,
-                                progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
-    except InputError as err:  # an option's value refused by the simulator: name the option
-        option = "--" + str(err.field).replace("_", "-")
-        if err.file is None and err.field and option in _OPTIONS["simulate"]:
-            raise InputError(err.message, field=option) from None
-        raise
+    out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions],
+                            duration=args.duration, sampling_rate=args.sampling_rate, tests=args.test,
+                            damping=args.damping, impulses=impulses, ambient=ambient, snr_db=args.snr,
+                            effects=effect, seed=args.seed, overwrite=args.overwrite, field=field,
+                            progress=lambda k, n: _progress(f"simulate: test {k} of {n}"))
     print(f"wrote {out}")
     return 0
 
@@ -262,7 +253,7 @@ def _selected_tests(campaign, names, file):
     known = [t.name for t in campaign.tests]
     for name in names or []:
         if name not in known:
-            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="test", file=file)
+            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="--test", file=file)
     return names
 
 
@@ -438,6 +429,17 @@ def main(argv: list[str] | None = None) -> int:
     return _run(args)
 
 
+def _as_option(err: InputError, command: str) -> InputError:
+    """``err`` naming the command's option when its field is an argument the option gave (the library
+    names its own argument: ``params``, ``duration``, ``effects.extra_mass``), in one place for every command."""
+    field = err.field or ""
+    hidden = {f"effects.{e.truth_key}": e.option.flag for e in effects.effects() if e.option is not None}
+    option = {**hidden, "excitation": "--impulses"}.get(field, "--" + field.replace("_", "-"))
+    if field and not field.startswith("--") and option in _OPTIONS.get(command, ()):
+        return InputError(err.message, field=option, file=err.file)
+    return err
+
+
 def _run(args) -> int:
     try:
         return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,
@@ -445,7 +447,7 @@ def _run(args) -> int:
     except InputError as err:
         if args.debug:
             traceback.print_exc()
-        print(f"stcs-ident: {err}", file=sys.stderr)
+        print(f"stcs-ident: {_as_option(err, args.command)}", file=sys.stderr)
         return 2
     except (ComputationError, FloatingPointError) as err:
         if args.debug:

@@ -17,7 +17,8 @@ class InputError(ValueError):
         What is wrong, in plain words.
     field : str, optional
         Dotted name of the offending field (``"cable.length"``,
-        ``"setup[case2].attachment[W1].position"``).
+        ``"setup[case2].attachment[W1].position"``), or the command-line
+        option (``"--duration"``), shown as ``option '--duration'``.
     file : str, optional
         The file that holds the field.
     """
@@ -32,8 +33,8 @@ class InputError(ValueError):
         parts = []
         if self.file:
             parts.append(str(self.file))
-        if self.field:
-            parts.append(f"field '{self.field}'")
+        if self.field:  # a command-line option is named as one
+            parts.append(f"{'option' if self.field.startswith('--') else 'field'} '{self.field}'")
         head = ": ".join(parts)
         return one_line(f"{head}: {self.message}" if head else self.message)
 

@@ -5,13 +5,15 @@ record) and a command line. :func:`run_case` runs it in-process through
 ``stcs_ident.cli.main`` under a time limit and classifies the outcome:
 
 - ``ok``: exit 0;
-- ``refused``: exit 2 with one line on standard error that names a file or
-  a field (``stcs-ident: <file>: field '<field>': ...``);
+- ``refused``: exit 2 with one line on standard error that names the
+  mutated file and its field (``stcs-ident: <file>: field '<field>': ...``;
+  for a file that does not parse at all, the file and what is wrong with
+  it), or, for an option, the option;
 - ``failed``: exit 1 with one line;
 - anything else is a finding: ``traceback`` (an exception escaped),
   ``hang`` (over the time limit), ``modified`` (an input file changed or
   disappeared), ``multiline`` (the message is not one line), ``unnamed``
-  (exit 2 naming neither file nor field), ``exit`` (another status),
+  (exit 2 not naming them), ``exit`` (another status),
   ``bad_json`` (a successful run wrote a JSON file that is not standard
   JSON: NaN or Infinity).
 
@@ -390,7 +392,7 @@ def run_case(case: Case, time_limit: float = 30.0) -> Outcome:
             status = "ok"
         elif code in (1, 2) and len(lines) != 1:
             status = "multiline"
-        elif code == 2 and not (str(case.directory) in lines[0] or "field '" in lines[0] or "argument -" in lines[0]):
+        elif code == 2 and not _names_what(case, lines[0]):
             status = "unnamed"
         elif code == 2:
             status = "refused"
@@ -401,6 +403,21 @@ def run_case(case: Case, time_limit: float = 30.0) -> Outcome:
     elif changed and status != "traceback":
         status = "modified"
     return Outcome(case, status, code, text)
+
+
+#: Refusals about a whole file, where no field exists: its syntax, its encoding, its container.
+FILE_LEVEL = ("not a valid TOML file", "not a TOML file", "not an HDF5 file", "cannot read the file")
+
+
+def _names_what(case: Case, line: str) -> bool:
+    """Whether a refusal names what is wrong: the mutated file and its field (or, for a file that cannot be
+    parsed at all, the file and what is wrong with it), or the option."""
+    if case.kind in OPTION_KINDS:
+        return "option '--" in line or "argument --" in line
+    file = case.directory / ("campaign.toml" if case.kind in TOML_KINDS else "records/T2.h5")
+    if str(file) not in line:
+        return False
+    return "field '" in line or "option '--" in line or any(s in line for s in FILE_LEVEL)
 
 
 FINDINGS = ("traceback", "hang", "modified", "multiline", "unnamed", "exit", "bad_json")

@@ -90,7 +90,7 @@ def test_bad_campaign_exits_2_with_one_line(tmp_path, capsys, text, field):
 
 def test_unknown_test_exits_2(tmp_path, capsys):
     code, _, err = run(["forward", _write(tmp_path, GOOD), "--test", "T9"], capsys)
-    assert code == 2 and "field 'test'" in err and "T9" in err and "campaign.toml" in err
+    assert code == 2 and "option '--test'" in err and "T9" in err and "campaign.toml" in err
 
 
 def test_bad_modes_exits_2(tmp_path, capsys):
@@ -286,7 +286,7 @@ def test_simulate_refuses_bad_field_options_naming_them(tmp_path, capsys, args, 
     out = tmp_path / "bad"
     assert main(["simulate", str(HAN), "--out", str(out), "--test", "case1-L4", "--duration", "20", *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and f"field '{field}'" in err[0]
+    assert len(err) == 1 and f"option '{field}'" in err[0]
     assert not out.exists()
 
 
@@ -302,5 +302,5 @@ def test_simulate_refuses_bad_hidden_effect_options_naming_them(tmp_path, capsys
     out = tmp_path / "bad"
     assert main(["simulate", str(HAN), "--out", str(out), "--test", "case1-L4", "--duration", "5", *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and f"field '{field}'" in err[0], err
+    assert len(err) == 1 and f"option '{field}'" in err[0], err
     assert not out.exists()

@@ -174,7 +174,7 @@ def test_cli_unknown_effect_is_refused(tmp_path, capsys):
     out = tmp_path / "out.json"
     code, err = _run(capsys, ["diagnose", str(d), "--effects", "tension,wind", "--json", str(out)])
     assert code == 2 and len(err) == 1
-    assert "campaign.toml" in err[0] and "field 'effects'" in err[0] and "'wind'" in err[0]
+    assert "campaign.toml" in err[0] and "option '--effects'" in err[0] and "'wind'" in err[0]
     assert not out.exists()
 
 
@@ -192,7 +192,7 @@ def test_cli_attachment_effect_without_a_setup_that_has_one_is_refused(tmp_path,
     d = _campaign_dir(tmp_path, TWO_TESTS, setups)
     code, err = _run(capsys, ["diagnose", str(d), "--effects", "attachment_position"])
     assert code == 2 and len(err) == 1
-    assert "field 'effects'" in err[0] and "setup" in err[0]
+    assert "option '--effects'" in err[0] and "setup" in err[0]
 
 
 def test_cli_writes_json(tmp_path, capsys):

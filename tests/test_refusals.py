@@ -83,7 +83,7 @@ def test_a_campaign_file_past_the_parser_s_limits_is_refused_naming_it(campaign,
 def test_a_name_with_a_newline_stays_on_one_line(campaign, capsys):
     edit(campaign, 'name = "T1"', 'name = "T1\\nsecond line"')
     line = refusal(["forward", campaign, "--test", "T1"], capsys)
-    assert "T1\\nsecond line" in line and "field 'test'" in line
+    assert "T1\\nsecond line" in line and "option '--test'" in line
 
 
 @pytest.mark.parametrize("dataset, link, field", [
@@ -110,9 +110,24 @@ def test_a_link_in_a_record_is_refused_naming_the_record_and_the_dataset(campaig
     (["simulate", "{c}", "--out", "{c}/../sim", "--impulses", "1000000"], "--impulses"),
     (["simulate", "{c}", "--out", "{c}/../sim", "--seed", "-1"], "--seed"),
     (["forward", "{c}", "--modes", str(2**62)], "--modes"),
+    (["simulate", "{c}", "--out", "{c}/../sim", "--extra-mass", "5@99"], "--extra-mass"),
+    (["simulate", "{c}", "--out", "{c}/../sim", "--impulses", "0"], "--impulses"),
+    (["identify", "{c}", "--params", "tension,nope"], "--params"),
+    (["diagnose", "{c}", "--effects", "wind"], "--effects"),
+    (["forward", "{c}", "--test", "nope"], "--test"),
 ])
 def test_an_option_that_would_harm_or_cannot_be_done_names_the_option(campaign, capsys, argv, option):
     before = {p: p.read_bytes() for p in campaign.rglob("*") if p.is_file()}
     line = refusal([a.format(c=campaign) for a in argv], capsys)
-    assert option in line
+    assert f"option '{option}'" in line or f"argument {option}" in line
     assert {p: p.read_bytes() for p in campaign.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize("rate, what", [(1e300, "must lie between"), (5.0, "below mode 1")])
+def test_a_record_s_sampling_rate_beyond_use_names_the_record_and_the_field(campaign, capsys, rate, what):
+    """1e300 Hz had ended deep in the spectra as "field 'f_max': must be > f_min", naming no file."""
+    record = campaign / "records" / "T2.h5"
+    with h5py.File(record, "r+") as h5:
+        h5.attrs["sampling_rate"] = rate
+    line = refusal(["spectra", campaign], capsys)
+    assert str(record) in line and "field 'sampling_rate'" in line and what in line

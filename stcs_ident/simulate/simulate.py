@@ -39,6 +39,7 @@ from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
 from ..model import Attachment, Cable
 from ..spectra.record import Record
+from ..spectra.record import sampling_rate as record_sampling_rate
 from .conditions import FieldConditions, RecordTruth
 from .disturbances import (
     apply_sensor_disturbances,
@@ -337,7 +338,7 @@ def _finite(value, name: str, *, positive: bool = False) -> float:
 
 def check_timing(duration, sampling_rate) -> tuple[float, int]:
     duration = _finite(duration, "duration", positive=True)
-    fs = _finite(sampling_rate, "sampling_rate", positive=True)
+    fs = record_sampling_rate(sampling_rate)
     n = duration * fs
     if n > MAX_SAMPLES:
         raise ModelError(f"gives {n:.3g} samples at {fs:g} Hz; a simulated record has at most {MAX_SAMPLES} "

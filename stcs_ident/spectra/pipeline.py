@@ -19,7 +19,7 @@ from ..model import Campaign, Test
 from .io_hdf5 import read_record
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
-from .validation import check_duration, check_positions
+from .validation import check_bandwidth, check_duration, check_positions
 
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.
@@ -93,7 +93,9 @@ def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX
     check_positions(record, cable.length, file=path)
     nominal = natural_frequencies(cable, atts, test.tension, max_modes, tension_model=tension_model)
     check_duration(record, nominal[0] / 1.5, file=path)  # a few periods of mode 1, with margin for a 15 % error
-    f_max = min(0.45 * record.sampling_rate, 1.3 * nominal[-1])
+    usable = 0.45  # of the sampling rate: the analysis band ends below the anti-aliasing filter's roll-off
+    check_bandwidth(record, nominal[0], usable=usable, file=path)
+    f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
     result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max)
     freqs = np.array([p.frequency for p in result.peaks])
     unc = np.array([p.uncertainty for p in result.peaks])

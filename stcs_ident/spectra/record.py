@@ -15,6 +15,27 @@ from ..errors import ModelError
 
 STANDARD_GRAVITY = 9.80665  # m/s² per g
 
+#: Sampling rates a record may have (Hz): from one sample in 1000 s to ten times the highest frequency a
+#: campaign may state (1 MHz). Outside, a unit or typing mistake (a rate of 1e300 Hz made the analysis
+#: band empty deep inside the spectra instead of being refused where it is read).
+SAMPLING_RATE_BAND = (1e-3, 1e7)
+
+
+def sampling_rate(value, name: str = "sampling_rate", file: str | None = None) -> float:
+    """``value`` as a sampling rate in :data:`SAMPLING_RATE_BAND`, Hz; ModelError naming ``name`` (and ``file``)
+    otherwise. The one check of a sampling rate, for records read, built or simulated."""
+    try:
+        rate = float(value)
+    except (TypeError, ValueError, OverflowError):
+        rate = np.nan
+    if isinstance(value, bool) or not np.isfinite(rate) or rate <= 0:
+        raise ModelError(f"must be a finite number > 0 Hz, got {value!r}", field=name, file=file)
+    low, high = SAMPLING_RATE_BAND
+    if not low <= rate <= high:
+        raise ModelError(f"must lie between {low:g} and {high:g} Hz (a unit or typing mistake), got {value!r}",
+                         field=name, file=file)
+    return rate
+
 
 @dataclass(frozen=True, eq=False)
 class Record:
@@ -48,10 +69,7 @@ class Record:
         if acc.ndim != 2:
             raise ModelError(f"must have shape (n_samples, n_channels), got {acc.shape}", field="acceleration")
         object.__setattr__(self, "acceleration", acc)
-        fs = float(self.sampling_rate)
-        if not np.isfinite(fs) or fs <= 0:
-            raise ModelError(f"must be > 0, got {self.sampling_rate!r}", field="sampling_rate")
-        object.__setattr__(self, "sampling_rate", fs)
+        object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=self.source))
         names = tuple(str(n) for n in self.channel_names)
         if len(names) != acc.shape[1]:
             raise ModelError(f"has {len(names)} names for {acc.shape[1]} channels", field="channel_name")

@@ -29,12 +29,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .record import STANDARD_GRAVITY, Record
+from .record import STANDARD_GRAVITY, Record, sampling_rate
 from .screening import screen_channels
 
 __all__ = [
-    "TIME_TOLERANCE", "UNITS", "Positions", "check_duration", "check_positions", "check_sampling_rate", "one_line",
-    "position_list", "positions_by_name", "rate_from_time", "validated_record",
+    "TIME_TOLERANCE", "UNITS", "Positions", "check_bandwidth", "check_duration", "check_positions",
+    "check_sampling_rate", "one_line", "position_list", "positions_by_name", "rate_from_time", "validated_record",
 ]
 
 #: Units a record may be in, with their factor to m/s².
@@ -73,6 +73,19 @@ def check_duration(record: Record, f1: float, periods: float = 5, file: str | No
             f"the record lasts {record.duration:.4g} s, shorter than {periods:g} periods of mode 1 "
             f"({f1:.4g} Hz): at least {minimum:.4g} s needed",
             field="acceleration", file=file or record.source,
+        )
+
+
+def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: float = 1.15,
+                    file: str | None = None) -> None:
+    """Refuse a record sampled too slowly to hold mode 1 (``f1`` in Hz, with ``margin`` for a model error):
+    its analysis band ends at ``usable`` × the sampling rate, below the anti-aliasing filter's roll-off."""
+    needed = margin * f1 / usable
+    if record.sampling_rate < needed:
+        raise InputError(
+            f"{record.sampling_rate:.4g} Hz resolves frequencies up to {usable * record.sampling_rate:.4g} Hz, "
+            f"below mode 1 ({f1:.4g} Hz): at least {needed:.4g} Hz needed",
+            field="sampling_rate", file=file or record.source,
         )
 
 
@@ -145,14 +158,8 @@ def _check_position_values(positions: Any, names: list[str], file: str | None) -
 
 
 def check_sampling_rate(value: Any, file: str | None) -> float:
-    """``value`` as a sampling rate, Hz: a finite number > 0."""
-    try:
-        rate = float(value)
-    except (TypeError, ValueError):
-        rate = np.nan
-    if not rate > 0 or rate == np.inf:
-        raise InputError(f"must be a finite number > 0 Hz, got {value!r}", field="sampling_rate", file=file)
-    return rate
+    """``value`` as a sampling rate, Hz (:func:`~stcs_ident.spectra.record.sampling_rate`), naming ``file``."""
+    return sampling_rate(value, file=file)
 
 
 def _check_start_time(value: Any, file: str | None) -> None:
