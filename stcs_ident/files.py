@@ -1,16 +1,24 @@
 """Outputs written whole or not at all: a file renamed into place, a directory swapped in whole.
 
 Every writer of the package goes through here (JSON and Markdown text,
-CSV tables, PNG figures), so that a failure (or an interrupted run) never
-leaves half a file or half a report, what is written is on disk before it
-is renamed into place, and it gets the permissions a plain ``open()`` or
-``mkdir`` would give.
+CSV tables, PNG figures, HDF5 records), so that a failure (or an
+interrupted run) never leaves half a file or half a report, what is
+written is on disk before it is renamed into place, and it gets the
+permissions a plain ``open()`` or ``mkdir`` would give.
+
+A run killed outright (``kill -9``, a power cut) cannot remove its
+temporary files; they are hidden (a leading dot) and their names carry
+the host and the process (``.<name>.stcs~<host>~<pid>~<random>``), so the
+next run that writes into the same directory removes those whose process
+is gone (:func:`remove_stale`).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import shutil
+import socket
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -24,6 +32,55 @@ def umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def _host() -> str:
+    return re.sub(r"[^A-Za-z0-9_.]", "_", socket.gethostname()) or "host"
+
+
+def _prefix(name: str) -> str:
+    """The prefix of this process's temporary names beside ``name``."""
+    return f".{name}.stcs~{_host()}~{os.getpid()}~"
+
+
+_STALE = re.compile(r"^\.(?P<name>.*)\.stcs~(?P<host>[A-Za-z0-9_.]+)~(?P<pid>\d+)~")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):  # another user's live process; a pid beyond the system's
+        return pid < 2**31
+    return True
+
+
+def remove_stale(directory: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files and directories that killed runs of this host left in ``directory``
+    (their process no longer exists); returns what was removed. Another host's, or a live process's, are
+    left alone. An old output moved aside by :func:`replace_directory` whose replacement never arrived is
+    put back first."""
+    removed = []
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return removed
+    host = _host()
+    for entry in entries:
+        m = _STALE.match(entry.name)
+        if not m or m["host"] != host or _alive(int(m["pid"])):
+            continue
+        path = Path(entry.path)
+        previous, target = path / "previous", Path(directory) / m["name"]
+        if entry.name.endswith(".old") and previous.exists() and not os.path.lexists(target):
+            os.replace(previous, target)  # killed between moving the old output aside and the new one in
+        if entry.is_dir(follow_symlinks=False):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
+        removed.append(path)
+    return removed
 
 
 def _fsync(path: Path) -> None:
@@ -45,7 +102,8 @@ def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
     """
     target = Path(path)
     directory = target.parent if str(target.parent) else Path(".")
-    fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=directory)
+    remove_stale(directory)
+    fd, name = tempfile.mkstemp(prefix=_prefix(target.name), suffix=suffix, dir=directory)
     os.close(fd)
     tmp = Path(name)
     try:
@@ -94,7 +152,7 @@ def replace_directory(tmp: Path, out: Path) -> None:
     if not out.exists():
         os.replace(tmp, out)
         return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+    old = Path(tempfile.mkdtemp(prefix=_prefix(out.name), suffix=".old", dir=out.parent))
     os.replace(out, old / "previous")
     try:
         os.replace(tmp, out)
@@ -110,7 +168,8 @@ def whole_directory(out: Path) -> Iterator[Path]:
     """A new directory beside ``out`` to fill; when the block ends it replaces ``out`` as a whole
     (:func:`replace_directory`), and when the block fails it is removed and ``out`` is untouched."""
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    remove_stale(out.parent)
+    tmp = Path(tempfile.mkdtemp(prefix=_prefix(out.name), suffix=".tmp", dir=out.parent))
     try:
         os.chmod(tmp, 0o777 & ~umask())  # mkdtemp makes 0700; give the mode a plain mkdir would
         yield tmp

@@ -92,6 +92,20 @@ def in_band(value, name: str, quantity: str, zero: bool = False) -> float:
     return v
 
 
+def real_number(value, name: str, *, positive: bool = False, nonnegative: bool = False) -> float:
+    """``value``, a real number (int or float, numpy's too; not a bool or a string), as a finite float
+    (> 0 with ``positive``, >= 0 with ``nonnegative``); ModelError naming ``name`` otherwise. The one check
+    of a number given through the library's API (the simulator's options and conditions)."""
+    import numpy as np
+
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ModelError(f"must be a number, got {value!r}", field=name)
+    v = finite_number(value, name)
+    if (positive and v <= 0) or (nonnegative and v < 0):
+        raise ModelError(f"must be a finite number {'> 0' if positive else '>= 0'}, got {value!r}", field=name)
+    return v
+
+
 def _positive(value, name: str) -> float:
     v = finite_number(value, name)
     if v <= 0:

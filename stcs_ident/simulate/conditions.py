@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from ..errors import ModelError
+from ..model import real_number
 
 __all__ = [
     "DRIFT_LIMIT", "DcOffsets", "FieldConditions", "LowPassLoading", "MainsHum", "PinkNoise", "RecordTruth",
@@ -57,7 +58,7 @@ class LowPassLoading:
 
     def __post_init__(self):
         object.__setattr__(self, "corner_frequency",
-                           _number(self.corner_frequency, "ambient_lowpass.corner_frequency", positive=True))
+                           real_number(self.corner_frequency, "ambient_lowpass.corner_frequency", positive=True))
         if isinstance(self.order, bool) or self.order not in (1, 2):
             raise ModelError(f"must be 1 or 2, got {self.order!r}", field="ambient_lowpass.order")
         object.__setattr__(self, "order", int(self.order))
@@ -106,10 +107,10 @@ class TensionDrift:
 
     def __post_init__(self):
         for name in ("rate", "phase"):
-            object.__setattr__(self, name, _number(getattr(self, name), f"drift.{name}"))
+            object.__setattr__(self, name, real_number(getattr(self, name), f"drift.{name}"))
         for name in ("amplitude", "walk"):
-            object.__setattr__(self, name, _number(getattr(self, name), f"drift.{name}", nonnegative=True))
-        object.__setattr__(self, "period", _number(self.period, "drift.period", positive=True))
+            object.__setattr__(self, name, real_number(getattr(self, name), f"drift.{name}", nonnegative=True))
+        object.__setattr__(self, "period", real_number(self.period, "drift.period", positive=True))
 
 
 @dataclass(frozen=True)
@@ -170,7 +171,7 @@ class MainsHum:
     relative: bool = False
 
     def __post_init__(self):
-        object.__setattr__(self, "frequency", _number(self.frequency, "hum.frequency", positive=True))
+        object.__setattr__(self, "frequency", real_number(self.frequency, "hum.frequency", positive=True))
         amplitudes = _levels(self.amplitudes, "hum.amplitudes", nonnegative=True, sequence=True)
         object.__setattr__(self, "amplitudes", amplitudes)
         if self.phases is not None:
@@ -357,9 +358,9 @@ def random_field_conditions(rng: np.random.Generator, sampling_rate: float, dura
     mains_frequency : float or None
         Fix the mains frequency (Hz) instead of drawing 50 or 60.
     """
-    fs = _number(sampling_rate, "sampling_rate", positive=True)
-    T = _number(duration, "duration", positive=True)
-    p = _number(probability, "probability", nonnegative=True)
+    fs = real_number(sampling_rate, "sampling_rate", positive=True)
+    T = real_number(duration, "duration", positive=True)
+    p = real_number(probability, "probability", nonnegative=True)
     if p > 1:
         raise ModelError(f"must lie in [0, 1], got {probability!r}", field="probability")
     if isinstance(n_channels, bool) or not isinstance(n_channels, int | np.integer) or n_channels < 1:
@@ -377,7 +378,7 @@ def random_field_conditions(rng: np.random.Generator, sampling_rate: float, dura
     pink = PinkNoise(float(log_uniform(0.01, 0.1)), relative=True)
     mains = float(rng.choice([50.0, 60.0])) + float(rng.uniform(-0.05, 0.05))
     if mains_frequency is not None:
-        mains = _number(mains_frequency, "mains_frequency", positive=True)
+        mains = real_number(mains_frequency, "mains_frequency", positive=True)
     n_harm = int(rng.integers(1, 6))
     amps = float(log_uniform(1e-3, 3e-2)) * np.cumprod(np.concatenate([[1.0], rng.uniform(0.1, 1.0, n_harm - 1)]))
     hum = MainsHum(mains, tuple(amps), phases=tuple(rng.uniform(0, 2 * math.pi, n_harm)),
@@ -394,24 +395,14 @@ def random_field_conditions(rng: np.random.Generator, sampling_rate: float, dura
 # --------------------------------------------------------------------------
 
 
-def _number(value, name: str, *, positive: bool = False, nonnegative: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ModelError(f"must be a number, got {value!r}", field=name)
-    v = float(value)
-    if not math.isfinite(v) or (positive and v <= 0) or (nonnegative and v < 0):
-        bound = " > 0" if positive else " >= 0" if nonnegative else ""
-        raise ModelError(f"must be a finite number{bound}, got {value!r}", field=name)
-    return v
-
-
 def _levels(value, name: str, *, nonnegative: bool = False, sequence: bool = False) -> float | tuple[float, ...]:
     """A number or a non-empty sequence of numbers (only a sequence if ``sequence``), checked."""
     if np.ndim(value) == 0 and not sequence:
-        return _number(value, name, nonnegative=nonnegative)
+        return real_number(value, name, nonnegative=nonnegative)
     if isinstance(value, str) or np.ndim(value) != 1 or len(value) == 0:
         raise ModelError(f"must be a {'' if sequence else 'number or a '}non-empty sequence of numbers, "
                          f"got {value!r}", field=name)
-    return tuple(_number(v, name, nonnegative=nonnegative) for v in value)
+    return tuple(real_number(v, name, nonnegative=nonnegative) for v in value)
 
 
 def _flag(value, name: str) -> bool:

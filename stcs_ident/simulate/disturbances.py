@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Sequence
 
 import numpy as np
@@ -47,6 +46,7 @@ from scipy.linalg import solve_discrete_lyapunov
 from scipy.signal import butter
 
 from ..errors import ModelError
+from ..files import atomic_path
 from ..forward.dsm import natural_frequencies
 from ..model import Attachment, Cable
 from .conditions import DRIFT_LIMIT, FieldConditions, LowPassLoading, MainsHum, TensionDrift
@@ -227,22 +227,13 @@ def write_record_as(record, path: str | os.PathLike, *, float32: bool = False) -
     if not float32:
         return
     target = os.fspath(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", dir=os.path.dirname(target) or ".")
-    os.close(fd)
-    try:
-        with h5py.File(target, "r") as src, h5py.File(tmp, "w") as dst:
-            dst.attrs.update(dict(src.attrs))
-            for name in src:
-                if name == "acceleration":
-                    dst.create_dataset(name, data=np.asarray(src[name][()], dtype=np.float32))
-                else:
-                    src.copy(name, dst)
-        os.chmod(tmp, os.stat(target).st_mode & 0o777)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(target) as tmp, h5py.File(target, "r") as src, h5py.File(tmp, "w") as dst:
+        dst.attrs.update(dict(src.attrs))
+        for name in src:
+            if name == "acceleration":
+                dst.create_dataset(name, data=np.asarray(src[name][()], dtype=np.float32))
+            else:
+                src.copy(name, dst)
 
 
 

@@ -37,7 +37,7 @@ import numpy as np
 from ..errors import ModelError
 from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
-from ..model import Attachment, Cable
+from ..model import Attachment, Cable, real_number
 from ..spectra.record import Record
 from ..spectra.record import sampling_rate as record_sampling_rate
 from .conditions import FieldConditions, RecordTruth
@@ -91,7 +91,7 @@ class Impulse:
 
     def __post_init__(self):
         for name in ("time", "position", "magnitude"):
-            object.__setattr__(self, name, _finite(getattr(self, name), f"impulse.{name}"))
+            object.__setattr__(self, name, real_number(getattr(self, name), f"impulse.{name}"))
 
 
 @dataclass(frozen=True)
@@ -115,9 +115,9 @@ class Ambient:
     correlation_length: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "rms_pressure", _finite(self.rms_pressure, "ambient.rms_pressure", positive=True))
+        object.__setattr__(self, "rms_pressure", real_number(self.rms_pressure, "ambient.rms_pressure", positive=True))
         if self.correlation_length is not None:
-            L = _finite(self.correlation_length, "ambient.correlation_length", positive=True)
+            L = real_number(self.correlation_length, "ambient.correlation_length", positive=True)
             object.__setattr__(self, "correlation_length", L)
 
 
@@ -214,7 +214,7 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
     fs, n_samples = check_timing(duration, sampling_rate)
     impulses = check_impulses(impulses)
     if snr_db is not None:
-        snr_db = _finite(snr_db, "snr_db")
+        snr_db = real_number(snr_db, "snr_db")
     if not impulses and ambient is None:
         raise ModelError("no excitation: give impulses and/or ambient", field="excitation")
     if ambient is not None and not isinstance(ambient, Ambient):
@@ -326,18 +326,8 @@ def _with_noise(clean: np.ndarray, snr_db: float | None, rng: np.random.Generato
     return clean + rng.standard_normal(clean.shape) * noise_rms
 
 
-def _finite(value, name: str, *, positive: bool = False) -> float:
-    """``value`` as a float, refusing non-numbers, NaN and infinities (and <= 0 if ``positive``)."""
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ModelError(f"must be a number, got {value!r}", field=name)
-    v = float(value)
-    if not math.isfinite(v) or (positive and v <= 0):
-        raise ModelError(f"must be a finite number{' > 0' if positive else ''}, got {value!r}", field=name)
-    return v
-
-
 def check_timing(duration, sampling_rate) -> tuple[float, int]:
-    duration = _finite(duration, "duration", positive=True)
+    duration = real_number(duration, "duration", positive=True)
     fs = record_sampling_rate(sampling_rate)
     n = duration * fs
     if n > MAX_SAMPLES:

@@ -50,6 +50,7 @@ MIN_GAP = 0.5  # s, onsets closer than this belong to one blow
 FORCE_SEARCH = 0.25  # s after an onset within which the blow is over
 CONFIRM_AFTER, CONFIRM_BEFORE = 0.5, 1.0  # s
 MIN_EVENT = 0.5  # s, shorter segments are not used
+BLOCK_SAMPLES = 65536  # rows at a time in the scans of the whole record (bounded temporaries)
 
 
 @dataclass(frozen=True)
@@ -86,14 +87,26 @@ def _frame_length(scale: tuple[float, float, int], sampling_rate: float) -> int:
     return max(scale[2], round(scale[0] * sampling_rate))
 
 
-def _frame_energy(signal: np.ndarray, frame: int) -> np.ndarray:
-    """Mean over channels of signal² scaled per channel by its median, averaged per frame."""
-    power = signal**2
-    scale = np.median(power[:: max(1, power.shape[0] // 20000)], axis=0)  # a subsample is plenty
+def _frame_energy(signal: np.ndarray, frame: int, difference: bool = False) -> np.ndarray:
+    """Mean over channels of signal² scaled per channel by its median, averaged per frame.
+
+    With ``difference``, of the first difference of ``signal`` instead. Computed in blocks of whole frames,
+    so that a record of gigabytes needs no temporary of its size.
+    """
+    n = signal.shape[0] - 1 if difference else signal.shape[0]
+    rows = np.arange(0, n, max(1, n // 20000))  # a subsample is plenty for the median
+    sample = signal[rows + 1] - signal[rows] if difference else signal[rows]
+    power = sample**2
+    scale = np.median(power, axis=0)
     scale = np.where(scale > 0, scale, np.maximum(power.mean(axis=0), np.finfo(float).tiny))
-    combined = (power / scale).mean(axis=1)
-    n_frames = combined.size // frame
-    return combined[: n_frames * frame].reshape(n_frames, frame).mean(axis=1)
+    n_frames = n // frame
+    energy = np.empty(n_frames)
+    block = max(1, BLOCK_SAMPLES // frame)  # frames per block
+    for k in range(0, n_frames, block):
+        lo, hi = k * frame, min(n_frames, k + block) * frame
+        part = np.diff(signal[lo:hi + 1], axis=0) if difference else signal[lo:hi]
+        energy[k:k + block] = ((part**2 / scale).mean(axis=1)).reshape(-1, frame).mean(axis=1)
+    return energy
 
 
 def _jumps(energy: np.ndarray, history: int, jump_db: float) -> np.ndarray:
@@ -118,10 +131,12 @@ def _jumps(energy: np.ndarray, history: int, jump_db: float) -> np.ndarray:
     return k[ahead[k] >= 10 ** (jump_db / 10) * before]
 
 
-def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.ndarray | None = None) -> list[_Onset]:
-    """Onsets at one scale; `energy`: the signal's :func:`_frame_energy` at this scale, if already computed."""
+def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.ndarray | None = None,
+                  difference: bool = False) -> list[_Onset]:
+    """Onsets at one scale (of the first difference with ``difference``); `energy`: the signal's
+    :func:`_frame_energy` at this scale, if already computed."""
     frame = _frame_length(scale, sampling_rate)
-    energy = _frame_energy(signal, frame) if energy is None else energy
+    energy = _frame_energy(signal, frame, difference) if energy is None else energy
     if energy.size < 8:
         return []
     history = max(4, round(scale[1] * sampling_rate / frame))
@@ -131,6 +146,16 @@ def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.nd
         peak = k + int(np.argmax(energy[k : k + search]))
         onsets.append(_Onset(sample=int(k * frame), frame=frame, start=int((peak + 1) * frame)))
     return onsets
+
+
+def _normalised_power(x: np.ndarray) -> np.ndarray:
+    """Mean over channels of x² divided by each channel's mean square, per sample (in blocks of rows)."""
+    mean_square = np.array([np.mean(x[:, j] ** 2) for j in range(x.shape[1])])
+    mean_square = np.maximum(mean_square, np.finfo(float).tiny)
+    out = np.empty(x.shape[0])
+    for lo in range(0, x.shape[0], BLOCK_SAMPLES):
+        out[lo:lo + BLOCK_SAMPLES] = (x[lo:lo + BLOCK_SAMPLES] ** 2 / mean_square).mean(axis=1)
+    return out
 
 
 def _confirmed(x2: np.ndarray, onset: _Onset, sampling_rate: float) -> bool:
@@ -182,13 +207,13 @@ def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]
         Empty for an ambient record (no blow found).
     """
     x = np.asarray(acceleration, dtype=float)
-    fine = _scale_onsets(np.diff(x, axis=0), sampling_rate, FINE)
+    fine = _scale_onsets(x, sampling_rate, FINE, difference=True)
     coarse_energy = _frame_energy(x, _frame_length(COARSE, sampling_rate))
     coarse = _scale_onsets(x, sampling_rate, COARSE, coarse_energy)
     merged = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
     onsets = []
     if merged:  # (an ambient record has none: the normalised power is not needed)
-        x2 = (x**2 / np.maximum(np.mean(x**2, axis=0), np.finfo(float).tiny)).mean(axis=1)
+        x2 = _normalised_power(x)
         onsets = [o for o in merged if _confirmed(x2, o, sampling_rate)]
     if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, coarse_energy):
         frame = _frame_length(COARSE, sampling_rate)

@@ -31,6 +31,7 @@ FLOOR_BLOCKS = 7  # running median over this many blocks
 FLOOR_PASSES = 3
 MASK_PROBABILITY = 0.01  # a bin above this chi-squared quantile starts a masked peak region
 MASK_SMOOTHING = 8  # cells averaged to find broad peaks for the mask
+CHUNK_VALUES = 2**20  # noise_floor: values of the spectra treated at once
 
 
 def _blocks(n: int, cell: int) -> list[tuple[int, int]]:
@@ -89,7 +90,14 @@ def noise_floor(spectra: np.ndarray, dof, cell: int, passes: int = FLOOR_PASSES)
     `dof` is a number or one per bin (degrees of freedom of the spectrum).
     `passes` = 1 takes the running median without leaving peaks out (for
     a spectrum whose peaks have been taken out already).
+
+    Columns are independent; a large array is done a group of columns at
+    a time (its temporaries, some ten times its size, stay bounded).
     """
+    group = max(1, CHUNK_VALUES // max(1, spectra.shape[0]))
+    if spectra.shape[1] > group:
+        return np.concatenate([noise_floor(spectra[:, c:c + group], dof, cell, passes)
+                               for c in range(0, spectra.shape[1], group)], axis=1)
     dof = np.broadcast_to(np.asarray(dof, dtype=float), spectra.shape[:1])
     # The quantiles once per distinct value (often one for all bins), then spread over the bins.
     dof, bins = np.unique(dof, return_inverse=True)

@@ -14,14 +14,13 @@ A file that is missing, unreadable or not HDF5 raises an
 from __future__ import annotations
 
 import os
-import tempfile
 from typing import Any
 
 import h5py
 import numpy as np
 
 from ..errors import InputError
-from ..files import umask
+from ..files import atomic_path
 from .record import Record
 from .validation import one_line, validated_record
 
@@ -82,23 +81,13 @@ def write_record(record: Record, path: str | os.PathLike) -> None:
     is written beside the target under a temporary name, then renamed, so a
     failure never leaves half a record. Dropped channels are not written.
     """
-    target = os.fspath(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", dir=os.path.dirname(target) or ".")
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as h5:
-            h5.attrs.update(format=FORMAT, version=VERSION, sampling_rate=record.sampling_rate, unit="m/s^2")
-            if record.start_time is not None:
-                h5.attrs["start_time"] = record.start_time
-            h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
-            h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
-            h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
-        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        h5.attrs.update(format=FORMAT, version=VERSION, sampling_rate=record.sampling_rate, unit="m/s^2")
+        if record.start_time is not None:
+            h5.attrs["start_time"] = record.start_time
+        h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
+        h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
+        h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
 
 
 def _open_hdf5(file: str) -> h5py.File:
@@ -160,6 +149,11 @@ def _read_dataset(h5: h5py.File, name: str, file: str) -> np.ndarray:
                              "float64) are read", field=name, file=file)
         if h5py.check_string_dtype(node.dtype) is not None:
             return np.asarray(node.asstr("utf-8")[()], dtype=object)
+        if node.dtype.kind == "f" and node.ndim > 0:  # straight into float64: no second copy of a large record
+            out = np.empty(node.shape, dtype=np.float64)
+            if node.size:
+                node.read_direct(out)
+            return out
         return np.asarray(node[()])
     except InputError:
         raise

@@ -211,15 +211,33 @@ def welch_length(n_samples: int) -> int:
     return int(min(n_samples, 2 ** int(np.round(np.log2(target)))))
 
 
-def _welch_segments(x: np.ndarray, nperseg: int) -> tuple[np.ndarray, float]:
-    """Hann-windowed, mean-removed segment DFTs (n_segments, n_freq, n_channels), 50 % overlap, and Σ window²."""
+#: Largest block of segment DFTs (all channels, a band of frequencies) held at once, bytes: with the
+#: record itself, what bounds the memory of the ambient overview (:func:`ambient_overview`).
+BLOCK_BYTES = 64 * 2**20
+
+
+def _segment_dfts(x: np.ndarray, nperseg: int, window: np.ndarray, budget: int):
+    """``(segment k, first channel, DFTs (n_freq, g))`` of the Hann-windowed, mean-removed segments (50 %
+    overlap), a segment and a group of channels at a time: rows read in order from the row-major record,
+    each step's arrays within ``budget`` bytes."""
     step = nperseg // 2
-    n_segments = max(1, (x.shape[0] - nperseg) // step + 1)
-    window = signal.windows.hann(nperseg, sym=False)
-    segments = np.lib.stride_tricks.sliding_window_view(x, nperseg, axis=0)[::step][:n_segments]  # (K, C, nperseg)
-    segments = segments - segments.mean(axis=-1, keepdims=True)
-    segments *= window  # in place: one copy of the overlapping segments, not two
-    return rfft(segments, axis=-1, workers=-1).transpose(0, 2, 1), float(np.sum(window**2))
+    n_segments = _n_segments(x.shape[0], nperseg)
+    g = int(np.clip(budget // max(1, 24 * nperseg), 1, x.shape[1]))
+    # Column sums of each half-segment, once: a segment's mean is that of its two halves.
+    halves = np.array([x[j * step:(j + 1) * step].sum(axis=0) for j in range(n_segments + 1)])
+    buffer = np.empty((nperseg, g))
+    for k in range(n_segments):
+        mean = (halves[k] + halves[k + 1]) / nperseg if 2 * step == nperseg else None
+        for c0 in range(0, x.shape[1], g):
+            segment = x[k * step:k * step + nperseg, c0:c0 + g]
+            out = buffer[:, :segment.shape[1]]
+            np.subtract(segment, segment.mean(axis=0) if mean is None else mean[c0:c0 + g], out=out)
+            out *= window[:, None]
+            yield k, c0, rfft(out, axis=0, workers=-1)
+
+
+def _n_segments(n_samples: int, nperseg: int) -> int:
+    return max(1, (n_samples - nperseg) // (nperseg // 2) + 1)
 
 
 def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
@@ -231,30 +249,68 @@ def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
     cross-spectral matrix, the Satterthwaite count ν (tr S)² / tr(S²) (tr S²
     corrected for its Wishart bias) runs from ν (coherent) to C ν
     (independent noise).
+
+    Memory: the spectra a Welch segment at a time, and the cross-spectral
+    sums band by band of frequency (each band's DFTs recomputed: a few
+    passes over a large record), so that beside the record about half
+    its size is held at most (or BLOCK_BYTES).
     """
     nperseg = welch_length(x.shape[0])
-    spectra, window_power = _welch_segments(x, nperseg)
-    n_segments = spectra.shape[0]
-    psd = _one_sided((np.abs(spectra) ** 2).mean(axis=0) / (window_power * sampling_rate))
+    n_segments = _n_segments(x.shape[0], nperseg)
+    window = signal.windows.hann(nperseg, sym=False)
+    window_power = float(np.sum(window**2))
+    budget = max(BLOCK_BYTES, x.nbytes // 8)
+    power = np.zeros((nperseg // 2 + 1, x.shape[1]))
+    for _, c0, dft in _segment_dfts(x, nperseg, window, budget):
+        power[:, c0:c0 + dft.shape[1]] += np.abs(dft) ** 2
+    psd = _one_sided(power / (n_segments * window_power * sampling_rate))
     frequency = np.arange(psd.shape[0]) * sampling_rate / nperseg
     # Equivalent degrees of freedom of Welch's average (Hann, 50 % overlap: correlation 0.167 between segments).
     rho2 = 0.167**2 if n_segments > 1 else 0.0
     dof = 2.0 * n_segments / (1.0 + 2.0 * rho2 * (1.0 - 1.0 / n_segments))
     floor = noise_floor(psd, dof, cell=2)
-    combined_dof = _coherent_dof(spectra, floor, dof, window_power, sampling_rate)
+    trace, frobenius = _whitened_sums(x, nperseg, window, floor, window_power * sampling_rate / 2.0, budget)
+    combined_dof = _coherent_dof(trace, frobenius, dof, n_channels=x.shape[1])
     channel_dof = np.full(frequency.shape, dof)
     return _overview(frequency, psd, floor, dof, combined_dof, channel_dof, cell=2, random_ripple=True)
 
 
-def _coherent_dof(spectra: np.ndarray, floor: np.ndarray, dof: float, window_power: float, fs: float) -> np.ndarray:
-    """ν (tr S)² / tr(S²) per bin, S the floor-whitened cross-spectral matrix (see :func:`ambient_overview`)."""
-    n_segments, _, n_channels = spectra.shape
-    scale = 1.0 / np.sqrt(floor * window_power * fs / 2.0)  # E|X|² of noise in a segment DFT
-    white = spectra * scale[None]
-    stacked = white.transpose(1, 2, 0)  # (f, C, K)
-    csd = stacked @ stacked.conj().transpose(0, 2, 1) / n_segments
-    trace = np.real(np.trace(csd, axis1=1, axis2=2))
-    frobenius = np.sum(np.abs(csd) ** 2, axis=(1, 2))
+def _whitened_sums(x: np.ndarray, nperseg: int, window: np.ndarray, floor: np.ndarray, noise_scale: float,
+                   budget: int) -> tuple[np.ndarray, np.ndarray]:
+    """tr S and ‖S‖²_F per bin, S the floor-whitened cross-spectral matrix Σ_k w_k w_kᴴ / K.
+
+    Over bands of frequency whose segment DFTs of all channels (complex64) fit in twice ``budget`` bytes:
+    per band, the DFTs are recomputed and the band kept. ‖S‖²_F from the C × C matrix or, when the
+    segments are fewer than the channels, from the K × K Gram matrix of the segments (the same norm).
+    """
+    n_freq = floor.shape[0]
+    n_channels = x.shape[1]
+    n_segments = _n_segments(x.shape[0], nperseg)
+    scale = 1.0 / np.sqrt(floor * noise_scale)  # E|X|² of noise in a segment DFT
+    trace = np.empty(n_freq)
+    frobenius = np.empty(n_freq)
+    width = max(1, 2 * budget // (8 * n_segments * n_channels))
+    for lo in range(0, n_freq, width):
+        hi = min(n_freq, lo + width)
+        band = np.empty((hi - lo, n_segments, n_channels), dtype=np.complex64)  # (f, K, C)
+        for k, c0, dft in _segment_dfts(x, nperseg, window, budget):
+            c1 = c0 + dft.shape[1]
+            band[:, k, c0:c1] = dft[lo:hi] * scale[lo:hi, c0:c1]
+        for a in range(0, hi - lo, 4096):  # the products in sub-bands: bounded temporaries
+            w = band[a:a + 4096]
+            if n_channels <= n_segments:
+                product = w.conj().transpose(0, 2, 1) @ w  # (f, C, C) = K S
+            else:
+                product = w @ w.conj().transpose(0, 2, 1)  # (f, K, K): the same Frobenius norm
+            rows = slice(lo + a, lo + a + w.shape[0])
+            trace[rows] = np.sum(w.real.astype(float) ** 2 + w.imag.astype(float) ** 2, axis=(1, 2)) / n_segments
+            frobenius[rows] = np.sum(product.real.astype(float) ** 2 + product.imag.astype(float) ** 2,
+                                     axis=(1, 2)) / n_segments**2
+    return trace, frobenius
+
+
+def _coherent_dof(trace: np.ndarray, frobenius: np.ndarray, dof: float, n_channels: int) -> np.ndarray:
+    """ν (tr S)² / tr(S²) per bin (see :func:`ambient_overview`), tr(S²) corrected for its Wishart bias."""
     effective = dof / 2.0
     square = np.maximum(frobenius - trace**2 / effective, trace**2 / n_channels)
     ratio = np.clip(trace**2 / square, 1.0, n_channels)

@@ -96,7 +96,7 @@ def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX
     usable = 0.45  # of the sampling rate: the analysis band ends below the anti-aliasing filter's roll-off
     check_bandwidth(record, nominal[0], usable=usable, file=path)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
-    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max)
+    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True)  # the record is ours
     freqs = np.array([p.frequency for p in result.peaks])
     unc = np.array([p.uncertainty for p in result.peaks])
     numbering = number_modes(freqs, unc, cable, atts, test.tension, tension_model=tension_model)

@@ -35,10 +35,21 @@ CLIP_LONG_RUN = 20
 CLIP_FRACTION = 0.005
 
 
+#: Rows scanned at a time (a record of gigabytes is read in row order, with bounded temporaries).
+BLOCK_ROWS = 65536
+
+
 def screen_channels(acceleration: np.ndarray, names: list[str], file: str | None) -> tuple[list[int], list]:
     """Indices of the usable channels and ``(name, reason)`` of the others."""
-    spread = acceleration.std(axis=0)
-    reasons = [_drop_reason(acceleration[:, j], spread[j], spread.max()) for j in range(len(names))]
+    low, high, spread, at_rails = _column_statistics(acceleration)
+    reasons = []
+    for j in range(len(names)):
+        if high[j] == low[j] or spread[j] <= DEAD_RELATIVE_STD * spread.max():
+            reasons.append("dead: constant signal")
+        elif at_rails[j] >= CLIP_MIN_RUN:  # only then can a run be held: look at the channel itself
+            reasons.append(_clip_reason(acceleration[:, j], low[j], high[j]))
+        else:
+            reasons.append(None)
     dropped = [(name, reason) for name, reason in zip(names, reasons) if reason]
     keep = [j for j, reason in enumerate(reasons) if reason is None]
     if not keep:
@@ -49,10 +60,31 @@ def screen_channels(acceleration: np.ndarray, names: list[str], file: str | None
     return keep, dropped
 
 
-def _drop_reason(signal: np.ndarray, spread: float, largest_spread: float) -> str | None:
-    if np.ptp(signal) == 0 or spread <= DEAD_RELATIVE_STD * largest_spread:
-        return "dead: constant signal"
-    rails = _clip_rails(signal)
+def _column_statistics(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per column: minimum, maximum, standard deviation, and the larger count of samples at either extreme;
+    in two passes over blocks of rows."""
+    n = x.shape[0]
+    low, high = x[0].copy(), x[0].copy()
+    total = np.zeros(x.shape[1])
+    for lo in range(0, n, BLOCK_ROWS):
+        block = x[lo:lo + BLOCK_ROWS]
+        low = np.minimum(low, block.min(axis=0))
+        high = np.maximum(high, block.max(axis=0))
+        total += block.sum(axis=0)
+    mean = total / n
+    squares = np.zeros(x.shape[1])
+    at_low = np.zeros(x.shape[1], dtype=int)
+    at_high = np.zeros(x.shape[1], dtype=int)
+    for lo in range(0, n, BLOCK_ROWS):
+        block = x[lo:lo + BLOCK_ROWS]
+        squares += ((block - mean) ** 2).sum(axis=0)
+        at_low += (block == low).sum(axis=0)
+        at_high += (block == high).sum(axis=0)
+    return low, high, np.sqrt(squares / n), np.maximum(at_low, at_high)
+
+
+def _clip_reason(signal: np.ndarray, low: float, high: float) -> str | None:
+    rails = _clip_rails(signal, low, high)
     if not rails:
         return None
     if len(rails) == 2 and np.isclose(abs(rails[0]), abs(rails[1]), rtol=0.01):
@@ -60,10 +92,10 @@ def _drop_reason(signal: np.ndarray, spread: float, largest_spread: float) -> st
     return "clipped at " + " and ".join(f"{rail:+.4g}" for rail in rails) + " m/s²"
 
 
-def _clip_rails(signal: np.ndarray) -> list[float]:
-    """The extreme values a saturated channel holds; empty when it is not clipped."""
+def _clip_rails(signal: np.ndarray, low: float, high: float) -> list[float]:
+    """The extreme values (``low``, ``high``) a saturated channel holds; empty when it is not clipped."""
     held = {}
-    for rail in (float(signal.min()), float(signal.max())):
+    for rail in (float(low), float(high)):
         runs = _run_lengths(signal == rail)
         held[rail] = runs[runs >= CLIP_MIN_RUN]
     longest = max((int(runs.max()) for runs in held.values() if runs.size), default=0)

@@ -98,6 +98,7 @@ def validated_record(
 ) -> Record:
     """Check the parts of a record, convert to m/s², drop dead and clipped channels."""
     file = source
+    given = acceleration
     acceleration = _check_shape(np.asarray(acceleration, dtype=float), file)
     names = _check_names(names, acceleration.shape[1], file)
     positions = _check_position_values(positions, names, file)
@@ -107,10 +108,13 @@ def validated_record(
     if start_time is not None:
         _check_start_time(start_time, file)
     _check_finite(acceleration, names, file)
-    acceleration = acceleration * UNITS[unit]
+    if UNITS[unit] != 1.0:  # in place when the array is ours already (converted to float64 above)
+        acceleration = acceleration * UNITS[unit] if acceleration is given else _scale(acceleration, UNITS[unit])
     keep, dropped = screen_channels(acceleration, names, file)
+    if dropped:  # (indexing copies the record: only when a channel goes)
+        acceleration = acceleration[:, keep]
     return Record(
-        acceleration=acceleration[:, keep], sampling_rate=sampling_rate,
+        acceleration=acceleration, sampling_rate=sampling_rate,
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
         start_time=start_time, source=source, dropped=tuple(dropped),
     )
@@ -169,17 +173,32 @@ def _check_start_time(value: Any, file: str | None) -> None:
         raise InputError(f"is not an ISO 8601 time: {value!r}", field="start_time", file=file) from None
 
 
+def _scale(array: np.ndarray, factor: float) -> np.ndarray:
+    array *= factor
+    return array
+
+
+#: Rows checked at a time by the scans of a whole record (bounded temporaries on a record of gigabytes).
+BLOCK_ROWS = 65536
+
+
 def _check_finite(acceleration: np.ndarray, names: list[str], file: str | None) -> None:
-    """Refuse NaN or inf samples, naming the first bad channel and sample."""
-    bad = ~np.isfinite(acceleration)
-    bad_channels = np.flatnonzero(bad.any(axis=0))
-    if not bad_channels.size:
+    """Refuse NaN or inf samples, naming the first bad channel and sample (scanned in blocks of rows)."""
+    bad_channels = np.zeros(acceleration.shape[1], dtype=bool)
+    first = np.full(acceleration.shape[1], -1)
+    for start in range(0, acceleration.shape[0], BLOCK_ROWS):
+        bad = ~np.isfinite(acceleration[start:start + BLOCK_ROWS])
+        new = bad.any(axis=0) & ~bad_channels
+        first[new] = start + np.argmax(bad[:, new], axis=0)
+        bad_channels |= new
+    if not bad_channels.any():
         return
-    channel = int(bad_channels[0])
-    sample = int(np.argmax(bad[:, channel]))
+    bad_list = np.flatnonzero(bad_channels)
+    channel = int(bad_list[0])
+    sample = int(first[channel])
     value = acceleration[sample, channel]
     what = "NaN" if np.isnan(value) else f"{value:g}"
-    others = f" ({bad_channels.size - 1} other channel(s) too)" if bad_channels.size > 1 else ""
+    others = f" ({bad_list.size - 1} other channel(s) too)" if bad_list.size > 1 else ""
     raise InputError(f"channel {names[channel]!r} has {what} at sample {sample} (0-based), "
                      f"its first non-finite sample{others}", field="acceleration", file=file)
 

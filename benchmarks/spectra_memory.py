@@ -1,0 +1,123 @@
+"""Memory and time of `stcs-ident spectra` on one large record: 50 channels × 2,000,000 float32 samples.
+
+The record (400 MB of float32 on disk, 800 MB as float64) is written once
+into a temporary campaign: the fuzzer's 8 m hanger with a clamp, at 200 Hz
+(2.8 hours), its first modes as narrow-band responses common to every
+channel (times each channel's mode shape), plus sensor noise. Then
+``stcs-ident spectra`` runs on it in a child process (the installed
+package's entry point), and this script prints the child's peak resident
+memory against the bound of the reliability issue: twice the record's
+float64 size plus a fixed overhead (the interpreter and its libraries,
+measured as the peak of the same command on a record of 1000 samples).
+
+Run from the repository root::
+
+    python benchmarks/spectra_memory.py                      # the 50 × 2,000,000 record
+    python benchmarks/spectra_memory.py --samples 200000     # a tenth of it, quicker
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+import h5py
+import numpy as np
+from common import print_header
+from fuzz_inputs import BASE_TOML, _frequencies
+from scipy import signal
+
+LENGTH, TENSION = 8.0, 5.0e5  # the fuzz campaign's cable and its test T2
+
+
+def write_record(path: Path, n_samples: int, n_channels: int, rate: float, seed: int = 0) -> None:
+    """A field-like ambient record written in blocks of rows (never the whole array in memory)."""
+    from stcs_ident.forward import batch_frequencies
+    from stcs_ident.model import Attachment, Cable
+
+    cable = Cable(length=LENGTH, mass_per_length=30.0, EI=2.0e5, EA=3.0e8, inclination=np.radians(10.0))
+    f = np.asarray(batch_frequencies(cable, (Attachment("W1", 2.7, 15.0),), TENSION, 12)).ravel()
+    f = f[f < 0.4 * rate]
+    rng = np.random.default_rng(seed)
+    x = np.linspace(0.05, 0.95, n_channels) * LENGTH
+    shapes = np.sin(np.outer(np.arange(1, f.size + 1), np.pi * x / LENGTH))  # (modes, channels)
+    zeta = 0.005
+    filters = []
+    for fn in f:  # a resonator per mode, driven by white noise: its modal response
+        w = 2 * np.pi * fn / rate
+        r = np.exp(-zeta * w)
+        filters.append(([1.0], [1.0, -2 * r * np.cos(w * np.sqrt(1 - zeta**2)), r * r]))
+    states = [np.zeros(2) for _ in f]
+    block = 200_000
+    with h5py.File(path, "w") as h5:
+        h5.attrs.update(format="stcs-record", version=1, sampling_rate=rate, unit="m/s^2")
+        data = h5.create_dataset("acceleration", shape=(n_samples, n_channels), dtype=np.float32)
+        h5.create_dataset("channel_name", data=[f"A{k + 1}" for k in range(n_channels)], dtype=h5py.string_dtype())
+        h5["channel_position"] = x
+        for start in range(0, n_samples, block):
+            n = min(block, n_samples - start)
+            q = np.empty((f.size, n))
+            for k, (b, a) in enumerate(filters):
+                q[k], states[k] = signal.lfilter(b, a, rng.standard_normal(n), zi=states[k])
+            acc = (q / np.arange(1, f.size + 1)[:, None]).T @ shapes
+            acc += 0.1 * acc.std() * rng.standard_normal(acc.shape)
+            data[start:start + n] = acc.astype(np.float32)
+
+
+def campaign(directory: Path, n_samples: int, n_channels: int, rate: float) -> Path:
+    (directory / "records").mkdir(parents=True)
+    (directory / "campaign.toml").write_text(BASE_TOML.format(f=_frequencies()), encoding="utf-8")
+    write_record(directory / "records" / "T2.h5", n_samples, n_channels, rate)
+    return directory
+
+
+def run_spectra(directory: Path) -> tuple[int, float, float, str]:
+    """Exit status, wall time (s), peak resident memory (MB) and standard error of ``stcs-ident spectra``,
+    run in a child process (its peak alone, from wait4)."""
+    command = [sys.executable, "-c", "import sys; from stcs_ident.cli import main; sys.exit(main(sys.argv[1:]))",
+               "spectra", str(directory), "--test", "T2", "--json", str(directory.parent / f"{directory.name}.json")]
+    with tempfile.TemporaryFile("w+") as err:
+        started = time.perf_counter()
+        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err, text=True)
+        _, status, usage = os.wait4(child.pid, 0)
+        elapsed = time.perf_counter() - started
+        err.seek(0)
+        return os.waitstatus_to_exitcode(status), elapsed, usage.ru_maxrss / 1024, err.read()
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=2_000_000)
+    parser.add_argument("--channels", type=int, default=50)
+    parser.add_argument("--rate", type=float, default=200.0, help="sampling rate, Hz (default 200)")
+    args = parser.parse_args(argv)
+    print_header()
+    with tempfile.TemporaryDirectory() as tmp:
+        started = time.perf_counter()
+        big = campaign(Path(tmp) / "big", args.samples, args.channels, args.rate)
+        size = (big / "records" / "T2.h5").stat().st_size
+        print(f"record: {args.channels} channels x {args.samples} samples float32 at {args.rate:g} Hz, "
+              f"{size / 1e6:.0f} MB on disk, written in {time.perf_counter() - started:.0f} s", flush=True)
+        _, _, overhead, _ = run_spectra(campaign(Path(tmp) / "small", 4096, args.channels, args.rate))
+        code, elapsed, peak, err = run_spectra(big)
+    float64 = args.samples * args.channels * 8 / 2**20
+    bound = 2 * float64 + overhead
+    print(f"fixed overhead (the same command on 4096 samples): {overhead:.0f} MB")
+    print(f"spectra on the record: {elapsed:.1f} s, peak resident memory {peak:.0f} MB; bound 2 x {float64:.0f} MB "
+          f"(float64 size) + {overhead:.0f} MB = {bound:.0f} MB: {'within' if peak <= bound else 'EXCEEDED'} "
+          f"({peak / float64:.2f} x the float64 size)")
+    if code != 0:
+        print(f"exit status {code}:", *err.strip().splitlines()[-3:], sep="\n  ")
+    return 0 if peak <= bound and code == 0 else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
