@@ -131,3 +131,37 @@ def test_a_record_s_sampling_rate_beyond_use_names_the_record_and_the_field(camp
         h5.attrs["sampling_rate"] = rate
     line = refusal(["spectra", campaign], capsys)
     assert str(record) in line and "field 'sampling_rate'" in line and what in line
+
+
+def test_a_nyquist_alternating_record_ends_cleanly(campaign, capsys):
+    """A record alternating at the Nyquist frequency once made the Whittle scoring step raise LinAlgError
+    (a singular Fisher matrix): now the fit stops and the command ends with exit 0 or one clean line."""
+    record = campaign / "records" / "T2.h5"
+    with h5py.File(record, "r+") as h5:
+        n = h5["acceleration"].shape[0]
+        h5["acceleration"][...] = np.repeat(((-1.0) ** np.arange(n))[:, None], 2, axis=1)  # the fuzzer's case
+    try:
+        code = main(["spectra", str(campaign)])
+    except SystemExit as exit_:
+        code = exit_.code
+    err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("spectra: ")]
+    assert code == 0 or (code in (1, 2) and len(err) == 1 and "Traceback" not in err[0]), (code, err)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_record_with_flipped_bits_is_read_or_refused_naming_it(campaign, capsys, seed):
+    """Bit flips anywhere in the HDF5 file (header, metadata or samples) had raised OSError, KeyError or
+    RuntimeError from h5py: a flip either leaves a readable record or is refused naming the record."""
+    record = campaign / "records" / "T2.h5"
+    data = bytearray(record.read_bytes())
+    rng = np.random.default_rng(seed)
+    for i in rng.integers(0, len(data), 40):
+        data[i] ^= 1 << int(rng.integers(8))
+    record.write_bytes(bytes(data))
+    try:
+        code = main(["spectra", str(campaign)])
+    except SystemExit as exit_:
+        code = exit_.code
+    err = [ln for ln in capsys.readouterr().err.splitlines()
+           if not ln.startswith("spectra: ") and "warning" not in ln]
+    assert code == 0 or (code == 2 and len(err) == 1 and str(record) in err[0]), (code, err)
