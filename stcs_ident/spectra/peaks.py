@@ -111,7 +111,7 @@ from .events import Event, detect_events, whole_record_event
 from .overview import Overview, ambient_overview, decay_overviews
 from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
 from .peak_result import Peak, PeakResult
-from .record import Record
+from .record import Record, check_finite
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
 from .wander import common_wander, with_common_wander
@@ -209,8 +209,7 @@ def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple
     fs = record.sampling_rate
     if kind not in KINDS:
         raise InputError(f"must be one of {', '.join(KINDS)}, got {kind!r}", field="kind")
-    if not np.all(np.isfinite(record.acceleration)):
-        raise InputError("contains NaN or infinite values", field="acceleration")
+    check_finite(record.acceleration, record.channel_names, record.source)  # a Record built in code: not read
     if record.n_samples < 256:
         raise InputError(f"needs at least 256 samples, has {record.n_samples}", field="acceleration")
     f_lo = 0.0 if f_min is None else float(f_min)

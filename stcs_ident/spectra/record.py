@@ -8,6 +8,7 @@ from end A along the chord.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +38,72 @@ def sampling_rate(value, name: str = "sampling_rate", file: str | None = None) -
     return rate
 
 
+def check_shape(acceleration: np.ndarray, file: str | None) -> np.ndarray:
+    if acceleration.ndim != 2:
+        raise ModelError(f"must have shape (n_samples, n_channels), got {acceleration.shape}",
+                         field="acceleration", file=file)
+    if acceleration.shape[0] == 0 or acceleration.shape[1] == 0:
+        raise ModelError(f"has no samples or no channels: shape {acceleration.shape}", field="acceleration", file=file)
+    return acceleration
+
+
+def check_names(names: Any, n_channels: int, file: str | None) -> list[str]:
+    names = np.asarray(names, dtype=object)
+    if names.shape != (n_channels,):
+        raise ModelError(f"must have shape ({n_channels},), one per channel, got {names.shape}",
+                         field="channel_name", file=file)
+    seen = set()
+    for index, name in enumerate(names):
+        if not isinstance(name, str) or not name.strip():
+            raise ModelError(f"channel {index} needs a non-empty text name, got {name!r}", field="channel_name",
+                             file=file)
+        if name in seen:
+            raise ModelError(f"duplicate channel name {name!r}", field="channel_name", file=file)
+        seen.add(name)
+    return [str(name) for name in names]
+
+
+def check_position_values(positions: Any, names: list[str], file: str | None) -> np.ndarray:
+    try:
+        positions = np.asarray(positions, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError("positions must be numbers", field="channel_position", file=file) from None
+    if positions.shape != (len(names),):
+        raise ModelError(f"must have shape ({len(names)},), one per channel, got {positions.shape}",
+                         field="channel_position", file=file)
+    bad = np.flatnonzero(~np.isfinite(positions))
+    if bad.size:
+        index = int(bad[0])
+        raise ModelError(f"channel {names[index]!r} has position {positions[index]}: not a finite number",
+                         field="channel_position", file=file)
+    return positions
+
+
+#: Rows checked at a time by the scans of a whole record (bounded temporaries on a record of gigabytes).
+BLOCK_ROWS = 65536
+
+
+def check_finite(acceleration: np.ndarray, names: list[str], file: str | None) -> None:
+    """Refuse NaN or inf samples, naming the first bad channel and sample (scanned in blocks of rows)."""
+    bad_channels = np.zeros(acceleration.shape[1], dtype=bool)
+    first = np.full(acceleration.shape[1], -1)
+    for start in range(0, acceleration.shape[0], BLOCK_ROWS):
+        bad = ~np.isfinite(acceleration[start:start + BLOCK_ROWS])
+        new = bad.any(axis=0) & ~bad_channels
+        first[new] = start + np.argmax(bad[:, new], axis=0)
+        bad_channels |= new
+    if not bad_channels.any():
+        return
+    bad_list = np.flatnonzero(bad_channels)
+    channel = int(bad_list[0])
+    sample = int(first[channel])
+    value = acceleration[sample, channel]
+    what = "NaN" if np.isnan(value) else f"{value:g}"
+    others = f" ({bad_list.size - 1} other channel(s) too)" if bad_list.size > 1 else ""
+    raise ModelError(f"channel {names[channel]!r} has {what} at sample {sample} (0-based), "
+                     f"its first non-finite sample{others}", field="acceleration", file=file)
+
+
 @dataclass(frozen=True, eq=False)
 class Record:
     """A multi-channel acceleration record.
@@ -63,23 +130,14 @@ class Record:
     dropped: tuple[tuple[str, str], ...] = field(default_factory=tuple)
 
     def __post_init__(self):
+        file = self.source
         acc = np.asarray(self.acceleration, dtype=float)
-        if acc.ndim == 1:
-            acc = acc[:, None]
-        if acc.ndim != 2:
-            raise ModelError(f"must have shape (n_samples, n_channels), got {acc.shape}", field="acceleration")
-        object.__setattr__(self, "acceleration", acc)
-        object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=self.source))
-        names = tuple(str(n) for n in self.channel_names)
-        if len(names) != acc.shape[1]:
-            raise ModelError(f"has {len(names)} names for {acc.shape[1]} channels", field="channel_name")
-        if len(set(names)) != len(names):
-            raise ModelError("channel names must be unique", field="channel_name")
-        object.__setattr__(self, "channel_names", names)
-        pos = np.asarray(self.channel_positions, dtype=float).reshape(-1)
-        if pos.shape != (acc.shape[1],):
-            raise ModelError(f"has {pos.size} positions for {acc.shape[1]} channels", field="channel_position")
-        object.__setattr__(self, "channel_positions", pos)
+        object.__setattr__(self, "acceleration", check_shape(acc[:, None] if acc.ndim == 1 else acc, file))
+        object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=file))
+        names = check_names(self.channel_names, self.acceleration.shape[1], file)
+        object.__setattr__(self, "channel_names", tuple(names))
+        object.__setattr__(self, "channel_positions", check_position_values(
+            np.asarray(self.channel_positions, dtype=float).reshape(-1), names, file))
 
     @property
     def n_samples(self) -> int:

@@ -29,7 +29,15 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .record import STANDARD_GRAVITY, Record, sampling_rate
+from .record import (
+    STANDARD_GRAVITY,
+    Record,
+    check_finite,
+    check_names,
+    check_position_values,
+    check_shape,
+    sampling_rate,
+)
 from .screening import screen_channels
 
 __all__ = [
@@ -99,15 +107,15 @@ def validated_record(
     """Check the parts of a record, convert to m/s², drop dead and clipped channels."""
     file = source
     given = acceleration
-    acceleration = _check_shape(np.asarray(acceleration, dtype=float), file)
-    names = _check_names(names, acceleration.shape[1], file)
-    positions = _check_position_values(positions, names, file)
+    acceleration = check_shape(np.asarray(acceleration, dtype=float), file)
+    names = check_names(names, acceleration.shape[1], file)
+    positions = check_position_values(positions, names, file)
     sampling_rate = check_sampling_rate(sampling_rate, file)
     if unit not in UNITS:
         raise InputError(f"unknown unit {unit!r}; use 'm/s^2' or 'g'", field="unit", file=file)
     if start_time is not None:
         _check_start_time(start_time, file)
-    _check_finite(acceleration, names, file)
+    check_finite(acceleration, names, file)
     if UNITS[unit] != 1.0:  # in place when the array is ours already (converted to float64 above)
         acceleration = acceleration * UNITS[unit] if acceleration is given else _scale(acceleration, UNITS[unit])
     keep, dropped = screen_channels(acceleration, names, file)
@@ -118,47 +126,6 @@ def validated_record(
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
         start_time=start_time, source=source, dropped=tuple(dropped),
     )
-
-
-def _check_shape(acceleration: np.ndarray, file: str | None) -> np.ndarray:
-    if acceleration.ndim != 2:
-        raise InputError(f"must have shape (n_samples, n_channels), got {acceleration.shape}",
-                         field="acceleration", file=file)
-    if acceleration.shape[0] == 0 or acceleration.shape[1] == 0:
-        raise InputError(f"has no samples or no channels: shape {acceleration.shape}", field="acceleration", file=file)
-    return acceleration
-
-
-def _check_names(names: Any, n_channels: int, file: str | None) -> list[str]:
-    names = np.asarray(names, dtype=object)
-    if names.shape != (n_channels,):
-        raise InputError(f"must have shape ({n_channels},), one per channel, got {names.shape}",
-                         field="channel_name", file=file)
-    seen = set()
-    for index, name in enumerate(names):
-        if not isinstance(name, str) or not name.strip():
-            raise InputError(f"channel {index} needs a non-empty text name, got {name!r}", field="channel_name",
-                             file=file)
-        if name in seen:
-            raise InputError(f"duplicate channel name {name!r}", field="channel_name", file=file)
-        seen.add(name)
-    return [str(name) for name in names]
-
-
-def _check_position_values(positions: Any, names: list[str], file: str | None) -> np.ndarray:
-    try:
-        positions = np.asarray(positions, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError("positions must be numbers", field="channel_position", file=file) from None
-    if positions.shape != (len(names),):
-        raise InputError(f"must have shape ({len(names)},), one per channel, got {positions.shape}",
-                         field="channel_position", file=file)
-    bad = np.flatnonzero(~np.isfinite(positions))
-    if bad.size:
-        index = int(bad[0])
-        raise InputError(f"channel {names[index]!r} has position {positions[index]}: not a finite number",
-                         field="channel_position", file=file)
-    return positions
 
 
 def check_sampling_rate(value: Any, file: str | None) -> float:
@@ -176,31 +143,6 @@ def _check_start_time(value: Any, file: str | None) -> None:
 def _scale(array: np.ndarray, factor: float) -> np.ndarray:
     array *= factor
     return array
-
-
-#: Rows checked at a time by the scans of a whole record (bounded temporaries on a record of gigabytes).
-BLOCK_ROWS = 65536
-
-
-def _check_finite(acceleration: np.ndarray, names: list[str], file: str | None) -> None:
-    """Refuse NaN or inf samples, naming the first bad channel and sample (scanned in blocks of rows)."""
-    bad_channels = np.zeros(acceleration.shape[1], dtype=bool)
-    first = np.full(acceleration.shape[1], -1)
-    for start in range(0, acceleration.shape[0], BLOCK_ROWS):
-        bad = ~np.isfinite(acceleration[start:start + BLOCK_ROWS])
-        new = bad.any(axis=0) & ~bad_channels
-        first[new] = start + np.argmax(bad[:, new], axis=0)
-        bad_channels |= new
-    if not bad_channels.any():
-        return
-    bad_list = np.flatnonzero(bad_channels)
-    channel = int(bad_list[0])
-    sample = int(first[channel])
-    value = acceleration[sample, channel]
-    what = "NaN" if np.isnan(value) else f"{value:g}"
-    others = f" ({bad_list.size - 1} other channel(s) too)" if bad_list.size > 1 else ""
-    raise InputError(f"channel {names[channel]!r} has {what} at sample {sample} (0-based), "
-                     f"its first non-finite sample{others}", field="acceleration", file=file)
 
 
 def positions_by_name(names: list[str], positions: Positions, file: str | None) -> dict[str, Any]:
