@@ -14,6 +14,7 @@ import traceback
 import warnings
 
 from . import __version__, effects
+from .cli_track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
 from .errors import ComputationError, InputError, StcsWarning, one_line
 
 DESCRIPTION = """\
@@ -48,6 +49,7 @@ EXAMPLES = {
     "simulate": "stcs-ident simulate campaigns/han2020 --out sim/ --test case1-L4 --extra-mass 5@6.0 --seed 1",
     "identify": "stcs-ident identify campaigns/han2020 --test case1-L4 --params tension,EI --method contour --plot figures/",
     "diagnose": "stcs-ident diagnose campaigns/han2020 --out report/",
+    "track": TRACK_EXAMPLE,
 }
 
 
@@ -117,13 +119,14 @@ def build_parser() -> argparse.ArgumentParser:
     dia.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
     dia.add_argument("--out", metavar="DIR", help="write the report (report.md, figures, CSV tables) into DIR")
     dia.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    add_track_parser(sub, _epilog("track"))
     for name, command in sub.choices.items():
         _OPTIONS[name] = {o for action in command._actions for o in action.option_strings}
     return parser
 
 
 def _simulate_parser(sub) -> None:
-    sim = sub.add_parser("simulate", epilog=_epilog("simulate"), formatter_class=argparse.RawDescriptionHelpFormatter, help="simulated records of a campaign's tests, with optional hidden effects",
+    sim = sub.add_parser("simulate", epilog=_epilog("simulate") + f"\n  {ARCHIVE_EXAMPLE}", formatter_class=argparse.RawDescriptionHelpFormatter, help="simulated records of a campaign's tests, with optional hidden effects",
                          description="Writes OUT/campaign.toml (the nominal cable only), OUT/records/<test>.h5 "
                                      "and OUT/truth.json (the true model and frequencies).")
     sim.add_argument("campaign", help="campaign directory or its campaign.toml")
@@ -162,6 +165,7 @@ def _simulate_parser(sub) -> None:
             o = effect.option
             eff.add_argument(o.flag, dest=f"effect_{effect.name}", metavar=o.metavar,
                              action="append" if o.repeatable else "store", help=f"{effect.name}: {o.help}")
+    add_archive_options(sim)
     sim.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
 
 
@@ -175,6 +179,12 @@ def _simulate(args) -> int:
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
     check_outputs([("--out", args.out, True)], _inputs(campaign, file))
+    if args.archive is not None:
+        if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
+            raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
+        from .cli_track import simulate_archive_from_args
+
+        return simulate_archive_from_args(args, campaign)
     try:
         fractions = [float(x) for x in args.sensors.split(",")]
     except ValueError:
@@ -442,8 +452,8 @@ def _as_option(err: InputError, command: str) -> InputError:
 
 def _run(args) -> int:
     try:
-        return {"forward": _forward, "spectra": _spectra, "simulate": _simulate,
-                "identify": _identify, "diagnose": _diagnose}[args.command](args)
+        return {"forward": _forward, "spectra": _spectra, "simulate": _simulate, "identify": _identify,
+                "diagnose": _diagnose, "track": lambda a: run_track(a, _write)}[args.command](args)
     except InputError as err:
         if args.debug:
             traceback.print_exc()

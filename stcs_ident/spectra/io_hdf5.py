@@ -65,13 +65,14 @@ def _read(file: str) -> Record:
         sampling_rate = _attr(h5.attrs, "sampling_rate", float, file)
         unit = _attr(h5.attrs, "unit", str, file)
         start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
+        temperature = _attr(h5.attrs, "temperature", float, file) if "temperature" in h5.attrs else None
         acceleration = _read_dataset(h5, "acceleration", file)
         names = _read_dataset(h5, "channel_name", file)
         positions = _read_dataset(h5, "channel_position", file)
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
     return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
-                             source=file)
+                             source=file, temperature=temperature)
 
 
 def write_record(record: Record, path: str | os.PathLike) -> None:
@@ -85,6 +86,8 @@ def write_record(record: Record, path: str | os.PathLike) -> None:
         h5.attrs.update(format=FORMAT, version=VERSION, sampling_rate=record.sampling_rate, unit="m/s^2")
         if record.start_time is not None:
             h5.attrs["start_time"] = record.start_time
+        if record.temperature is not None:
+            h5.attrs["temperature"] = record.temperature
         h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
         h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
         h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)

@@ -19,6 +19,7 @@ from ..model import Campaign, Test
 from .io_hdf5 import read_record
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
+from .record import Record
 from .validation import check_bandwidth, check_duration, check_positions
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -87,7 +88,12 @@ def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX
                  tension_model: str = "uniform") -> TestSpectra:
     """Pick and number the modal frequencies of one test's record."""
     path = record_path(campaign, test)
-    record = read_record(path)
+    return analyse_record(campaign, test, read_record(path), path, max_modes=max_modes, tension_model=tension_model)
+
+
+def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *, max_modes: int = DEFAULT_MAX_MODES,
+                   tension_model: str = "uniform") -> TestSpectra:
+    """:func:`analyse_test` of a record already read (from ``path``); its mean is removed in place."""
     cable = campaign.cable
     atts = campaign.setup(test.setup).attachments
     check_positions(record, cable.length, file=path)

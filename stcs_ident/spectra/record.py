@@ -38,6 +38,23 @@ def sampling_rate(value, name: str = "sampling_rate", file: str | None = None) -
     return rate
 
 
+#: Temperatures a record may state, °C: beyond any structure's service (a unit or typing mistake outside).
+TEMPERATURE_BAND = (-100.0, 150.0)
+
+
+def check_temperature(value: Any, file: str | None) -> float:
+    """``value`` as a temperature in :data:`TEMPERATURE_BAND`, °C; ModelError naming the file otherwise."""
+    try:
+        t = float(value)
+    except (TypeError, ValueError, OverflowError):
+        t = np.nan
+    low, high = TEMPERATURE_BAND
+    if isinstance(value, bool) or not low <= t <= high:
+        raise ModelError(f"must be a number between {low:g} and {high:g} °C, got {value!r}", field="temperature",
+                         file=file)
+    return t
+
+
 def check_shape(acceleration: np.ndarray, file: str | None) -> np.ndarray:
     if acceleration.ndim != 2:
         raise ModelError(f"must have shape (n_samples, n_channels), got {acceleration.shape}",
@@ -119,6 +136,9 @@ class Record:
         The file it was read from (for messages).
     dropped : tuple of (channel name, reason)
         Channels removed when the record was read (dead or clipped).
+    temperature : float or None
+        °C during the record (of the cable or the air, as the monitoring
+        system gives it), for the temperature normalisation of ``track``.
     """
 
     acceleration: np.ndarray
@@ -128,6 +148,7 @@ class Record:
     start_time: str | None = None
     source: str | None = None
     dropped: tuple[tuple[str, str], ...] = field(default_factory=tuple)
+    temperature: float | None = None
 
     def __post_init__(self):
         file = self.source
@@ -138,6 +159,8 @@ class Record:
         object.__setattr__(self, "channel_names", tuple(names))
         object.__setattr__(self, "channel_positions", check_position_values(
             np.asarray(self.channel_positions, dtype=float).reshape(-1), names, file))
+        if self.temperature is not None:
+            object.__setattr__(self, "temperature", check_temperature(self.temperature, file))
 
     @property
     def n_samples(self) -> int:

@@ -102,7 +102,7 @@ def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: flo
 
 def validated_record(
     acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
-    *, unit: str, start_time: str | None, source: str | None,
+    *, unit: str, start_time: str | None, source: str | None, temperature: float | None = None,
 ) -> Record:
     """Check the parts of a record, convert to m/s², drop dead and clipped channels."""
     file = source
@@ -124,7 +124,7 @@ def validated_record(
     return Record(
         acceleration=acceleration, sampling_rate=sampling_rate,
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
-        start_time=start_time, source=source, dropped=tuple(dropped),
+        start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature,
     )
 
 

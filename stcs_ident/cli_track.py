@@ -1,0 +1,123 @@
+"""The command line of archives: ``stcs-ident track`` and ``stcs-ident simulate --archive``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .errors import InputError
+
+TRACK_EXAMPLE = "stcs-ident track monitoring/ --out histories/ --workers 2"
+ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archive 3 --cables 3 "
+                   "--tension-change C2,2026-03-02T12:00:00+00:00,-0.015")
+
+
+def add_track_parser(sub, epilog: str) -> None:
+    trk = sub.add_parser("track", epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter,
+                         help="an archive of field records into tension histories, with lasting changes",
+                         description="Processes the records of ARCHIVE/<cable>/records/ not processed before "
+                                     "(known by content): modes, tension with 1σ, temperature normalisation, "
+                                     "lasting changes. Writes OUT/records.parquet, OUT/report.md, "
+                                     "OUT/<cable>.png, OUT/events.csv and OUT/cables.csv.")
+    trk.add_argument("archive", help="archive directory: one folder per cable with campaign.toml and records/")
+    trk.add_argument("--cable", action="append", metavar="NAME", help="only this cable (repeatable)")
+    trk.add_argument("--out", metavar="DIR", help="output directory, also the state of reruns "
+                                                  "(default ARCHIVE.track beside the archive)")
+    trk.add_argument("--json", metavar="FILE", help="write the JSON summary ('-' for standard output)")
+    trk.add_argument("--workers", type=_workers, default=1, metavar="N", help="local processes (default 1)")
+    trk.add_argument("--scheduler", metavar="ADDRESS",
+                     help="a Dask distributed scheduler (tcp://host:8786) to run the records on instead")
+    trk.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if not 1 <= n <= 1024:
+        raise argparse.ArgumentTypeError(f"must be 1 … 1024, got {n}")
+    return n
+
+
+def run_track(args, write) -> int:
+    """``stcs-ident track``: ``write(path, text)`` writes the JSON whole."""
+    import os
+
+    from .files import check_outputs
+    from .report import to_json
+    from .track.api import default_out, track
+    from .track.archive import discover, record_paths
+
+    out = args.out if args.out is not None else str(default_out(args.archive))
+    specs = discover(args.archive, args.cable)  # refuses a bad archive before any work
+    inputs = [os.path.join(s.directory, "campaign.toml") for s in specs]
+    inputs += [str(p) for s in specs for p in record_paths(s)]
+    check_outputs([("--out", out, True), ("--json", args.json, False)], inputs)
+    summary = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
+                    progress=sys.stderr.isatty())
+    if args.json:
+        write(args.json, to_json(summary))
+    if args.json != "-":
+        for name, cable in summary["cables"].items():
+            events = "; ".join(f"{100 * e['change']:+.2f} ± {100 * e['uncertainty']:.2f} % from {e['start_time']}"
+                               for e in cable["events"]) or "no lasting change"
+            print(f"{name}: {cable['processed']} of {cable['records']} records with a tension, "
+                  f"{cable['failed']} failed; {events}")
+        print(f"wrote {out}")
+    return 0
+
+
+def add_archive_options(sim) -> None:
+    arc = sim.add_argument_group("archive (days of monitoring records instead of one record per test)")
+    arc.add_argument("--archive", type=float, metavar="DAYS",
+                     help="write OUT as an archive for `track`: DAYS of ambient records per cable (the campaign's "
+                          "cable and first test), with daily temperature cycles and record-to-record scatter")
+    arc.add_argument("--cables", type=int, default=1, metavar="N", help="cables C1 … CN, all of the campaign (1)")
+    arc.add_argument("--interval", type=float, default=600.0, metavar="S", help="seconds between records (600)")
+    arc.add_argument("--tension-change", metavar="CABLE,TIME,REL",
+                     help="a lasting relative tension change of one cable from an ISO 8601 time on")
+
+
+def simulate_archive_from_args(args, campaign) -> int:
+    from .simulate.archive import ArchiveOptions, TensionChange, simulate_archive
+
+    if not 1 <= args.cables <= 1000:
+        raise InputError(f"must be 1 … 1000, got {args.cables}", field="--cables")
+    names = [f"C{k}" for k in range(1, args.cables + 1)]
+    change = None
+    if args.tension_change:
+        parts = args.tension_change.split(",")
+        if len(parts) != 3:
+            raise InputError(f"expected CABLE,TIME,REL, got {args.tension_change!r}", field="--tension-change")
+        try:
+            change = TensionChange(parts[0], parts[1], float(parts[2]))
+        except ValueError as err:
+            raise InputError(getattr(err, "message", str(err)), field="--tension-change") from None
+        if change.cable not in names:
+            raise InputError(f"no cable named {change.cable!r} (cables: {', '.join(names)})",
+                             field="--tension-change")
+    try:
+        options = ArchiveOptions(days=args.archive, interval=args.interval, duration=args.duration,
+                                 sampling_rate=args.sampling_rate, snr_db=args.snr, damping=args.damping,
+                                 rms_pressure=args.ambient or 20.0,
+                                 sensors=tuple(float(x) for x in args.sensors.split(",")))
+    except ValueError as err:
+        options_of = {"archive.days": "--archive", "archive.snr_db": "--snr", "archive.rms_pressure": "--ambient",
+                      "archive.interval": "--interval", "archive.duration": "--duration",
+                      "archive.sampling_rate": "--sampling-rate", "archive.damping": "--damping"}
+        raise InputError(getattr(err, "message", str(err)),
+                         field=options_of.get(getattr(err, "field", None), "--archive")) from None
+    if options.n_records * args.cables > 10**6:
+        raise InputError(f"gives {options.n_records * args.cables} records; at most 1,000,000", field="--archive")
+    out = simulate_archive(dict.fromkeys(names, campaign), args.out, options=options, change=change, seed=args.seed,
+                           progress=_every(500))
+    print(f"wrote {out}")
+    return 0
+
+
+def _every(n: int):
+    def progress(done, total):
+        if done % n == 0 or done == total:
+            print(f"simulate: record {done} of {total}", file=sys.stderr, flush=True)
+    return progress

@@ -1,0 +1,186 @@
+"""An archive of monitoring records, simulated: days of ambient records per cable, the way ``track`` hides events.
+
+Each cable of the archive is a campaign (its cable and the setup of its first
+test, whose tension is the reference). Every ``interval`` seconds a record is
+simulated at the cable's tension at that time:
+
+    H(t) = H_ref · (1 + c_θ (θ(t) − θ_ref)) · (1 + ε) · (1 + Δ · [t ≥ t_Δ])
+
+- θ(t), the temperature, follows a daily cycle (minimum at 05:00, maximum at
+  17:00) plus a slow random walk (weather), and is written in the record;
+- c_θ, the relative change of tension per °C (the cable's thermal strain
+  against its anchorages: a few 1e-4 to 1e-3 per °C);
+- ε, a record-to-record scatter (traffic and wind on the deck: the mean
+  tension during ten minutes is not the same twice), Gaussian;
+- Δ, an optional lasting change from t_Δ on one cable (a broken wire, a
+  slipped anchorage).
+
+The excitation is ambient (wind): a random pressure along the cable with
+sensor noise. ``truth.json`` beside the cables holds each record's true
+tension and temperature, and the change.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
+from pathlib import Path
+
+import numpy as np
+
+from ..campaign_toml import campaign_to_toml
+from ..errors import ModelError
+from ..files import whole_directory, write_atomic
+from ..model import Campaign, real_number
+from ..spectra.io_hdf5 import write_record
+from .simulate import Ambient, simulate_record
+
+__all__ = ["ArchiveOptions", "TensionChange", "simulate_archive"]
+
+
+@dataclass(frozen=True)
+class TensionChange:
+    """A lasting relative change of one cable's tension from a time on (``change`` = after / before − 1)."""
+
+    cable: str
+    time: str
+    change: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "change", real_number(self.change, "tension_change.change"))
+        if not -0.5 < self.change < 0.5:
+            raise ModelError(f"must lie between -0.5 and 0.5, got {self.change!r}", field="tension_change.change")
+        object.__setattr__(self, "time", _utc(self.time, "tension_change.time").isoformat())
+
+
+@dataclass(frozen=True)
+class ArchiveOptions:
+    """How the records of a simulated archive are made (see the module docstring)."""
+
+    days: float = 3.0
+    interval: float = 600.0  # s between record starts
+    duration: float = 60.0  # s per record
+    sampling_rate: float = 100.0
+    start: str = "2026-03-01T00:00:00+00:00"
+    sensors: tuple[float, ...] = (0.23, 0.5, 0.71)  # fractions of the length
+    temperature_mean: float = 12.0  # °C
+    temperature_amplitude: float = 6.0  # °C, half the daily swing
+    thermal_coefficient: float = -5e-4  # relative tension change per °C
+    scatter: float = 1e-3  # relative record-to-record scatter of the tension
+    rms_pressure: float = 20.0  # N/m, the wind
+    snr_db: float = 30.0
+    damping: float = 0.005
+
+    def __post_init__(self):
+        for name in ("days", "interval", "duration", "sampling_rate", "rms_pressure"):
+            object.__setattr__(self, name, real_number(getattr(self, name), f"archive.{name}", positive=True))
+        for name in ("temperature_mean", "temperature_amplitude", "thermal_coefficient", "scatter", "snr_db"):
+            object.__setattr__(self, name, real_number(getattr(self, name), f"archive.{name}"))
+        if self.duration > self.interval:
+            raise ModelError("a record cannot last longer than the interval between records", field="archive.duration")
+        object.__setattr__(self, "start", _utc(self.start, "archive.start").isoformat())
+
+    @property
+    def n_records(self) -> int:
+        return int(self.days * 86400.0 // self.interval)
+
+
+def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, *,
+                     options: ArchiveOptions | None = None, change: TensionChange | None = None,
+                     seed: int = 0, progress: Callable[[int, int], None] | None = None) -> Path:
+    """Write an archive ``out/<cable>/{campaign.toml, records/<day>/<cable>_<time>.h5}`` and ``out/truth.json``.
+
+    Parameters
+    ----------
+    campaigns : mapping of cable name to Campaign
+        Each needs a test: its setup and tension are the cable's (the reference).
+    options : ArchiveOptions
+    change : TensionChange or None
+        A lasting change of one cable's tension.
+    seed : int
+        The same seed gives the same archive.
+    progress : callable(done, total), optional
+
+    Returns
+    -------
+    Path of the archive, written whole or not at all.
+    """
+    if change is not None and change.cable not in campaigns:
+        raise ModelError(f"no cable named {change.cable!r} (cables: {', '.join(campaigns)})",
+                         field="tension_change.cable")
+    for name, campaign in campaigns.items():
+        if not campaign.tests:
+            raise ModelError("needs a test: its setup and tension are the cable's reference", field=f"cable[{name}]")
+    options = ArchiveOptions() if options is None else options
+    out = Path(out)
+    start = datetime.fromisoformat(options.start)
+    times = [start + timedelta(seconds=k * options.interval) for k in range(options.n_records)]
+    total, done = len(campaigns) * len(times), 0
+    truth: dict = {"options": _asdict(options), "change": None if change is None else _asdict(change), "cables": {}}
+    with whole_directory(out) as tmp:
+        for index, (name, campaign) in enumerate(campaigns.items()):
+            rng = np.random.default_rng([seed, index])
+            temperature = _temperatures(times, options, rng)
+            test = campaign.tests[0]
+            reference = float(test.tension)
+            cable_dir = tmp / name
+            (cable_dir / "records").mkdir(parents=True)
+            write_atomic(cable_dir / "campaign.toml", campaign_to_toml(campaign, header=f"cable {name} of a "
+                                                                                          "simulated archive"))
+            attachments = campaign.setup(test.setup).attachments
+            positions = [f * campaign.cable.length for f in options.sensors]
+            rows = []
+            for k, (time, theta) in enumerate(zip(times, temperature)):
+                tension = reference * (1 + options.thermal_coefficient * (theta - options.temperature_mean))
+                tension *= 1 + options.scatter * rng.standard_normal()
+                if change is not None and change.cable == name and time >= datetime.fromisoformat(change.time):
+                    tension *= 1 + change.change
+                record = simulate_record(campaign.cable, attachments, tension, positions,
+                                         duration=options.duration, sampling_rate=options.sampling_rate,
+                                         damping=options.damping, ambient=Ambient(options.rms_pressure),
+                                         snr_db=options.snr_db, seed=[seed, index, k])
+                record = _with(record, start_time=time.isoformat(), temperature=round(float(theta), 3))
+                day = cable_dir / "records" / time.strftime("%Y-%m-%d")
+                day.mkdir(exist_ok=True)
+                relative = f"records/{day.name}/{name}_{time.strftime('%Y%m%dT%H%M%S')}.h5"
+                write_record(record, cable_dir / relative)
+                rows.append({"record": relative, "start_time": time.isoformat(), "tension": tension,
+                             "temperature": float(theta)})
+                done += 1
+                if progress is not None:
+                    progress(done, total)
+            truth["cables"][name] = {"reference_tension": reference, "records": rows}
+        write_atomic(tmp / "truth.json", json.dumps(truth, indent=1) + "\n")
+    return out
+
+
+def _temperatures(times: Sequence[datetime], options: ArchiveOptions, rng: np.random.Generator) -> np.ndarray:
+    """Daily cycle (minimum at 05:00, maximum at 17:00 UTC) plus a slow random walk of the weather."""
+    hours = np.array([t.hour + t.minute / 60 + t.second / 3600 for t in times])
+    cycle = -np.cos(2 * np.pi * (hours - 5.0) / 24.0)
+    steps = rng.standard_normal(len(times)) * 0.05 * np.sqrt(options.interval / 600.0)
+    weather = np.cumsum(steps)
+    return options.temperature_mean + options.temperature_amplitude * cycle + weather - weather.mean()
+
+
+def _with(record, **changes):
+    from dataclasses import replace
+
+    return replace(record, **changes)
+
+
+def _asdict(obj) -> dict:
+    from dataclasses import asdict
+
+    return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(obj).items()}
+
+
+def _utc(text, field: str) -> datetime:
+    try:
+        time = datetime.fromisoformat(str(text))
+    except ValueError:
+        raise ModelError(f"is not an ISO 8601 time: {text!r}", field=field) from None
+    return time.replace(tzinfo=UTC) if time.tzinfo is None else time

@@ -1,0 +1,72 @@
+"""The archive of field records: its cables, their records, and a record's identity by content.
+
+    ARCHIVE/<cable>/campaign.toml      the cable and its setup; its first test (if any) gives the
+                                       reference tension that numbers the modes
+    ARCHIVE/<cable>/records/**/*.h5    the records (attrs start_time required, temperature optional)
+
+A record is known by the SHA-256 of its bytes, not by its name: a rerun
+skips what it processed before even when records were moved or renamed,
+and a record rewritten under the same name is processed again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..campaign_io import load_campaign
+from ..errors import InputError
+from ..model import Campaign
+
+__all__ = ["CableSpec", "content_id", "discover", "record_paths"]
+
+
+@dataclass(frozen=True)
+class CableSpec:
+    """One cable of an archive: its campaign, the setup its records are of, and the reference tension."""
+
+    name: str
+    directory: str
+    campaign: Campaign
+    setup: str
+    reference_tension: float
+
+
+def discover(archive: str | os.PathLike, cables: list[str] | None = None) -> list[CableSpec]:
+    """The cables of ``archive`` (folders holding a campaign.toml), all or those named in ``cables``."""
+    root = Path(archive)
+    if not root.is_dir():
+        raise InputError("is not a directory (an archive holds one folder per cable)", file=str(root))
+    found = sorted(p.parent.name for p in root.glob("*/campaign.toml"))
+    if not found:
+        raise InputError("holds no cable: expected <cable>/campaign.toml folders", file=str(root))
+    for name in cables or []:
+        if name not in found:
+            raise InputError(f"no cable named {name!r} (known: {', '.join(found)})", field="--cable", file=str(root))
+    return [_cable(root / name) for name in (cables or found)]
+
+
+def _cable(directory: Path) -> CableSpec:
+    campaign = load_campaign(directory)
+    file = str(directory / "campaign.toml")
+    if not campaign.tests:
+        raise InputError("needs a test: its tension is the reference that numbers the modes of the records, and "
+                         "its setup what is attached", field="test", file=file)
+    test = campaign.tests[0]
+    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension))
+
+
+def record_paths(spec: CableSpec) -> list[Path]:
+    """The cable's records (``records/**/*.h5``), in path order."""
+    return sorted((Path(spec.directory) / "records").rglob("*.h5"))
+
+
+def content_id(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
+    """SHA-256 of the file's bytes (hex, 32 characters), read in chunks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        while block := stream.read(chunk):
+            digest.update(block)
+    return digest.hexdigest()[:32]

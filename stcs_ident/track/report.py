@@ -1,0 +1,103 @@
+"""The ``track`` report: per cable the tension history and its modes, a summary of the cables, the events.
+
+    OUT/records.parquet          one row per record (written by the run)
+    OUT/report.md                the summary table, the events, the failed records
+    OUT/events.csv               one row per lasting change
+    OUT/cables.csv               one row per cable
+    OUT/<cable>.png              tension (as identified and normalised for temperature, 1σ band,
+                                 events marked), temperature, and the frequency of each mode
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..files import write_atomic, write_csv, write_figure
+
+__all__ = ["write_report"]
+
+
+def write_report(out: Path, specs, table: pd.DataFrame, histories, summary: dict) -> None:
+    cables = pd.DataFrame([
+        {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
+         "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
+         "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"], "events": len(c["events"])}
+        for name, c in summary["cables"].items()])
+    events = pd.DataFrame([{"cable": name, **e} for name, c in summary["cables"].items() for e in c["events"]],
+                          columns=["cable", "start_time", "change", "uncertainty", "alarm_time"])
+    write_csv(cables, out / "cables.csv", index=False)
+    write_csv(events, out / "events.csv", index=False)
+    for spec in specs:
+        rows, history = histories[spec.name]
+        write_figure(_figure(spec, table, rows, history), out / f"{spec.name}.png")
+    write_atomic(out / "report.md", _markdown(summary, cables, events))
+
+
+def _figure(spec, table: pd.DataFrame, rows, history):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 7.5), layout="constrained")
+    top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.2, 2))
+    data = table.loc[rows]
+    t = data["start_time"].dt.tz_convert(None) if len(data) else data["start_time"]
+    kN = 1e-3
+    tension, sigma = data["tension"].to_numpy() * kN, data["tension_sigma"].to_numpy() * kN
+    top.fill_between(t, tension - sigma, tension + sigma, color="tab:blue", alpha=0.25, lw=0, label="1σ")
+    top.plot(t, tension, ".", ms=2.5, color="tab:blue", label="identified")
+    top.plot(t, history.normalised * kN, ".", ms=2.5, color="tab:orange",
+             label=f"normalised to {history.mean_temperature:.1f} °C" if np.isfinite(history.mean_temperature)
+             else "no temperature: not normalised")
+    top.plot(t, data["level"].to_numpy() * kN, "-", color="k", lw=1, label="level between changes")
+    for e in history.events:
+        top.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
+        top.annotate(f"{100 * e.change:+.2f} ± {100 * e.uncertainty:.2f} %", (t.iloc[e.index], 1.0),
+                     xycoords=("data", "axes fraction"), va="top", ha="left", color="tab:red", fontsize=8)
+    top.set_ylabel("tension (kN)")
+    top.set_title(f"{spec.name}: {len(data)} records with a tension; reference {spec.reference_tension * kN:.1f} kN, "
+                  f"EI {spec.campaign.cable.EI:.4g} N m² (held)")
+    top.legend(loc="lower left", fontsize=8, ncol=4)
+    if data["temperature"].notna().any():
+        middle.plot(t, data["temperature"], "-", color="tab:green", lw=0.8)
+    middle.set_ylabel("temperature (°C)")
+    modes = sorted({m for ms in data["modes"] for m in ms})
+    for mode in modes:
+        pairs = [(time, f[list(ms).index(mode)]) for time, ms, f in zip(t, data["modes"], data["frequencies"])
+                 if mode in list(ms)]
+        times, freq = zip(*pairs)
+        bottom.plot(times, np.asarray(freq) / mode, ".", ms=2, label=f"mode {mode}")
+    bottom.set_ylabel("frequency / mode number (Hz)")
+    bottom.set_xlabel("time (UTC)")
+    if modes:
+        bottom.legend(loc="upper left", fontsize=7, ncol=min(len(modes), 8))
+    return fig
+
+
+def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
+    lines = [f"# Tension histories of {summary['archive']}", "",
+             ("Tensions are fitted per record with EI held at the campaign's value, from the modes picked and "
+             "numbered against the nominal model at the reference tension. The normalised tension removes a "
+             "linear temperature effect fitted per cable; a lasting change is found by a two-sided CUSUM of the "
+             "normalised tension (see the documentation of `track`)."), "", "## Cables", "",
+             "| cable | records | with a tension | failed | reference (kN) | per °C | scatter | events |",
+             "|---|---|---|---|---|---|---|---|"]
+    for _, c in cables.iterrows():
+        thermal = "" if pd.isna(c["thermal_coefficient_per_C"]) else f"{100 * c['thermal_coefficient_per_C']:+.3f} %"
+        scatter = "" if pd.isna(c["scatter"]) else f"{100 * c['scatter']:.2f} %"
+        lines.append(f"| {c['cable']} | {c['records']} | {c['processed']} | {c['failed']} | "
+                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} |")
+    lines += ["", "## Lasting changes", ""]
+    if events.empty:
+        lines.append("None found.")
+    else:
+        lines += ["| cable | from | change | 1σ | alarm at |", "|---|---|---|---|---|"]
+        for _, e in events.iterrows():
+            lines.append(f"| {e['cable']} | {e['start_time']} | {100 * e['change']:+.2f} % | "
+                         f"{100 * e['uncertainty']:.2f} % | {e['alarm_time']} |")
+    failures = [(name, f) for name, c in summary["cables"].items() for f in c["failures"]]
+    lines += ["", "## Records without a tension", ""]
+    lines += [f"- {name}/{f['record']}: {f['reason']}" for name, f in failures] or ["None."]
+    lines += ["", "Figures: " + ", ".join(f"[{n}]({n}.png)" for n in summary["cables"]), ""]
+    return "\n".join(lines)

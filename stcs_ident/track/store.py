@@ -1,0 +1,69 @@
+"""The table of processed records: Parquet parts written whole, read back as one tidy DataFrame.
+
+Each finished batch of records becomes one part file, ``OUT/parts/<first
+record id>-<n>.parquet``, written whole or not at all (beside its target,
+then renamed): a run killed at any moment keeps every batch finished before,
+and the next run skips their records (known by content). ``records.parquet``
+is the union, rewritten whole at the end of each run, for the user to open
+(pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps the types (times, lists
+of modes and frequencies) and is read column by column.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from ..files import atomic_path
+from .process import COLUMNS
+
+__all__ = ["append_part", "read_table", "write_table"]
+
+PARTS = "parts"
+TABLE = "records.parquet"
+#: A row's columns: the record's (:data:`~stcs_ident.track.process.COLUMNS`), and its file's size and
+#: modification time (ns) when processed, which spare hashing it again on a rerun.
+ROW_COLUMNS = (*COLUMNS, "size", "mtime_ns")
+
+
+def _frame(rows: list[dict]) -> pd.DataFrame:
+    frame = pd.DataFrame(rows, columns=list(ROW_COLUMNS))
+    frame["start_time"] = pd.to_datetime(frame["start_time"], utc=True, errors="coerce", format="ISO8601")
+    for name in ("temperature", "tension", "tension_sigma"):
+        frame[name] = frame[name].astype(float)
+    for name in ("n_modes", "size", "mtime_ns"):
+        frame[name] = frame[name].astype("int64")
+    return frame
+
+
+def append_part(out: str | os.PathLike, rows: list[dict]) -> Path:
+    """Write ``rows`` as one new part, whole or not at all."""
+    directory = Path(out) / PARTS
+    directory.mkdir(parents=True, exist_ok=True)
+    target = directory / f"{rows[0]['record_id']}-{len(rows)}.parquet"
+    with atomic_path(target, suffix=".parquet") as tmp:
+        _frame(rows).to_parquet(tmp, index=False)
+    return target
+
+
+def read_table(out: str | os.PathLike) -> pd.DataFrame:
+    """Every part's rows, one per record (the latest row of a record processed twice), sorted by cable and time."""
+    parts = sorted((Path(out) / PARTS).glob("*.parquet"))
+    if not parts:
+        return _frame([])
+    frame = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+    frame = frame.drop_duplicates(["cable", "record_id"], keep="last")
+    return frame.sort_values(["cable", "start_time", "record"], kind="stable").reset_index(drop=True)
+
+
+def write_table(out: str | os.PathLike, frame: pd.DataFrame) -> Path:
+    """``records.parquet``, whole or not at all."""
+    target = Path(out) / TABLE
+    buffer = io.BytesIO()
+    frame.to_parquet(buffer, index=False)
+    with atomic_path(target, suffix=".parquet") as tmp:
+        tmp.write_bytes(buffer.getvalue())
+    return target
