@@ -177,7 +177,8 @@ def _run_dask(batches, scheduler: str, out: Path, bar) -> None:
     with client:
         queue = iter(batches)
         n = max(2, 2 * sum(client.nthreads().values()))
-        futures = as_completed([client.submit(process_batch, *job, pure=False) for job in _take(queue, n)])
+        futures = as_completed([client.submit(process_batch, *job, pure=False) for job in _take(queue, n)],
+                               loop=client.loop)
         for future in futures:
             rows = future.result()
             append_part(out, rows)

@@ -51,7 +51,7 @@ def append_part(out: str | os.PathLike, rows: list[dict]) -> Path:
 
 def read_table(out: str | os.PathLike) -> pd.DataFrame:
     """Every part's rows, one per record (the latest row of a record processed twice), sorted by cable and time."""
-    parts = sorted((Path(out) / PARTS).glob("*.parquet"))
+    parts = sorted(p for p in (Path(out) / PARTS).glob("*.parquet") if not p.name.startswith("."))  # not a temporary
     if not parts:
         return _frame([])
     frame = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)

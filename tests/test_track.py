@@ -1,0 +1,189 @@
+"""track: an archive of simulated monitoring records into tension histories, with a hidden lasting change.
+
+The archive: three hangers (8 m, 400 kN) × three days of 60-s ambient records
+every hour, daily temperature cycles (±6 °C, −0.05 %/°C), 0.1 %
+record-to-record scatter, and a 1.5 % tension loss on C2 from 2026-03-02
+12:00. Records are made by the simulator, analysed blind by spectra and
+identify, the history by the CUSUM of track.events.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from fuzz_inputs import BASE_TOML, _frequencies
+
+from stcs_ident.campaign_io import load_campaign
+from stcs_ident.cli import main
+from stcs_ident.simulate.archive import ArchiveOptions, TensionChange, simulate_archive
+from stcs_ident.track.api import track
+from stcs_ident.track.events import analyse_history
+
+CHANGE = TensionChange("C2", "2026-03-02T12:00:00+00:00", -0.015)
+
+
+def _campaign(directory: Path):
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / "campaign.toml").write_text(BASE_TOML.replace('record = "records/T2.h5"\n', "")
+                                             .format(f=_frequencies()), encoding="utf-8")
+    return load_campaign(directory)
+
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory):
+    root = tmp_path_factory.mktemp("track")
+    campaign = _campaign(root / "campaign")
+    simulate_archive({name: campaign for name in ("C1", "C2", "C3")}, root / "archive",
+                     options=ArchiveOptions(days=3, interval=3600), change=CHANGE, seed=3)
+    return root / "archive"
+
+
+@pytest.fixture(scope="module")
+def tracked(archive):
+    out = archive.parent / "out"
+    return track(archive, out, workers=2), out
+
+
+@pytest.mark.slow
+def test_the_hidden_tension_loss_is_found_on_its_cable_only(archive, tracked):
+    summary, out = tracked
+    truth = json.loads((archive / "truth.json").read_text())
+    for name, cable in summary["cables"].items():
+        assert cable["records"] == 72 and cable["processed"] == 72 and cable["failed"] == 0
+        assert len(cable["events"]) == (name == "C2"), (name, cable["events"])
+    event = summary["cables"]["C2"]["events"][0]
+    times = [r["start_time"] for r in truth["cables"]["C2"]["records"]]
+    found, true = times.index(event["start_time"]), times.index(CHANGE.time)
+    assert abs(found - true) <= 3  # the acceptance: within 3 records of its start
+    assert abs(event["change"] - CHANGE.change) <= 0.003  # the acceptance: 0.3 % absolute
+    assert abs(event["change"] - CHANGE.change) <= 3 * event["uncertainty"]  # and within its 3σ
+    # The temperature normalisation recovers the simulated coefficient (−5e-4 per °C; 1σ about 5e-5 here).
+    for cable in summary["cables"].values():
+        assert abs(cable["thermal_coefficient"] - ArchiveOptions().thermal_coefficient) < 2e-4
+    # Each record's tension against the truth: its 1σ covers the identification's error, not the scatter.
+    table = pd.read_parquet(out / "records.parquet")
+    true_tension = {(n, r["record"]): r["tension"] for n, c in truth["cables"].items() for r in c["records"]}
+    z = np.array([(row.tension - true_tension[(row.cable, row.record)]) / row.tension_sigma
+                  for row in table.itertuples()])
+    assert 0.55 <= np.mean(np.abs(z) <= 1) <= 0.85 and np.mean(np.abs(z) <= 3) >= 0.97, np.percentile(np.abs(z), 68)
+
+
+@pytest.mark.slow
+def test_a_dask_local_cluster_gives_the_same_rows(archive, tracked, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    _, out = tracked
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        track(archive, tmp_path / "dask", cables=["C1"], scheduler=cluster.scheduler_address, report=False)
+    local = pd.read_parquet(out / "records.parquet")
+    dask = pd.read_parquet(tmp_path / "dask" / "records.parquet")
+    columns = ["cable", "record", "record_id", "start_time", "status", "modes", "frequencies", "tension",
+               "tension_sigma", "temperature"]
+    pd.testing.assert_frame_equal(local[local["cable"] == "C1"][columns].reset_index(drop=True),
+                                  dask[columns].reset_index(drop=True))
+
+
+@pytest.fixture
+def small(tmp_path):
+    campaign = _campaign(tmp_path / "campaign")
+    simulate_archive({"C1": campaign}, tmp_path / "archive", options=ArchiveOptions(days=0.5, interval=1800), seed=5)
+    return tmp_path / "archive"
+
+
+@pytest.mark.slow
+def test_a_run_killed_midway_and_restarted_ends_with_the_same_table(small, tmp_path):
+    whole = tmp_path / "whole"
+    track(small, whole, report=False, batch=2)
+    out = tmp_path / "killed"
+    command = [sys.executable, "-c", ("import sys; from stcs_ident.track.api import track; "
+               f"track({str(small)!r}, {str(out)!r}, batch=2, report=False)")]
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    while child.poll() is None and len(list((out / "parts").glob("*.parquet"))) < 3:
+        time.sleep(0.01)
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    finished = len(list((out / "parts").glob("*.parquet")))
+    assert 0 < finished < 12  # killed midway: some batches done, not all
+    track(small, out, report=False, batch=2)
+    a, b = pd.read_parquet(whole / "records.parquet"), pd.read_parquet(out / "records.parquet")
+    pd.testing.assert_frame_equal(a.drop(columns=["mtime_ns"]), b.drop(columns=["mtime_ns"]))
+    assert not [p for p in out.rglob("*") if ".stcs~" in p.name]  # the killed run's temporaries are gone
+
+
+def test_a_rerun_processes_only_new_records_known_by_content(small, tmp_path):
+    out = tmp_path / "out"
+    calls = []
+    track(small, out, report=False, progress=lambda done, total: calls.append(total))
+    assert calls[-1] == 24
+    records = small / "C1" / "records"
+    day = next(records.iterdir())
+    first = min(day.glob("*.h5"))
+    shutil.copy(first, records / "renamed-copy.h5")  # the same content under another name: not new
+    calls.clear()
+    summary = track(small, out, report=False, progress=lambda done, total: calls.append(total))
+    assert calls == [] and summary["cables"]["C1"]["records"] == 24
+    (records / "renamed-copy.h5").unlink()
+
+
+def test_unreadable_records_are_rows_with_their_reason_and_the_rest_go_on(small, tmp_path):
+    import h5py
+
+    records = small / "C1" / "records" / "bad"
+    records.mkdir()
+    good = min((small / "C1" / "records").rglob("*.h5"))
+    (records / "truncated.h5").write_bytes(good.read_bytes()[:5000])
+    (records / "text.h5").write_text("time,a\n0,1\n")
+    shutil.copy(good, records / "nan.h5")
+    shutil.copy(good, records / "no-time.h5")
+    with h5py.File(records / "nan.h5", "r+") as h5:
+        h5["acceleration"][10, 1] = np.nan
+        h5.attrs["temperature"] = 3.0  # another content than the good record's
+    with h5py.File(records / "no-time.h5", "r+") as h5:
+        del h5.attrs["start_time"]
+    summary = track(small, tmp_path / "out", report=False)
+    cable = summary["cables"]["C1"]
+    assert cable["records"] == 28 and cable["processed"] == 24 and cable["failed"] == 4
+    reasons = {f["record"]: f["reason"] for f in cable["failures"]}
+    assert "not an HDF5 file" in reasons["records/bad/text.h5"]
+    assert "cannot read" in reasons["records/bad/truncated.h5"]
+    assert "NaN at sample 10" in reasons["records/bad/nan.h5"]
+    assert "start_time" in reasons["records/bad/no-time.h5"]
+
+
+def test_the_cli_tracks_an_archive_it_simulated(tmp_path, capsys):
+    campaign = tmp_path / "campaign"
+    _campaign(campaign)
+    arch = tmp_path / "arch"
+    assert main(["simulate", str(campaign), "--out", str(arch), "--archive", "0.25", "--cables", "2",
+                 "--interval", "1800"]) == 0
+    assert main(["track", str(arch), "--out", str(tmp_path / "h"), "--json", str(tmp_path / "s.json")]) == 0
+    summary = json.loads((tmp_path / "s.json").read_text())
+    assert set(summary["cables"]) == {"C1", "C2"} and summary["cables"]["C1"]["processed"] == 12
+    assert {p.name for p in (tmp_path / "h").iterdir()} >= {"records.parquet", "report.md", "C1.png", "C2.png",
+                                                             "events.csv", "cables.csv"}
+    capsys.readouterr()
+    assert main(["track", str(arch), "--out", str(arch / "C1")]) == 2  # an output over the inputs
+    assert "option '--out'" in capsys.readouterr().err
+
+
+def test_healthy_histories_raise_at_most_one_false_event_per_cable_month():
+    """Thirty cable-months of 10-minute tensions (daily cycles of ±6 °C at −0.05 %/°C, a weather drift the
+    tension does not follow, 0.2 % scatter): the issue's bound is 1 false event per cable-month."""
+    rng = np.random.default_rng(7)
+    events = 0
+    for _ in range(30):
+        n = 4320
+        hours = np.arange(n) / 6.0
+        weather = np.cumsum(rng.standard_normal(n)) * 0.05
+        theta = 12 - 6 * np.cos(2 * np.pi * (hours - 5) / 24) + weather
+        tension = 4e5 * (1 - 5e-4 * (theta - weather - 12)) * (1 + 0.002 * rng.standard_normal(n))
+        events += len(analyse_history(tension, theta, 4e5).events)
+    assert events <= 30, events  # measured: 0 (benchmarks/track.py gives the rate over more months)
