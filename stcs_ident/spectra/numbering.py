@@ -86,14 +86,19 @@ def assign(frequencies, sigma, families):
     best[:, 0, :] = 0.0
     choice = np.zeros((F, n + 1, K + 1), dtype=np.int8)  # 0 skip mode, 1 match, 2 peak unassigned
     for j in range(1, n + 1):
-        best[:, j, 0] = best[:, j - 1, 0] + UNASSIGNED_COST
-        choice[:, j, 0] = 2
-        for k in range(1, K + 1):
-            options = np.stack([best[:, j, k - 1], best[:, j - 1, k - 1] + resid[:, j - 1, k - 1],
-                                best[:, j - 1, k] + UNASSIGNED_COST])
-            c = np.argmin(options, axis=0)
-            best[:, j, k] = np.take_along_axis(options, c[None], axis=0)[0]
-            choice[:, j, k] = c
+        # Row j at once: the match or unassigned option per mode k (ties to the match), then the skip option
+        # (best[j, k-1], ties to it) is a running minimum along k, as the recurrence taken mode by mode.
+        match = best[:, j - 1, :-1] + resid[:, j - 1, :]
+        unassigned = best[:, j - 1, :] + UNASSIGNED_COST
+        options = unassigned.copy()
+        options[:, 1:] = np.minimum(match, unassigned[:, 1:])
+        row_choice = np.full((F, K + 1), 2, dtype=np.int8)
+        row_choice[:, 1:] = np.where(match <= unassigned[:, 1:], 1, 2)
+        running = np.minimum.accumulate(options, axis=1)
+        skip = np.zeros((F, K + 1), dtype=bool)
+        skip[:, 1:] = running[:, :-1] <= options[:, 1:]
+        best[:, j, :] = running
+        choice[:, j, :] = np.where(skip, 0, row_choice)
     modes = np.zeros((F, n), dtype=int)
     for fam in range(F):
         j, k = n, K

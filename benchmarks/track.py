@@ -1,0 +1,113 @@
+"""`track` end to end on a simulated monitoring archive: records per second per core, scaling, memory.
+
+The archive: a hanger-like cable (8 m, 400 kN, a clamp) and a stay-like one
+(120 m, 30°, 4 MN, sag, a 50 kg damper mass 3 m from the anchorage), each
+with 3 accelerometers recording 10 minutes at 100 Hz every 10 minutes
+(daily temperature cycles, record-to-record scatter; ``stcs-ident simulate
+--archive``'s model). Two archives are made: the large one (``--records``,
+default 2000) is tracked with 2 workers; a smaller one (``--scaling``,
+default 400) with 1 and then 2 workers, which gives the scaling ratio and,
+against the large one, whether memory stays flat with the archive's size.
+Each run is a child process (the installed package's ``track``); its peak
+resident memory is that of its largest process (wait4).
+
+Targets (issue): ≥ 2 records/s/core, ≥ 1.8× from 1 to 2 workers, memory flat.
+
+Run from the repository root::
+
+    python benchmarks/track.py                   # about 15 minutes on two cores
+    python benchmarks/track.py --records 400 --scaling 100   # quicker
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from common import print_header
+
+
+def campaigns(root: Path) -> dict:
+    from fuzz_inputs import BASE_TOML, _frequencies
+
+    from stcs_ident.campaign_io import load_campaign
+    from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+
+    (root / "hanger").mkdir(parents=True)
+    (root / "hanger" / "campaign.toml").write_text(BASE_TOML.replace('record = "records/T2.h5"\n', "")
+                                                   .format(f=_frequencies()), encoding="utf-8")
+    stay = Campaign("stay", Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9,
+                                  inclination=math.radians(30.0)),
+                    setups=(Setup("S", (Attachment("D", 3.0, 50.0),)),), tests=(Test("T", "S", 4.0e6),))
+    return {"hanger": load_campaign(root / "hanger"), "stay": stay}
+
+
+def make_archive(path: Path, n_records: int, cables: dict) -> float:
+    from stcs_ident.simulate.archive import ArchiveOptions, simulate_archive
+
+    per_cable = n_records // len(cables)
+    options = ArchiveOptions(days=per_cable * 600.0 / 86400.0, interval=600.0, duration=600.0, sampling_rate=100.0)
+    started = time.perf_counter()
+    simulate_archive(cables, path, options=options, seed=1)
+    return time.perf_counter() - started
+
+
+def run_track(archive: Path, out: Path, workers: int) -> tuple[float, float, int]:
+    """Wall time, peak resident memory (MB, its largest process), exit status of a `track` child process."""
+    command = [sys.executable, "-c", "import sys; from stcs_ident.cli import main; sys.exit(main(sys.argv[1:]))",
+               "track", str(archive), "--out", str(out), "--workers", str(workers)]
+    with tempfile.TemporaryFile("w+") as err:
+        started = time.perf_counter()
+        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(child.pid, 0)
+        return time.perf_counter() - started, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--records", type=int, default=2000)
+    parser.add_argument("--scaling", type=int, default=400, help="records of the archive timed with 1 and 2 workers")
+    args = parser.parse_args(argv)
+    print_header()
+    print(f"cores: {os.cpu_count()}, load average before: {os.getloadavg()[0]:.2f}", flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        cables = campaigns(root / "campaigns")
+        for name, n in (("small", args.scaling), ("large", args.records)):
+            seconds = make_archive(root / name, n, cables)
+            print(f"archive {name}: {n} records (2 cables, 3 channels, 600 s at 100 Hz) simulated in {seconds:.0f} s",
+                  flush=True)
+        one, mem_one, code_one = run_track(root / "small", root / "out1", 1)
+        two, mem_two, code_two = run_track(root / "small", root / "out2", 2)
+        large, mem_large, code_large = run_track(root / "large", root / "out3", 2)
+        import pandas as pd
+
+        table = pd.read_parquet(root / "out3" / "records.parquet")
+        ok = int((table["status"] == "ok").sum())
+        per_cable = table.groupby("cable")["status"].apply(lambda s: (s == "ok").mean())
+    print(f"\n{'run':<34}{'records':>9}{'wall s':>9}{'rec/s':>8}{'rec/s/core':>12}{'peak MB':>9}{'exit':>6}")
+    for label, n, wall, workers, mem, code in (
+            ("small archive, 1 worker", args.scaling, one, 1, mem_one, code_one),
+            ("small archive, 2 workers", args.scaling, two, 2, mem_two, code_two),
+            ("large archive, 2 workers", args.records, large, 2, mem_large, code_large)):
+        print(f"{label:<34}{n:>9}{wall:>9.1f}{n / wall:>8.2f}{n / wall / workers:>12.2f}{mem:>9.0f}{code:>6}")
+    print(f"\nscaling 1 -> 2 workers: {one / two:.2f}x (target >= 1.8)")
+    print(f"records per second per core, large archive: {args.records / large / 2:.2f} (target >= 2)")
+    print(f"peak memory: {mem_two:.0f} MB on {args.scaling} records, {mem_large:.0f} MB on {args.records} "
+          f"({mem_large / mem_two:.2f}x for {args.records / args.scaling:.0f}x the records)")
+    print(f"large archive: {ok} of {len(table)} records with a tension "
+          f"({', '.join(f'{c} {100 * f:.1f} %' for c, f in per_cable.items())})")
+    return 0 if code_one == code_two == code_large == 0 else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
