@@ -17,6 +17,7 @@ Run from the repository root::
 
     python benchmarks/track.py                   # about 15 minutes on two cores
     python benchmarks/track.py --records 400 --scaling 100   # quicker
+    python benchmarks/track.py --false-alarms-only --months 300
 """
 
 from __future__ import annotations
@@ -72,12 +73,47 @@ def run_track(archive: Path, out: Path, workers: int) -> tuple[float, float, int
         return time.perf_counter() - started, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
 
 
+def false_alarms(months: int, seed: int = 11) -> list[tuple[str, int]]:
+    """Events found on healthy 30-day histories of 10-minute tensions, per condition (none is true)."""
+    import numpy as np
+
+    from stcs_ident.track.events import analyse_history
+
+    rng = np.random.default_rng(seed)
+    conditions = {
+        "daily cycle, 0.2 % scatter": {"lag": 0.0, "drift": 0.0, "scatter": 0.002},
+        "+ weather drift the tension does not follow": {"lag": 0.0, "drift": 0.05, "scatter": 0.002},
+        "+ cable lagging the air by 1 h": {"lag": 1.0, "drift": 0.05, "scatter": 0.002},
+        "0.5 % scatter": {"lag": 1.0, "drift": 0.05, "scatter": 0.005},
+    }
+    out = []
+    for label, c in conditions.items():
+        events = 0
+        for _ in range(months):
+            hours = np.arange(4320) / 6.0
+            weather = np.cumsum(rng.standard_normal(hours.size)) * c["drift"]
+            air = 12 - 6 * np.cos(2 * np.pi * (hours - 5) / 24) + weather
+            cable = 12 - 6 * np.cos(2 * np.pi * (hours - 5 - c["lag"]) / 24)
+            tension = 4e5 * (1 - 5e-4 * (cable - 12)) * (1 + c["scatter"] * rng.standard_normal(hours.size))
+            events += len(analyse_history(tension, air, 4e5).events)
+        out.append((label, events))
+    return out
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--records", type=int, default=2000)
     parser.add_argument("--scaling", type=int, default=400, help="records of the archive timed with 1 and 2 workers")
+    parser.add_argument("--months", type=int, default=100, help="healthy cable-months per condition (false alarms)")
+    parser.add_argument("--false-alarms-only", action="store_true")
     args = parser.parse_args(argv)
     print_header()
+    print(f"false events on healthy histories ({args.months} cable-months of 10-minute records per condition; "
+          "bound: 1 per cable-month):")
+    for label, events in false_alarms(args.months):
+        print(f"  {label:<48}{events:>5} events, {events / args.months:.3f} per cable-month")
+    if args.false_alarms_only:
+        return 0
     print(f"cores: {os.cpu_count()}, load average before: {os.getloadavg()[0]:.2f}", flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
