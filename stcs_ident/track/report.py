@@ -53,7 +53,7 @@ def _figure(spec, table: pd.DataFrame, rows, history):
     top.plot(t, data["level"].to_numpy() * kN, "-", color="k", lw=1, label="level between changes")
     for e in history.events:
         top.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
-        top.annotate(f"{100 * e.change:+.2f} ± {100 * e.uncertainty:.2f} %", (t.iloc[e.index], 1.0),
+        top.annotate(f" {100 * e.change:+.2f} ± {100 * e.uncertainty:.2f} %", (t.iloc[e.index], 0.97),
                      xycoords=("data", "axes fraction"), va="top", ha="left", color="tab:red", fontsize=8)
     top.set_ylabel("tension (kN)")
     top.set_title(f"{spec.name}: {len(data)} records with a tension; reference {spec.reference_tension * kN:.1f} kN, "
@@ -71,7 +71,7 @@ def _figure(spec, table: pd.DataFrame, rows, history):
     bottom.set_ylabel("frequency / mode number (Hz)")
     bottom.set_xlabel("time (UTC)")
     if modes:
-        bottom.legend(loc="upper left", fontsize=7, ncol=min(len(modes), 8))
+        bottom.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=7, ncol=1 + len(modes) // 12)
     return fig
 
 
