@@ -246,8 +246,7 @@ def _summary(archive, specs, table: pd.DataFrame, histories) -> dict:
             "records": len(mine), "processed": int((mine["status"] == "ok").sum()),
             "failed": int((mine["status"] != "ok").sum()),
             "reference_tension": spec.reference_tension, "EI": spec.campaign.cable.EI,
-            "thermal_coefficient": None if history.mean_temperature != history.mean_temperature
-            else history.thermal_coefficient,
+            "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
             "events": [{"start_time": pd.Timestamp(times[e.index]).isoformat(),
                         "change": e.change, "uncertainty": e.uncertainty,
