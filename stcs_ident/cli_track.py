@@ -55,7 +55,7 @@ def run_track(args, write) -> int:
     inputs += [str(p) for s in specs for p in record_paths(s)]
     check_outputs([("--out", out, True), ("--json", args.json, False)], inputs)
     summary = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
-                    progress=sys.stderr.isatty())
+                    progress=True if sys.stderr.isatty() else _lines())
     if args.json:
         write(args.json, to_json(summary))
     if args.json != "-":
@@ -114,6 +114,23 @@ def simulate_archive_from_args(args, campaign) -> int:
                            progress=_every(500))
     print(f"wrote {out}")
     return 0
+
+
+def _lines():
+    """Progress as a line on standard error every 5 % of the records, with the time left (not a terminal)."""
+    import time
+
+    started, shown = time.perf_counter(), [-1]
+
+    def progress(done, total):
+        step = int(20 * done / total)
+        if step > shown[0] or done == total:
+            shown[0] = step
+            elapsed = time.perf_counter() - started
+            left = elapsed / done * (total - done)
+            print(f"track: {done} of {total} records, {elapsed:.0f} s, about {left:.0f} s left", file=sys.stderr,
+                  flush=True)
+    return progress
 
 
 def _every(n: int):
