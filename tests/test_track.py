@@ -187,3 +187,23 @@ def test_healthy_histories_raise_at_most_one_false_event_per_cable_month():
         tension = 4e5 * (1 - 5e-4 * (theta - weather - 12)) * (1 + 0.002 * rng.standard_normal(n))
         events += len(analyse_history(tension, theta, 4e5).events)
     assert events <= 30, events  # measured: 0 (benchmarks/track.py gives the rate over more months)
+
+
+def test_the_size_of_a_change_comes_with_an_honest_one_sigma():
+    """300 histories of 432 10-minute tensions (daily cycles, 0.2 % scatter, the cable lagging the air by an
+    hour in half of them) with a 1.5 % loss at record 300: the loss is found within 3 records in nearly all,
+    and |error| <= 1σ of its size in about 68 %, <= 3σ in at least 98 % (measured: 70 % and 100 %; under a
+    weather drift the tension does not follow, 54 % and 98 %: benchmarks/track.py's conditions)."""
+    rng = np.random.default_rng(5)
+    z = []
+    for k in range(300):
+        hours = np.arange(432) / 6.0
+        air = 12 - 6 * np.cos(2 * np.pi * (hours - 5) / 24)
+        cable = 12 - 6 * np.cos(2 * np.pi * (hours - 5 - (k % 2)) / 24)
+        tension = 4e5 * (1 - 5e-4 * (cable - 12)) * (1 + 0.002 * rng.standard_normal(hours.size))
+        tension[300:] *= 1 - 0.015
+        found = [e for e in analyse_history(tension, air, 4e5).events if abs(e.index - 300) <= 3]
+        z += [(e.change + 0.015) / e.uncertainty for e in found[:1]]
+    z = np.abs(np.array(z))
+    assert len(z) >= 0.9 * 300
+    assert 0.6 <= np.mean(z <= 1) <= 0.8 and np.mean(z <= 3) >= 0.98, (np.mean(z <= 1), np.mean(z <= 3))
