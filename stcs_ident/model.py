@@ -78,6 +78,7 @@ BANDS = {
     "tension": (1e-3, 1e12, "N"),
     "mass": (1e-9, 1e9, "kg"),
     "stiffness": (1e-9, 1e15, "N/m"),
+    "coefficient": (1e-6, 1e12, "N s/m"),
 }
 
 
@@ -248,6 +249,41 @@ class Attachment:
         object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
         object.__setattr__(self, "mass", in_band(self.mass, f"{where}.mass", "mass", zero=True))
         object.__setattr__(self, "stiffness", in_band(self.stiffness, f"{where}.stiffness", "stiffness", zero=True))
+
+
+@dataclass(frozen=True)
+class Damper:
+    """A transverse damper from the cable to ground: a viscous dashpot, with an optional parallel spring and
+    moving mass. At its point it adds the dynamic stiffness ``stiffness + s coefficient + s² mass`` for the
+    complex eigenvalue s; with one, the modes are complex (frequency |s|/2π, damping ratio −Re(s)/|s|).
+
+    Parameters
+    ----------
+    name : str
+    position : float
+        Distance from end A along the chord, m.
+    coefficient : float
+        Dashpot, N s/m (> 0).
+    stiffness : float
+        Spring in parallel with the dashpot, N/m.
+    mass : float
+        Moving mass of the damper, kg.
+    """
+
+    name: str
+    position: float
+    coefficient: float
+    stiffness: float = 0.0
+    mass: float = 0.0
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ModelError("must be a non-empty string", field="damper.name")
+        where = f"damper[{self.name}]"
+        object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
+        object.__setattr__(self, "coefficient", in_band(self.coefficient, f"{where}.coefficient", "coefficient"))
+        object.__setattr__(self, "stiffness", in_band(self.stiffness, f"{where}.stiffness", "stiffness", zero=True))
+        object.__setattr__(self, "mass", in_band(self.mass, f"{where}.mass", "mass", zero=True))
 
 
 @dataclass(frozen=True)
