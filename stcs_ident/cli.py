@@ -126,7 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _simulate_parser(sub) -> None:
-    sim = sub.add_parser("simulate", epilog=_epilog("simulate") + f"\n  {ARCHIVE_EXAMPLE}", formatter_class=argparse.RawDescriptionHelpFormatter, help="simulated records of a campaign's tests, with optional hidden effects",
+    sim = sub.add_parser("simulate", epilog=f"examples:\n  {EXAMPLES['simulate']}\n  {ARCHIVE_EXAMPLE}", formatter_class=argparse.RawDescriptionHelpFormatter, help="simulated records of a campaign's tests, with optional hidden effects",
                          description="Writes OUT/campaign.toml (the nominal cable only), OUT/records/<test>.h5 "
                                      "and OUT/truth.json (the true model and frequencies).")
     sim.add_argument("campaign", help="campaign directory or its campaign.toml")
