@@ -7,7 +7,7 @@ import sys
 
 from .errors import InputError
 
-TRACK_EXAMPLE = "stcs-ident track archive/ --out histories/ --workers 2   # archive/ as simulate --archive writes it"
+TRACK_EXAMPLE = "stcs-ident track archive/ --out histories/ --workers 2"
 ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archive 3 --cables 3 "
                    "--tension-change C2,2026-03-02T12:00:00+00:00,-0.015")
 

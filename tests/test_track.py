@@ -172,6 +172,14 @@ def test_the_cli_tracks_an_archive_it_simulated(tmp_path, capsys):
     capsys.readouterr()
     assert main(["track", str(arch), "--out", str(arch / "C1")]) == 2  # an output over the inputs
     assert "option '--out'" in capsys.readouterr().err
+    from stcs_ident.cli import build_parser
+    from stcs_ident.cli_track import ARCHIVE_EXAMPLE
+
+    args = build_parser().parse_args(ARCHIVE_EXAMPLE.split()[1:])  # the help's example is a valid command line
+    assert args.archive == 3 and args.cables == 3 and args.tension_change.startswith("C2,")
+    assert main(["simulate", str(campaign), "--out", str(tmp_path / "x"), "--archive", "1",
+                 "--tension-change", "C9,2026-03-01T00:00:00,-0.01"]) == 2
+    assert "option '--tension-change'" in capsys.readouterr().err
 
 
 def test_healthy_histories_raise_at_most_one_false_event_per_cable_month():
