@@ -20,9 +20,15 @@ from __future__ import annotations
 import numpy as np
 
 
+def _real_or_complex(x):
+    """``x`` as a float array, or complex if it is (a complex frequency: the damped modes)."""
+    x = np.asarray(x)
+    return x if np.iscomplexobj(x) else x.astype(float)
+
+
 def _x_cos_minus_sin(x):
     """x cos x − sin x without cancellation near 0."""
-    x = np.asarray(x, float)
+    x = _real_or_complex(x)
     x2 = x * x
     series = x * x2 * (-1.0 / 3 + x2 * (1.0 / 30 + x2 * (-1.0 / 840 + x2 / 45360)))
     return np.where(np.abs(x) < 0.1, series, x * np.cos(x) - np.sin(x))
@@ -30,7 +36,7 @@ def _x_cos_minus_sin(x):
 
 def _x_minus_tanh(x):
     """x − tanh x without cancellation near 0."""
-    x = np.asarray(x, float)
+    x = _real_or_complex(x)
     x2 = x * x
     series = x * x2 * (1.0 / 3 + x2 * (-2.0 / 15 + x2 * (17.0 / 315 - x2 * 62.0 / 2835)))
     return np.where(np.abs(x) < 0.1, series, x - np.tanh(x))
@@ -38,7 +44,7 @@ def _x_minus_tanh(x):
 
 def _x_minus_tan(x):
     """x − tan x without cancellation near 0."""
-    x = np.asarray(x, float)
+    x = _real_or_complex(x)
     x2 = x * x
     series = -x * x2 * (1.0 / 3 + x2 * (2.0 / 15 + x2 * (17.0 / 315 + x2 * 62.0 / 2835)))
     return np.where(np.abs(x) < 0.1, series, x - np.tan(x))
@@ -95,7 +101,7 @@ class BeamSegment:
         """The 4×4 dynamic stiffness matrices, shape (..., 4, 4)."""
         a, b, d = self.sym
         e, f, h = self.anti
-        K = np.empty(np.shape(a) + (4, 4))
+        K = np.empty(np.shape(a) + (4, 4), dtype=np.result_type(a, float))
         K[..., 0, 0] = K[..., 2, 2] = 0.5 * (a + e)
         K[..., 1, 1] = K[..., 3, 3] = 0.5 * (d + h)
         K[..., 0, 2] = K[..., 2, 0] = 0.5 * (a - e)
@@ -165,7 +171,7 @@ class StringSegment:
         self.translation_residual = 2.0 * H * q * _x_minus_tan(q * half)
 
     def matrix(self):
-        K = np.empty(np.shape(self.diag) + (2, 2))
+        K = np.empty(np.shape(self.diag) + (2, 2), dtype=np.result_type(self.diag, float))
         K[..., 0, 0] = K[..., 1, 1] = self.diag
         K[..., 0, 1] = K[..., 1, 0] = self.off
         return K

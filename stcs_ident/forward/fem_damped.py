@@ -44,13 +44,15 @@ class ComplexModes:
 
 
 def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], dampers: Sequence[Damper], tension: float,
-                     n_modes: int, n_elements: int = 200, tension_model: str = "uniform") -> ComplexModes:
+                     n_modes: int, n_elements: int = 200, tension_model: str = "uniform",
+                     grading: float = 0.0) -> ComplexModes:
     """The lowest ``n_modes`` complex modes of the cable with its attachments and dampers (finite elements).
 
     Parameters
     ----------
-    cable, attachments, tension, n_elements, tension_model :
-        As :func:`~stcs_ident.forward.fem_assembly.fe_matrices`.
+    cable, attachments, tension, n_elements, tension_model, grading :
+        As :func:`~stcs_ident.forward.fem_assembly.fe_matrices` (``grading`` refines the boundary layers
+        of a taut beam at restrained ends).
     dampers : sequence of Damper
         Each strictly inside the span; one at the position of an attachment shares its node.
     n_modes : int
@@ -67,7 +69,7 @@ def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], dampers: S
                              field=f"damper[{d.name}].position")
     # A damper's spring and moving mass are an attachment's; a node at each damper.
     nodes = [Attachment(f"damper {d.name}", d.position, d.mass, d.stiffness) for d in dampers]
-    model = fe_matrices(cable, list(attachments) + nodes, tension, n_elements, tension_model)
+    model = fe_matrices(cable, list(attachments) + nodes, tension, n_elements, tension_model, grading)
     K = model.stiffness_dense()
     M = model.M.toarray()
     C = np.zeros_like(K)
