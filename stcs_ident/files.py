@@ -83,6 +83,18 @@ def remove_stale(directory: str | os.PathLike) -> list[Path]:
     return removed
 
 
+_CLEANED: set[str] = set()
+
+
+def _clean_once(directory: Path) -> None:
+    """:func:`remove_stale` once per directory and process: a run writing thousands of files into one
+    directory (the parts of ``track``) does not list it before each of them."""
+    key = os.path.realpath(directory)
+    if key not in _CLEANED:
+        remove_stale(directory)
+        _CLEANED.add(key)
+
+
 def _fsync(path: Path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
@@ -102,7 +114,7 @@ def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
     """
     target = Path(path)
     directory = target.parent if str(target.parent) else Path(".")
-    remove_stale(directory)
+    _clean_once(directory)
     fd, name = tempfile.mkstemp(prefix=_prefix(target.name), suffix=suffix, dir=directory)
     os.close(fd)
     tmp = Path(name)
@@ -168,7 +180,7 @@ def whole_directory(out: Path) -> Iterator[Path]:
     """A new directory beside ``out`` to fill; when the block ends it replaces ``out`` as a whole
     (:func:`replace_directory`), and when the block fails it is removed and ``out`` is untouched."""
     out.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale(out.parent)
+    _clean_once(out.parent)
     tmp = Path(tempfile.mkdtemp(prefix=_prefix(out.name), suffix=".tmp", dir=out.parent))
     try:
         os.chmod(tmp, 0o777 & ~umask())  # mkdtemp makes 0700; give the mode a plain mkdir would

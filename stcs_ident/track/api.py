@@ -86,6 +86,9 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     specs = discover(archive, cables)
     out = Path(out) if out is not None else default_out(archive)
     out.mkdir(parents=True, exist_ok=True)
+    from ..files import remove_stale
+
+    remove_stale(out / "parts")  # what a killed run left, even if this one has nothing new to write there
     known = read_table(out)
     pending = _pending(specs, known)
     total = sum(len(items) for _, items in pending)
