@@ -37,7 +37,7 @@ def test_the_exact_solver_follows_krenk_s_universal_curve(eta):
 
 @pytest.mark.slow
 def test_random_cables_with_dampers_agree_with_the_finite_element_model():
-    """8 random cables (strings and beams with ξ = l √(H/EI) up to 300, clamped, pinned or spring ends, an
+    """5 random cables (strings and beams with ξ = l √(H/EI) up to 300, clamped, pinned or spring ends, an
     attachment, one or two dampers with springs and masses, from below to beyond the optimal coefficient):
     frequencies and damping ratios to 1e-4 against graded elements (100 and 200, extrapolated by Richardson).
 
@@ -47,7 +47,7 @@ def test_random_cables_with_dampers_agree_with_the_finite_element_model():
     without the dashpot both agree to 1e-14 with the Wittrick-Williams solver). The issue's 1e-6 needs a
     better conditioned reference (shift-invert on the quadratic problem): the next step."""
     rng = np.random.default_rng(13)
-    for _ in range(8):
+    for _ in range(5):
         length = rng.uniform(20.0, 150.0)
         m = rng.uniform(5.0, 80.0)
         H = rng.uniform(0.3, 6.0) * 1e6
