@@ -222,6 +222,17 @@ class Cable:
         return self.mass_per_length * self.gravity * math.cos(self.inclination)
 
 
+def _check_point(obj, kind: str) -> str:
+    """The checks an attachment and a damper share (name, position, mass, stiffness); returns the field prefix."""
+    if not isinstance(obj.name, str) or not obj.name:
+        raise ModelError("must be a non-empty string", field=f"{kind}.name")
+    where = f"{kind}[{obj.name}]"
+    object.__setattr__(obj, "position", _positive(obj.position, f"{where}.position"))
+    object.__setattr__(obj, "mass", in_band(obj.mass, f"{where}.mass", "mass", zero=True))
+    object.__setattr__(obj, "stiffness", in_band(obj.stiffness, f"{where}.stiffness", "stiffness", zero=True))
+    return where
+
+
 @dataclass(frozen=True)
 class Attachment:
     """A point mass and/or transverse spring clamped on the cable.
@@ -243,12 +254,7 @@ class Attachment:
     stiffness: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise ModelError("must be a non-empty string", field="attachment.name")
-        where = f"attachment[{self.name}]"
-        object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
-        object.__setattr__(self, "mass", in_band(self.mass, f"{where}.mass", "mass", zero=True))
-        object.__setattr__(self, "stiffness", in_band(self.stiffness, f"{where}.stiffness", "stiffness", zero=True))
+        _check_point(self, "attachment")
 
 
 @dataclass(frozen=True)
@@ -277,13 +283,8 @@ class Damper:
     mass: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise ModelError("must be a non-empty string", field="damper.name")
-        where = f"damper[{self.name}]"
-        object.__setattr__(self, "position", _positive(self.position, f"{where}.position"))
+        where = _check_point(self, "damper")
         object.__setattr__(self, "coefficient", in_band(self.coefficient, f"{where}.coefficient", "coefficient"))
-        object.__setattr__(self, "stiffness", in_band(self.stiffness, f"{where}.stiffness", "stiffness", zero=True))
-        object.__setattr__(self, "mass", in_band(self.mass, f"{where}.mass", "mass", zero=True))
 
 
 @dataclass(frozen=True)
