@@ -26,7 +26,7 @@ from typing import Any
 from . import effects
 from .campaign_toml import campaign_to_toml
 from .errors import CampaignError, ModelError
-from .model import Attachment, Boundary, Cable, Campaign, Published, Setup, Test
+from .model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
 
 __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 
@@ -37,8 +37,9 @@ _TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance")
 _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
-_SETUP_KEYS = ("name", "attachment")
+_SETUP_KEYS = ("name", "attachment", "damper")
 _ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
+_DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass")
 _TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
@@ -213,19 +214,25 @@ def _parse_setup(table: dict[str, Any], index: int, length: float) -> Setup:
     name = _item_name(table, "setup", index)
     where = f"setup[{name}]"
     _check_keys(table, _SETUP_KEYS, where)
-    kind = f"{where}.attachment"
-    found = _tables(table.get("attachment", []), kind)
-    attachments = [_parse_attachment(t, i, kind, length) for i, t in enumerate(found, 1)]
-    return Setup(name, tuple(attachments))
+    points = []
+    for noun, keys in (("attachment", _ATTACHMENT_KEYS), ("damper", _DAMPER_KEYS)):
+        kind = f"{where}.{noun}"
+        found = _tables(table.get(noun, []), kind)
+        points += [_parse_point(t, i, kind, keys, length) for i, t in enumerate(found, 1)]
+    try:
+        return Setup(name, tuple(points))
+    except ModelError as err:
+        raise CampaignError(err.message, field=err.field) from err
 
 
-def _parse_attachment(table: dict[str, Any], index: int, kind: str, length: float) -> Attachment:
-    """Build one ``[[setup.attachment]]``; ``kind`` is ``setup[<name>].attachment``."""
+def _parse_point(table: dict[str, Any], index: int, kind: str, keys, length: float) -> Attachment:
+    """Build one ``[[setup.attachment]]`` or ``[[setup.damper]]``; ``kind`` is ``setup[<name>].<noun>``."""
     name = _item_name(table, kind, index)
     where = f"{kind}[{name}]"
-    _check_keys(table, _ATTACHMENT_KEYS, where)
+    _check_keys(table, keys, where)
     if "damping" in table:
-        raise CampaignError("damping is not supported yet; remove the key", field=f"{where}.damping")
+        raise CampaignError("an attachment has no damping; give a damper as a [[setup.damper]] with its "
+                            "coefficient (N s/m)", field=f"{where}.damping")
     position = _number(_required(table, "position", where), f"{where}.position")
     if not 0 < position < length:
         message = f"position {position} m is outside the span (0, {length}) m"
@@ -233,6 +240,9 @@ def _parse_attachment(table: dict[str, Any], index: int, kind: str, length: floa
     mass = _number(table.get("mass", 0.0), f"{where}.mass")
     stiffness = _number(table.get("stiffness", 0.0), f"{where}.stiffness")
     try:
+        if kind.endswith(".damper"):
+            coefficient = _number(_required(table, "coefficient", where), f"{where}.coefficient")
+            return Damper(name, position, mass, stiffness, coefficient=coefficient)
         return Attachment(name, position, mass, stiffness)
     except ModelError as err:
         # The model names the field from the attachment down; add the setup.

@@ -79,11 +79,16 @@ def _cable_lines(cable: Cable) -> list[str]:
 def _setup_lines(setup: Setup) -> list[str]:
     lines = ["[[setup]]", f"name = {_toml_string(setup.name)}"]
     for a in setup.attachments:
+        damper = getattr(a, "coefficient", None) is not None
         lines += [
             "",
-            "  [[setup.attachment]]",
+            "  [[setup.damper]]" if damper else "  [[setup.attachment]]",
             f"  name = {_toml_string(a.name)}",
             f"  position = {_toml_float(a.position)}",
+        ]
+        if damper:
+            lines.append(f"  coefficient = {_toml_float(a.coefficient)}")
+        lines += [
             f"  mass = {_toml_float(a.mass)}",
             f"  stiffness = {_toml_float(a.stiffness)}",
         ]

@@ -258,33 +258,42 @@ class Attachment:
 
 
 @dataclass(frozen=True)
-class Damper:
+class Damper(Attachment):
     """A transverse damper from the cable to ground: a viscous dashpot, with an optional parallel spring and
     moving mass. At its point it adds the dynamic stiffness ``stiffness + s coefficient + s² mass`` for the
     complex eigenvalue s; with one, the modes are complex (frequency |s|/2π, damping ratio −Re(s)/|s|).
+
+    A damper is an attachment (its spring and moving mass are one) with a dashpot: it sits among a setup's
+    attachments, ordered by position, and everything that moves or weighs an attachment applies to it.
 
     Parameters
     ----------
     name : str
     position : float
         Distance from end A along the chord, m.
-    coefficient : float
-        Dashpot, N s/m (> 0).
-    stiffness : float
-        Spring in parallel with the dashpot, N/m.
     mass : float
         Moving mass of the damper, kg.
+    stiffness : float
+        Spring in parallel with the dashpot, N/m.
+    coefficient : float
+        Dashpot, N s/m (> 0; keyword only).
     """
 
-    name: str
-    position: float
-    coefficient: float
-    stiffness: float = 0.0
-    mass: float = 0.0
+    coefficient: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         where = _check_point(self, "damper")
         object.__setattr__(self, "coefficient", in_band(self.coefficient, f"{where}.coefficient", "coefficient"))
+
+
+def _noun(a: Attachment) -> str:
+    """``"damper"`` or ``"attachment"``: how fields and messages name it."""
+    return "damper" if isinstance(a, Damper) else "attachment"
+
+
+def has_dampers(attachments) -> bool:
+    """Whether any of ``attachments`` is a :class:`Damper` (its modes are complex)."""
+    return any(isinstance(a, Damper) for a in attachments)
 
 
 @dataclass(frozen=True)
@@ -306,15 +315,16 @@ class Setup:
             if not isinstance(a, Attachment):
                 raise ModelError("must hold Attachment objects", field=f"setup[{self.name}].attachment")
         names = [a.name for a in atts]
-        for n in names:
-            if names.count(n) > 1:
-                raise ModelError(f"duplicate attachment name {n!r}", field=f"setup[{self.name}].attachment[{n}].name")
+        for a in atts:
+            if names.count(a.name) > 1:
+                raise ModelError(f"duplicate name {a.name!r} (attachments and dampers share the names of a setup)",
+                                 field=f"setup[{self.name}].{_noun(a)}[{a.name}].name")
         atts = tuple(sorted(atts, key=lambda a: a.position))
         for a, b in itertools.pairwise(atts):
             if a.position == b.position:
                 raise ModelError(
-                    f"attachments {a.name!r} and {b.name!r} are at the same position {a.position} m",
-                    field=f"setup[{self.name}].attachment[{b.name}].position",
+                    f"{_noun(a)} {a.name!r} and {_noun(b)} {b.name!r} are at the same position {a.position} m",
+                    field=f"setup[{self.name}].{_noun(b)}[{b.name}].position",
                 )
         object.__setattr__(self, "attachments", atts)
 
@@ -324,7 +334,7 @@ class Setup:
             if not 0 < a.position < length:
                 raise ModelError(
                     f"position {a.position} m is outside the span (0, {length}) m",
-                    field=f"setup[{self.name}].attachment[{a.name}].position",
+                    field=f"setup[{self.name}].{_noun(a)}[{a.name}].position",
                 )
 
 

@@ -360,9 +360,9 @@ def test_bad_input_names_file_and_field(tmp_path, text, field):
     assert_one_line_naming(info.value, file, field)
 
 
-def test_damping_says_not_supported(tmp_path):
+def test_attachment_damping_points_to_the_damper_table(tmp_path):
     file = write_campaign(tmp_path / "bad", after_w1("  damping = 0.0\n"))
-    with pytest.raises(CampaignError, match="damping is not supported yet"):
+    with pytest.raises(CampaignError, match=r"give a damper as a \[\[setup.damper\]\]"):
         load_campaign(file.parent)
 
 

@@ -29,7 +29,7 @@ def test_without_a_damper_the_modes_are_the_undamped_solver_s():
 def test_the_exact_solver_follows_krenk_s_universal_curve(eta):
     L, m, H, xd = 100.0, 50.0, 2.0e6, 2.0
     c = eta * np.sqrt(H * m) / (np.pi * xd / L)
-    modes = complex_modes(Cable(L, m, 0.0), [], [Damper("D", xd, c)], H, 3)
+    modes = complex_modes(Cable(L, m, 0.0), [], [Damper("D", xd, coefficient=c)], H, 3)
     eta_n = eta * np.arange(1, 4)  # η grows with the mode number
     krenk = (xd / L) * eta_n / (1 + eta_n**2)
     np.testing.assert_allclose(modes.damping, krenk, rtol=0.04)  # the asymptote's O(x_d/l) error: 2-3 %
@@ -59,7 +59,7 @@ def test_random_cables_with_dampers_agree_with_the_finite_element_model():
         for k in range(int(rng.integers(1, 3))):
             x = rng.uniform(0.01, 0.05) * length if k == 0 else rng.uniform(0.9, 0.97) * length
             eta = 10 ** rng.uniform(-1, 1)
-            dampers.append(Damper(f"D{k}", x, eta * np.sqrt(H * m) / (np.pi * x / length),
+            dampers.append(Damper(f"D{k}", x, coefficient=eta * np.sqrt(H * m) / (np.pi * x / length),
                                   stiffness=rng.uniform(0, 2e4), mass=rng.uniform(0, 20.0)))
         exact = complex_modes(cable, atts, dampers, H, 4)
         coarse, fine = (fe_complex_modes(cable, atts, dampers, H, 4, n_elements=n, tension_model="none",

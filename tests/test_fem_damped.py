@@ -23,7 +23,7 @@ XD = 0.02 * L
 @pytest.mark.parametrize("eta", [0.3, 1.0, 3.0])
 def test_a_string_with_a_damper_near_an_end_follows_krenk_s_universal_curve(n, eta):
     c = eta * np.sqrt(H * M) / (np.pi * n * XD / L)
-    modes = fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", XD, c)], H, 4, n_elements=80)
+    modes = fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", XD, coefficient=c)], H, 4, n_elements=80)
     krenk = (XD / L) * eta / (1 + eta**2)
     assert modes.damping[n - 1] == pytest.approx(krenk, rel=0.04)  # O(x_d/l) = 2 % of the asymptote, and more
     assert modes.frequency[n - 1] == pytest.approx(n * np.sqrt(H / M) / (2 * L), rel=0.03)  # shifted by < x_d/l
@@ -31,7 +31,7 @@ def test_a_string_with_a_damper_near_an_end_follows_krenk_s_universal_curve(n, e
 
 def test_the_largest_damping_is_half_the_damper_s_relative_position():
     etas = np.geomspace(0.2, 5.0, 25)
-    zeta = [fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", XD, e * np.sqrt(H * M) / (np.pi * XD / L))], H, 1,
+    zeta = [fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", XD, coefficient=e * np.sqrt(H * M) / (np.pi * XD / L))], H, 1,
                              n_elements=60).damping[0] for e in etas]
     best = int(np.argmax(zeta))
     assert 0.7 <= etas[best] <= 1.4
@@ -43,7 +43,7 @@ def test_a_vanishing_damper_leaves_the_undamped_modes():
     that spring and mass, and no damping. To 1e-7: the companion form, solved by QZ as a non-symmetric
     problem of twice the size, keeps about 8 digits where the symmetric undamped solver keeps 12."""
     cable = Cable(30.0, 12.0, 5.0e4, EA=3.0e9, inclination=0.4)
-    damper = Damper("D", 1.2, 1e-6, stiffness=2.0e3, mass=4.0)
+    damper = Damper("D", 1.2, coefficient=1e-6, stiffness=2.0e3, mass=4.0)
     modes = fe_complex_modes(cable, [Attachment("W", 11.0, 20.0)], [damper], 1.5e6, 5, n_elements=120)
     undamped = fe_frequencies(cable, [Attachment("W", 11.0, 20.0), Attachment("D", 1.2, 4.0, 2.0e3)], 1.5e6, 5,
                               n_elements=120)
@@ -53,4 +53,4 @@ def test_a_vanishing_damper_leaves_the_undamped_modes():
 
 def test_a_damper_outside_the_span_is_refused():
     with pytest.raises(ModelError, match="damper"):
-        fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", 120.0, 1.0)], H, 2)
+        fe_complex_modes(Cable(L, M, 0.0), [], [Damper("D", 120.0, coefficient=1.0)], H, 2)
