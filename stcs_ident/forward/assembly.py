@@ -76,10 +76,12 @@ class CableBatch:
     gcos : g cos θ, m/s²
     positions, masses, springs : attachments, ascending positions
     end_a, end_b : rotational stiffness at A and B (inf = clamped)
+    dashpots : the attachments' viscous coefficients (N s/m; a damper's), or None; used only by the
+        complex solver (:mod:`.damped`), never by :meth:`assemble`
     """
 
     def __init__(self, topology, *, length, mass_per_length, EI, tension, EA, weight, gcos,
-                 positions, masses, springs, end_a, end_b):
+                 positions, masses, springs, end_a, end_b, dashpots=None):
         self.topology = topology
         self.length = length
         self.m = mass_per_length
@@ -92,6 +94,7 @@ class CableBatch:
         self.springs = springs
         self.end_a = end_a
         self.end_b = end_b
+        self.dashpots = np.zeros_like(masses) if dashpots is None else dashpots
         self.kinks = masses * gcos[:, None] / tension[:, None]
         self.seg_len, self.slope_start, self.slope_end = end_slopes(
             length, positions, weight / tension, self.kinks
@@ -174,11 +177,11 @@ class CableBatch:
         return scale
 
     def assemble(self, idx, omega, segments=None):
-        """K(ω) of shape (len(idx), n_dof, n_dof), and the J0 count."""
+        """K(ω) of shape (len(idx), n_dof, n_dof), and the J0 count (None for a complex ω)."""
         topo = self.topology
         n = len(idx)
         seg = self.segments(idx, omega) if segments is None else segments
-        J0 = seg.clamped_count().sum(axis=1)
+        J0 = None if np.iscomplexobj(omega) else seg.clamped_count().sum(axis=1)  # complex ω: the damped modes
         parts = [seg.matrix().reshape(n, -1)]
         if topo.tension_model != "none":
             gamma = self.w[idx] / (self.H[idx] * self.m[idx] * omega * omega)

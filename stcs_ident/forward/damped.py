@@ -1,107 +1,213 @@
 """Complex modes of a cable with dampers, exact: the dynamic stiffness at a complex eigenvalue s.
 
-Prototype (issue 13): segments between attachments and dampers are the exact tensioned-beam (or string)
-elements of :mod:`.elements` evaluated at ω = −i s (m ω² = −m s²); an attachment adds m s² + k at its node,
-a damper k_d + c s + m_d s². Without the sag term (``EA`` ignored). Each mode is followed from its
-undamped root (the certified Wittrick–Williams solve, dampers replaced by their springs and masses) as the
-dashpots grow from 0 to their values, by Newton steps on log det K(s).
+A damper (:class:`~stcs_ident.model.Damper`) is an attachment with a dashpot: at its node it adds
+``k + c s + m s²``. Every segment between nodes is the exact tensioned-beam (or string) element of
+:mod:`.elements` evaluated at ω = −i s, and the sag-extensibility term (one additional tension ĥ, as in the
+undamped solver) is kept, so K(s) is the undamped solver's matrix continued into the complex plane plus
+``c s`` on the dampers' displacements. Its zeros are the eigenvalues s; a mode's frequency is |s|/2π and
+its damping ratio −Re(s)/|s|.
+
+How every mode is found, and none missed
+-----------------------------------------
+1. The undamped roots (dashpots removed, springs and masses kept) come from the Wittrick–Williams solver,
+   which certifies their count.
+2. Each is followed as the dashpots grow from 0 to their values (t = 0 … 1, c → t c): a secant predictor,
+   Newton's method on det K(s) (derivative by a central difference), and a step halved whenever Newton
+   fails or jumps farther than a quarter of the distance to the neighbouring undamped roots.
+3. The count is certified by the argument principle: on the rectangle Im s ∈ [ω₁/4, ω_top],
+   Re s ∈ [−ω_top, ω₁/20] (ω_top midway between the last requested mode and the next), the winding number
+   of det K(s) plus the number of its poles inside (the clamped-segment frequencies, which are real: the
+   J0 count of the undamped solver) is the number of eigenvalues inside. It must equal the number found
+   there, and no two paths may end on one root; otherwise a ComputationError says a mode was lost.
+   The phase of det K is followed with adaptive refinement (no step of more than π/4).
+
+The rectangle covers every mode up to the band's top with a damping ratio below about 0.7 (beyond the
+left edge lie only modes damped more than that, which no record shows as a peak).
+
+Without a dashpot the result is the undamped solver's, bit for bit (s = iω, damping 0).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError
-from ..model import Attachment, Cable, Damper
-from .dsm import natural_frequencies
-from .elements import BeamSegment, StringSegment
-from .fem_damped import ComplexModes
+from ..errors import ComputationError, ModelError
+from ..model import Attachment, Cable
+from .dsm import _items, build_batch
+from .roots import solve_modes
 
-__all__ = ["complex_modes"]
+__all__ = ["ComplexModes", "batch_complex_modes", "complex_modes"]
 
-
-def _stiffness(cable: Cable, tension: float, points: np.ndarray, point_terms, s: complex) -> np.ndarray:
-    """K(s) on the free degrees of freedom: nodes at the ends and at ``points``; ``point_terms`` (k, c, m)."""
-    x = np.concatenate(([0.0], points, [cable.length]))
-    lengths = np.diff(x)
-    omega = -1j * s
-    beam = cable.EI > 0
-    per = 2 if beam else 1
-    n = per * x.size
-    K = np.zeros((n, n), dtype=complex)
-    if beam:
-        seg = BeamSegment(lengths, cable.EI, tension, cable.mass_per_length, np.full(lengths.size, omega))
-    else:
-        seg = StringSegment(lengths, tension, cable.mass_per_length, np.full(lengths.size, omega))
-    blocks = seg.matrix()
-    for j in range(lengths.size):
-        dofs = slice(per * j, per * j + 2 * per)
-        K[dofs, dofs] += blocks[j]
-    for i, (k, c, m) in enumerate(point_terms, start=1):
-        K[per * i, per * i] += k + c * s + m * s * s
-    free = np.ones(n, dtype=bool)
-    free[0] = free[per * (x.size - 1)] = False  # no displacement at the anchorages
-    if beam:
-        for dof, boundary in ((1, cable.boundary_a), (n - 1, cable.boundary_b)):
-            if boundary.is_clamped:
-                free[dof] = False
-            else:
-                K[dof, dof] += boundary.rotational_stiffness
-    return K[np.ix_(free, free)]
+NEWTON_RTOL = 1e-12  # relative step at convergence
+NEWTON_ITER = 40
+FIRST_STEP = 0.25  # of the dashpots' values
+MIN_STEP = 1e-6
+JUMP = 0.25  # of the distance to the neighbouring undamped roots: a longer step is refused
+MAX_ARG_STEP = math.pi / 4  # phase change between neighbouring contour points
+MAX_CONTOUR_POINTS = 200_000
 
 
-def _points(attachments, dampers, scale: float):
-    """Node positions and (k, c, m) per node, attachments and dampers at one position merged."""
-    terms: dict[float, list[float]] = {}
-    for a in attachments:
-        terms.setdefault(a.position, [0.0, 0.0, 0.0])
-        terms[a.position][0] += a.stiffness
-        terms[a.position][2] += a.mass
-    for d in dampers:
-        terms.setdefault(d.position, [0.0, 0.0, 0.0])
-        terms[d.position][0] += d.stiffness
-        terms[d.position][1] += scale * d.coefficient
-        terms[d.position][2] += d.mass
-    points = np.array(sorted(terms))
-    return points, [tuple(terms[p]) for p in points]
+@dataclass(frozen=True)
+class ComplexModes:
+    """Complex eigenvalues s (Im s > 0), their frequencies |s|/2π (Hz) and damping ratios −Re(s)/|s|."""
+
+    s: np.ndarray
+    frequency: np.ndarray
+    damping: np.ndarray
 
 
-def _newton(cable, tension, points, terms, s: complex, tol: float = 1e-12, max_iter: int = 50) -> complex:
-    for _ in range(max_iter):
+def complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
+                  tension_model: str = "uniform", certify: bool = True) -> ComplexModes:
+    """The first ``n_modes`` complex modes of one configuration (see the module docstring).
+
+    Parameters
+    ----------
+    cable : Cable
+    attachments : sequence of Attachment
+        Dampers among them (:class:`~stcs_ident.model.Damper`).
+    tension : float
+        H, N.
+    n_modes : int
+    tension_model : {"uniform", "per-segment", "none"}
+        As the undamped solver.
+    certify : bool
+        Check the count by the argument principle (costs about as much as the solve).
+
+    Returns
+    -------
+    ComplexModes
+        Ordered by mode (the undamped mode each was followed from).
+
+    Raises
+    ------
+    ComputationError
+        If a path does not converge or the count finds a mode the paths missed.
+    """
+    s = batch_complex_modes(cable, attachments, float(tension), n_modes, tension_model=tension_model,
+                            certify=certify)
+    return _modes(s)
+
+
+def _modes(s: np.ndarray) -> ComplexModes:
+    a = np.abs(s)
+    return ComplexModes(s=s, frequency=a / (2 * math.pi), damping=-s.real / a)
+
+
+def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension, n_modes: int = 6, *,
+                        tension_model: str = "uniform", certify: bool = True, **overrides) -> np.ndarray:
+    """Complex eigenvalues s (rad/s) of many parameter sets, shape ``broadcast_shape + (n_modes,)``.
+
+    Parameters as :func:`~stcs_ident.forward.batch_frequencies`, with one more per-attachment override,
+    ``coefficients`` (N s/m, the dashpots; 0 for an attachment without one).
+    """
+    if int(n_modes) < 1:
+        raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
+    n_modes = int(n_modes)
+    shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
+    total = math.prod(shape)
+    out = np.empty((total, n_modes), dtype=complex)
+    for batch, sel in groups:
+        count = len(sel)
+        config, mode = _items(0, count, n_modes + 1)
+        omega = solve_modes(batch, config, mode).reshape(count, n_modes + 1)
+        s = 1j * omega
+        damped = np.flatnonzero(batch.dashpots.any(axis=1))
+        for c in damped:
+            s[c] = follow_roots(batch, int(c), omega[c])
+            if certify:
+                certify_count(batch, int(c), omega[c], s[c], n_modes)
+        out[sel] = s[:, :n_modes]
+    return out.reshape(shape + (n_modes,))
+
+
+def determinant(batch, config: int, s: np.ndarray, t: float = 1.0) -> np.ndarray:
+    """det of the scaled K(s) of configuration ``config``, the dashpots scaled by ``t``, at points ``s``."""
+    s = np.asarray(s, dtype=complex)
+    idx = np.full(s.size, config)
+    K, _ = batch.assemble(idx, -1j * s)
+    v = batch.v_dof[1:-1]
+    K[:, v, v] += t * batch.dashpots[config] * s[:, None]
+    scale = batch._scale[config]
+    return np.linalg.det(K * scale[:, None] * scale[None, :])
+
+
+def _newton(batch, config: int, s: complex, t: float) -> complex | None:
+    """Newton's method on det K(s); None if it does not converge."""
+    for _ in range(NEWTON_ITER):
         h = 1e-7 * abs(s)
-        K = _stiffness(cable, tension, points, terms, s)
-        dK = (_stiffness(cable, tension, points, terms, s + h) - _stiffness(cable, tension, points, terms, s - h))
-        dK /= 2 * h
-        try:
-            step = 1.0 / np.trace(np.linalg.solve(K, dK))  # 1 / (d/ds log det K)
-        except np.linalg.LinAlgError:  # exactly on a root or a pole of a segment: step off it
-            s *= 1 + 1e-9j
-            continue
+        f, fp, fm = determinant(batch, config, np.array([s, s + h, s - h]), t)
+        slope = (fp - fm) / (2 * h)
+        if not (np.isfinite(f) and np.isfinite(slope)) or slope == 0:
+            return None
+        step = f / slope
         s -= step
-        if abs(step) < tol * abs(s):
+        if abs(step) <= NEWTON_RTOL * abs(s):
             return s
-    raise ComputationError(f"a damped mode near {abs(s) / (2 * np.pi):.6g} Hz did not converge")
+    return None
 
 
-def complex_modes(cable: Cable, attachments: Sequence[Attachment], dampers: Sequence[Damper], tension: float,
-                  n_modes: int, steps: int = 16) -> ComplexModes:
-    """The first ``n_modes`` complex modes (see the module docstring); the sag term is left out."""
-    cable = replace(cable, EA=None)
-    undamped = list(attachments) + [Attachment(f"damper {d.name}", d.position, d.mass, d.stiffness) for d in dampers]
-    f0 = natural_frequencies(cable, undamped, tension, n_modes, tension_model="none")
-    roots = []
-    for f in np.asarray(f0).ravel():
-        s = 2j * np.pi * f
-        for k in range(1, steps + 1):  # the dashpots from 0 to their values
-            points, terms = _points(attachments, dampers, (k / steps) ** 2)
-            s = _newton(cable, tension, points, terms, s)
-        roots.append(s)
-    s = np.array(roots)
-    if np.unique(np.round(s / abs(s).max(), 9)).size < s.size:
-        raise ComputationError("two damped modes' paths merged: the continuation lost a mode")
-    order = np.argsort(np.abs(s))
-    s = s[order]
-    return ComplexModes(s=s, frequency=np.abs(s) / (2 * np.pi), damping=-s.real / np.abs(s))
+def follow_roots(batch, config: int, omega: np.ndarray) -> np.ndarray:
+    """Each undamped root ``omega`` (rad/s) followed as the dashpots grow to their values (complex s)."""
+    gaps = np.diff(np.concatenate(([0.0], omega, [2 * omega[-1] - omega[-2] if omega.size > 1 else 2 * omega[0]])))
+    reach = JUMP * np.minimum(gaps[:-1], gaps[1:])
+    out = np.empty(omega.size, dtype=complex)
+    for k, w in enumerate(omega):
+        t, dt, s, velocity = 0.0, FIRST_STEP, 1j * w, 0.0
+        while t < 1.0:
+            t1 = min(1.0, t + dt)
+            guess = s + velocity * (t1 - t)
+            s1 = _newton(batch, config, guess, t1)
+            if s1 is None or abs(s1 - s) > reach[k]:
+                dt *= 0.5
+                if dt < MIN_STEP:
+                    raise ComputationError(f"the damped mode {k + 1} near {w / (2 * math.pi):.6g} Hz could not be "
+                                           "followed as the dampers grow")
+                continue
+            velocity = (s1 - s) / (t1 - t)
+            s, t, dt = s1, t1, min(2 * dt, 1.0)
+        out[k] = s
+    return out
+
+
+def certify_count(batch, config: int, omega: np.ndarray, s: np.ndarray, n_modes: int) -> None:
+    """The argument-principle check of the module docstring; raises ComputationError on a mismatch."""
+    top_pair = s[n_modes - 1:n_modes + 1].imag
+    if not top_pair[1] > top_pair[0]:
+        raise ComputationError("the damped modes are not ordered in frequency at the top of the band; ask for one "
+                               "mode more or fewer")
+    lo, hi = 0.25 * omega[0], 0.5 * (top_pair[0] + top_pair[1])
+    left, right = -hi, 0.05 * omega[0]
+    inside = np.count_nonzero((s.imag > lo) & (s.imag < hi) & (s.real > left) & (s.real < right))
+    turns = winding_number(lambda z: determinant(batch, config, z), [right + 1j * lo, right + 1j * hi,
+                                                                      left + 1j * hi, left + 1j * lo])
+    _, _, J0 = batch.evaluate(np.array([config, config]), np.array([lo, hi]))
+    zeros = turns + int(J0[1] - J0[0])
+    if zeros != inside or np.unique(np.round(s / hi, 9)).size < s.size:
+        raise ComputationError(f"the damped modes below {hi / (2 * math.pi):.6g} Hz number {zeros} by the argument "
+                               f"principle, but {inside} were found: a mode was lost")
+
+
+def winding_number(f, corners: Sequence[complex], per_edge: int = 32) -> int:
+    """Turns of f(z) around 0 along the closed polygon ``corners`` (counter-clockwise), phase-tracked."""
+    z = np.concatenate([a + (b - a) * np.linspace(0.0, 1.0, per_edge, endpoint=False)
+                        for a, b in zip(corners, list(corners[1:]) + [corners[0]])])
+    z = np.append(z, z[0])
+    v = f(z)
+    while True:
+        step = np.angle(v[1:] / v[:-1])
+        with np.errstate(divide="ignore"):
+            ratio = np.abs(np.log(np.abs(v[1:] / v[:-1])))
+        coarse = np.flatnonzero((np.abs(step) > MAX_ARG_STEP) | ~(ratio < 1.0))
+        if coarse.size == 0:
+            total = step.sum() / (2 * math.pi)
+            return int(round(total))
+        if z.size + coarse.size > MAX_CONTOUR_POINTS:
+            raise ComputationError("the count of damped modes did not resolve (the determinant's phase varies too "
+                                   "fast on the contour)")
+        mid = 0.5 * (z[coarse] + z[coarse + 1])
+        z = np.insert(z, coarse + 1, mid)
+        v = np.insert(v, coarse + 1, f(mid))

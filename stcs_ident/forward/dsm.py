@@ -27,7 +27,8 @@ from .roots import solve_modes
 #: (items × dofs² doubles) while keeping numpy's per-call overhead small.
 CHUNK = 8192
 
-_OVERRIDES = ("tension", "EI", "length", "mass_per_length", "positions", "masses", "stiffnesses", "end_a", "end_b")
+_OVERRIDES = ("tension", "EI", "length", "mass_per_length", "positions", "masses", "stiffnesses", "end_a", "end_b",
+              "coefficients")
 
 
 def _check_tension_model(tension_model: str) -> None:
@@ -64,6 +65,7 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
         "positions": overrides.get("positions", [a.position for a in atts]),
         "masses": overrides.get("masses", [a.mass for a in atts]),
         "stiffnesses": overrides.get("stiffnesses", [a.stiffness for a in atts]),
+        "coefficients": overrides.get("coefficients", [getattr(a, "coefficient", 0.0) for a in atts]),
     }
     arrays = {k: np.asarray(v, float) for k, v in scalars.items()}
     att_arrays = {}
@@ -114,7 +116,7 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
             EA=_filled(count, cable.EA if cable.EA is not None else np.inf),
             weight=m * g * math.cos(theta), gcos=_filled(count, g * math.cos(theta)),
             positions=part["positions"], masses=part["masses"], springs=part["stiffnesses"],
-            end_a=part["end_a"], end_b=part["end_b"],
+            end_a=part["end_a"], end_b=part["end_b"], dashpots=part["coefficients"],
         )
         groups.append((batch, np.arange(n) if sel is None else sel))
     return shape, groups
@@ -162,7 +164,7 @@ def _validate_inputs(arrays, att_arrays):
         if not _at_least(arrays[name], 0.0, True):
             raise ModelError("must be finite and > 0", field=name)
     for name, v in (("EI", arrays["EI"]), ("masses", att_arrays["masses"]),
-                    ("stiffnesses", att_arrays["stiffnesses"])):
+                    ("stiffnesses", att_arrays["stiffnesses"]), ("coefficients", att_arrays["coefficients"])):
         if not _at_least(v, 0.0, False):
             raise ModelError("must be finite and >= 0", field=name)
     for name in ("end_a", "end_b"):
