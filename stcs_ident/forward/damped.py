@@ -11,9 +11,10 @@ How every mode is found, and none missed
 -----------------------------------------
 1. The undamped roots (dashpots removed, springs and masses kept) come from the Wittrick–Williams solver,
    which certifies their count.
-2. Each is followed as the dashpots grow from 0 to their values (t = 0 … 1, c → t c): a secant predictor,
-   Newton's method on det K(s) (derivative by a central difference), and a step halved whenever Newton
-   fails or jumps farther than a quarter of the distance to the neighbouring undamped roots.
+2. Each is followed as the dashpots grow from 0 to their values (t = 0 … 1, c → t c): first in one step
+   (a Möbius model of the path as the start of the secant method on det K(s)), else by geometric steps
+   in t, each shortened whenever the secant method fails or jumps farther than a quarter of the
+   distance to the neighbouring undamped roots.
 3. The count is certified by the argument principle: on the rectangle Im s ∈ [ω₁/4, ω_top],
    Re s ∈ [−ω_top, ω₁/20] (ω_top midway between the last requested mode and the next), the winding number
    of det K(s) plus the number of its poles inside (the clamped-segment frequencies, which are real: the
@@ -29,6 +30,7 @@ Without a dashpot the result is the undamped solver's, bit for bit (s = iω, dam
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,14 +40,20 @@ import numpy as np
 from ..errors import ComputationError, ModelError
 from ..model import Attachment, Cable
 from .dsm import _items, build_batch
-from .roots import solve_modes
+from .roots import FORCE_NUMPY, solve_modes
+
+try:  # the optional compiled kernel (setup.py); same numerics, no per-call overhead
+    from . import _damped_kernel
+except ImportError:  # pragma: no cover - depends on the install
+    _damped_kernel = None
 
 __all__ = ["ComplexModes", "batch_complex_modes", "complex_modes"]
 
-NEWTON_RTOL = 1e-12  # relative step at convergence
-NEWTON_ITER = 40
-FIRST_STEP = 0.25  # of the dashpots' values
-MIN_STEP = 1e-6
+SECANT_RTOL = 1e-10  # relative step at convergence (the next step's error is below 1e-15: order 1.6)
+SECANT_ITER = 40
+START = 0.01  # the first step's first-order shift, in units of the reach
+GROWTH = 4.0  # largest ratio of consecutive t
+MIN_RATIO = 1 + 1e-6
 JUMP = 0.25  # of the distance to the neighbouring undamped roots: a longer step is refused
 MAX_ARG_STEP = math.pi / 4  # phase change between neighbouring contour points
 MAX_CONTOUR_POINTS = 200_000
@@ -116,12 +124,64 @@ def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension
         omega = solve_modes(batch, config, mode).reshape(count, n_modes + 1)
         s = 1j * omega
         damped = np.flatnonzero(batch.dashpots.any(axis=1))
-        for c in damped:
-            s[c] = follow_roots(batch, int(c), omega[c])
-            if certify:
-                certify_count(batch, int(c), omega[c], s[c], n_modes)
+        pinned = _pinned_roots(batch, damped, n_modes + 1) if damped.size else None
+        if damped.size and use_kernel() and batch.n_dof <= 64:
+            s[damped] = _solve_compiled(batch, damped, omega, pinned, n_modes, certify)
+        else:
+            for i, c in enumerate(damped):
+                s[c] = follow_roots(batch, int(c), omega[c], pinned[i])
+                if certify:
+                    certify_count(batch, int(c), omega[c], s[c], n_modes)
         out[sel] = s[:, :n_modes]
     return out.reshape(shape + (n_modes,))
+
+
+def use_kernel() -> bool:
+    """Whether the compiled kernel is available and not switched off (``STCS_IDENT_NUMPY=1``)."""
+    return _damped_kernel is not None and not FORCE_NUMPY
+
+
+_FAILURES = {
+    1: "a damped mode could not be followed as the dampers grow",
+    2: "the damped modes are not ordered in frequency at the top of the band; ask for one mode more or fewer",
+    3: "the count of damped modes did not resolve (the determinant's phase varies too fast on the contour)",
+    4: "the argument principle counts another number of damped modes than were found: a mode was lost",
+    5: "two damped modes' paths ended on one root: a mode was lost",
+}
+
+
+PIN = 1e8  # a pinning spring, in units of the scaled matrix's entries (order one): roots within ~1e-8
+
+
+def _pinned_roots(batch, configs: np.ndarray, n: int) -> np.ndarray:
+    """The first ``n`` roots (rad/s) of ``configs`` with every damper's node held by a stiff spring."""
+    pinned = copy.copy(batch)
+    pinned._constant = batch._constant.copy()
+    nd = batch.n_dof
+    rows, cols = np.nonzero(batch.dashpots)
+    v = batch.v_dof[cols + 1]
+    pinned._constant[rows, v * nd + v] += PIN / batch._scale[rows, v] ** 2
+    config, mode = _items(0, len(batch), n)
+    keep = np.isin(config, configs)
+    return solve_modes(pinned, config[keep], mode[keep]).reshape(len(configs), n)
+
+
+def _solve_compiled(batch, configs, omega, pinned, n_modes, certify):
+    topo = batch.topology
+    model = {"none": 0, "uniform": 1, "per-segment": 2}[topo.tension_model]
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)
+    raw, status = _damped_kernel.solve(
+        topo.n_attachments, batch.n_dof, topo.n_h, int(topo.string), model,
+        i64(batch.v_dof), i64(batch.t_dof), i64(batch.h_dof),
+        f64(batch.length), f64(batch.m), f64(batch.EI), f64(batch.H), f64(batch.w), f64(batch.seg_len),
+        f64(batch.masses), f64(batch._constant), f64(batch._scale), f64(batch.dashpots), i64(configs), f64(omega), f64(pinned),
+        int(n_modes), int(bool(certify)),
+    )
+    status = np.frombuffer(status, dtype=np.intc)
+    if status.any():
+        raise ComputationError(_FAILURES[int(status[status != 0][0])])
+    return np.frombuffer(raw, dtype=complex).reshape(len(configs), n_modes + 1).copy()
 
 
 def determinant(batch, config: int, s: np.ndarray, t: float = 1.0) -> np.ndarray:
@@ -135,42 +195,75 @@ def determinant(batch, config: int, s: np.ndarray, t: float = 1.0) -> np.ndarray
     return np.linalg.det(K * scale[:, None] * scale[None, :])
 
 
-def _newton(batch, config: int, s: complex, t: float) -> complex | None:
-    """Newton's method on det K(s); None if it does not converge."""
-    for _ in range(NEWTON_ITER):
-        h = 1e-7 * abs(s)
-        f, fp, fm = determinant(batch, config, np.array([s, s + h, s - h]), t)
-        slope = (fp - fm) / (2 * h)
-        if not (np.isfinite(f) and np.isfinite(slope)) or slope == 0:
+def _secant(f, a: complex, fa: complex, b: complex) -> complex | None:
+    """A root of ``f`` by the secant method from ``a`` (where f is ``fa``) and ``b``; None if it fails."""
+    for _ in range(SECANT_ITER):
+        fb = f(b)
+        if not np.isfinite(fb):
             return None
-        step = f / slope
-        s -= step
-        if abs(step) <= NEWTON_RTOL * abs(s):
-            return s
+        if fb == 0:
+            return b
+        if fb == fa:
+            return None
+        step = fb * (b - a) / (fb - fa)
+        a, fa, b = b, fb, b - step
+        if abs(step) <= SECANT_RTOL * abs(b):
+            return b
     return None
 
 
-def follow_roots(batch, config: int, omega: np.ndarray) -> np.ndarray:
-    """Each undamped root ``omega`` (rad/s) followed as the dashpots grow to their values (complex s)."""
+def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray) -> np.ndarray:
+    """Each undamped root ``omega`` (rad/s) followed as the dashpots grow to their values (complex s).
+
+    First in one step. As t grows from 0 to ∞, a root moves from s₀ = iω to iω∞, the root with the
+    dampers' nodes pinned (``pinned``: its k-th root for the k-th mode, by interlacing). For one damper
+    the path is a Möbius map of t (det K is linear in t, and the dynamic stiffness the damper sees has a
+    zero at s₀ and a pole at iω∞), so 1/(s − s₀) = 1/(t δ₁) + 1/(iω∞ − s₀), δ₁ the first-order shift:
+    the secant method's start. If that fails or lands farther than ``JUMP`` times the distance to the
+    neighbouring roots from the prediction, by geometric steps in t (:func:`_follow_in_steps`).
+    """
     gaps = np.diff(np.concatenate(([0.0], omega, [2 * omega[-1] - omega[-2] if omega.size > 1 else 2 * omega[0]])))
     reach = JUMP * np.minimum(gaps[:-1], gaps[1:])
     out = np.empty(omega.size, dtype=complex)
+
+    def det(z, t):
+        return determinant(batch, config, np.array([z]), t)[0]
+
     for k, w in enumerate(omega):
-        t, dt, s, velocity = 0.0, FIRST_STEP, 1j * w, 0.0
-        while t < 1.0:
-            t1 = min(1.0, t + dt)
-            guess = s + velocity * (t1 - t)
-            s1 = _newton(batch, config, guess, t1)
-            if s1 is None or abs(s1 - s) > reach[k]:
-                dt *= 0.5
-                if dt < MIN_STEP:
-                    raise ComputationError(f"the damped mode {k + 1} near {w / (2 * math.pi):.6g} Hz could not be "
-                                           "followed as the dampers grow")
-                continue
-            velocity = (s1 - s) / (t1 - t)
-            s, t, dt = s1, t1, min(2 * dt, 1.0)
-        out[k] = s
+        s0, h = 1j * w, 1e-7 * w
+        f1 = det(s0, 1.0)
+        first = -f1 * 2 * h / (det(s0 + h, 0.0) - det(s0 - h, 0.0))  # the first-order shift
+        guess = s0 + 1 / (1 / first + 1 / (1j * (pinned[k] - w)))
+        s = _secant(lambda z: det(z, 1.0), s0, f1, guess)
+        if s is not None and abs(s - guess) <= reach[k]:
+            out[k] = s
+            continue
+        out[k] = _follow_in_steps(det, s0, first, reach[k], k)
     return out
+
+
+def _follow_in_steps(det, s0: complex, first: complex, reach: float, k: int) -> complex:
+    """The root from s₀ at t = 0 to t = 1 by geometric steps in t (a dashpot's effect spans decades)."""
+    t = min(1.0, START * reach / abs(first))  # where the first-order shift is a small fraction of the reach
+    s = _secant(lambda z: det(z, t), s0, det(s0, t), s0 + first * t)
+    previous, ratio = None, GROWTH
+    while s is not None and t < 1.0:
+        t1 = min(1.0, t * ratio)
+        if previous is None:
+            guess = s + first * (t1 - t)
+        else:  # linear in log t
+            guess = s + (s - previous[1]) * math.log(t1 / t) / math.log(t / previous[0])
+        s1 = _secant(lambda z: det(z, t1), s, det(s, t1), guess)
+        if s1 is None or abs(s1 - s) > reach:
+            ratio = math.sqrt(ratio)
+            if ratio < MIN_RATIO:
+                break
+            continue
+        previous, s, t, ratio = (t, s), s1, t1, min(ratio * ratio, GROWTH)
+    if s is None or t < 1.0:
+        raise ComputationError(f"the damped mode {k + 1} near {abs(s0) / (2 * math.pi):.6g} Hz could not be followed "
+                               "as the dampers grow")
+    return s
 
 
 def certify_count(batch, config: int, omega: np.ndarray, s: np.ndarray, n_modes: int) -> None:
