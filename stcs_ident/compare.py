@@ -19,8 +19,9 @@ from scipy.optimize import minimize_scalar
 
 from .formatting import percent_error
 from .forward import batch_frequencies
+from .forward.damped import complex_modes
 from .forward import reference as closed_form
-from .model import Campaign, Test
+from .model import Campaign, Test, has_dampers
 from .settings import Settings
 
 
@@ -39,6 +40,7 @@ class TestComparison:
     beam_pinned: np.ndarray
     measured: np.ndarray | None
     reference: dict[str, np.ndarray] = field(default_factory=dict)
+    damping: np.ndarray | None = None  # the DSM's damping ratios, with a damper (complex modes)
 
     def error(self, column: str) -> np.ndarray | None:
         """(computed − measured) / measured × 100 for one model column."""
@@ -54,6 +56,8 @@ class TestComparison:
             data[col] = getattr(self, col)
             if self.measured is not None:
                 data[f"{col}_error_%"] = self.error(col)
+        if self.damping is not None:
+            data["dsm_damping_%"] = 100 * self.damping
         for label, values in self.reference.items():
             data[label] = values
         return pd.DataFrame(data)
@@ -132,7 +136,8 @@ class ForwardResult:
                  "measured": floats(t.measured),
                  "errors": None if t.measured is None else
                  {c: floats(t.error(c)) for c in ("dsm", "taut_string", "beam_pinned")},
-                 "reference": {k: floats(v) for k, v in t.reference.items()}}
+                 "reference": {k: floats(v) for k, v in t.reference.items()},
+                 **({} if t.damping is None else {"damping": {"dsm": floats(t.damping)}})}
                 for t in self.tests
             ],
             "reference_checks": [
@@ -188,8 +193,13 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
         if test.modes is not None:
             shown = tuple(sorted(set(shown) | set(test.modes)))
         n = max(max(shown), 6 if n_modes is None else n_modes)
-        dsm_all = batch_frequencies(cable, atts, test.tension, n, tension_model=tension_model)
         idx = np.array(shown) - 1
+        damping = None
+        if has_dampers(atts):
+            modes = complex_modes(cable, atts, test.tension, n, tension_model=tension_model)
+            dsm_all, damping = modes.frequency, modes.damping[idx]
+        else:
+            dsm_all = batch_frequencies(cable, atts, test.tension, n, tension_model=tension_model)
         by_mode = dict(zip(test.modes or (), test.frequencies or ()))
         measured = None
         if test.frequencies is not None:
@@ -204,7 +214,7 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
             name=test.name, setup=test.setup, tension=test.tension, modes=shown, dsm=dsm_all[idx],
             taut_string=closed_form.taut_string(cable.length, cable.mass_per_length, test.tension, shown),
             beam_pinned=closed_form.beam_pinned(cable.length, cable.mass_per_length, test.tension, cable.EI, shown),
-            measured=measured, reference=reference,
+            measured=measured, reference=reference, damping=damping,
         ))
     checks = _reference_checks(campaign, [campaign.test(t.name) for t in out if t.name not in picked],
                                tension_model)

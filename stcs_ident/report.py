@@ -29,6 +29,8 @@ def forward_text(result: ForwardResult) -> str:
         refs = list(t.reference)
         widths = {label: max(len(label), 9) for label in refs}
         head += "".join(f" {label:>{widths[label]}}" for label in refs)
+        if t.damping is not None:
+            head += f" {'DSM ζ %':>8}"
         lines.append(head)
         errors = {c: t.error(c) for c in ("taut_string", "beam_pinned", "dsm")}
         for i, k in enumerate(t.modes):
@@ -37,6 +39,8 @@ def forward_text(result: ForwardResult) -> str:
                 err = errors[col]
                 row += f" {_fmt(float(getattr(t, col)[i]))} {_fmt(None if err is None else float(err[i]), 2, 7)}"
             row += "".join(f" {_fmt(float(t.reference[label][i]), 3, widths[label])}" for label in refs)
+            if t.damping is not None:
+                row += f" {_fmt(100 * float(t.damping[i]), 3, 8)}"
             lines.append(row)
         if t.measured is not None:
             errs = {c: rms(errors[c]) for c in errors}

@@ -213,7 +213,11 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
         ``mass_per_length``, ``end_a``, ``end_b`` (rotational stiffness,
         inf = clamped), and per attachment (last axis, one value per
         attachment in ascending nominal position) ``positions``,
-        ``masses``, ``stiffnesses``.
+        ``masses``, ``stiffnesses``, ``coefficients`` (a damper's dashpot,
+        N s/m).
+
+    With a dashpot (a :class:`~stcs_ident.model.Damper`) the modes are
+    complex and the frequencies are |s|/2π (:mod:`.damped`).
 
     Returns
     -------
@@ -222,6 +226,11 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
     if int(n_modes) < 1:
         raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
     n_modes = int(n_modes)
+    if _damped(attachments, overrides):  # complex modes: the frequency is |s|/2π
+        from .damped import batch_complex_modes
+
+        return np.abs(batch_complex_modes(cable, attachments, tension, n_modes, tension_model=tension_model,
+                                          **overrides)) / (2 * math.pi)
     shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
     total = math.prod(shape)
     if len(groups) == 1 and total <= CHUNK:  # the usual small batch: no scattering
@@ -242,6 +251,13 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
             if progress is not None:
                 progress(done, total)
     return out.reshape(shape + (n_modes,))
+
+
+def _damped(attachments, overrides) -> bool:
+    """Whether a dashpot is on: a damper among the attachments, or a non-zero ``coefficients`` override."""
+    if "coefficients" in overrides:
+        return bool(np.any(np.asarray(overrides["coefficients"], float) != 0))
+    return any(getattr(a, "coefficient", 0.0) for a in attachments)
 
 
 def _items(start, stop, n_modes):
