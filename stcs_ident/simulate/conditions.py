@@ -281,6 +281,10 @@ class RecordTruth:
         d[n] of :class:`TensionDrift` at the samples; None: constant.
     sensitivities : ndarray (N,) or None
         s_k = d ln f_k / d ln H; None without drift.
+    damping : ndarray (N,) or None
+        Each mode's damping ratio: the modal damping given, or, for a cable
+        with dampers, the complex mode's −Re(s)/|s| (its frequency above is
+        |s|/2π); at t = 0 under a drift.
     """
 
     frequencies: np.ndarray
@@ -289,6 +293,7 @@ class RecordTruth:
     n_samples: int
     relative_tension: np.ndarray | None = None
     sensitivities: np.ndarray | None = None
+    damping: np.ndarray | None = None
 
     @property
     def drifts(self) -> bool:

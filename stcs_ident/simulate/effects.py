@@ -18,7 +18,7 @@ from typing import Any
 from .. import effects as registry
 from ..effects.base import Truth
 from ..errors import ModelError
-from ..model import Attachment, Cable
+from ..model import Attachment, Cable, Damper
 
 __all__ = ["Effects", "true_model"]
 
@@ -130,7 +130,9 @@ def true_model(cable: Cable, attachments: Sequence[Attachment], tension: float,
         Sorted by position. An extra mass or spring is a new attachment
         named ``"(extra mass)"`` / ``"(extra spring)"``; attachments that
         end up at one position are merged into one (masses and stiffnesses
-        added, names joined with ``+``), as the solver needs distinct nodes.
+        added, names joined with ``+``), as the solver needs distinct nodes;
+        a :class:`~stcs_ident.model.Damper` stays a Damper (merged with
+        another, their dashpots add).
     tension : float
 
     Raises
@@ -156,9 +158,18 @@ def true_model(cable: Cable, attachments: Sequence[Attachment], tension: float,
 
 
 def _merge_coincident(atts: list[Attachment]) -> tuple[Attachment, ...]:
+    """One attachment per position: masses and springs added; with a damper among them a Damper, whose
+    dashpots add too (parallel dashpots to ground)."""
     merged: dict[float, Attachment] = {}
     for a in atts:
         b = merged.get(a.position)
-        merged[a.position] = a if b is None else Attachment(
-            f"{b.name}+{a.name}", a.position, b.mass + a.mass, b.stiffness + a.stiffness)
+        if b is None:
+            merged[a.position] = a
+            continue
+        name, mass, stiffness = f"{b.name}+{a.name}", b.mass + a.mass, b.stiffness + a.stiffness
+        if isinstance(a, Damper) or isinstance(b, Damper):
+            coefficient = sum(x.coefficient for x in (a, b) if isinstance(x, Damper))
+            merged[a.position] = Damper(name, a.position, mass, stiffness, coefficient=coefficient)
+        else:
+            merged[a.position] = Attachment(name, a.position, mass, stiffness)
     return tuple(sorted(merged.values(), key=lambda a: a.position))

@@ -19,6 +19,13 @@ effects (:class:`~stcs_ident.simulate.effects.Effects`) act on the true
 model only. :func:`~stcs_ident.simulate.simulate_campaign.simulate_campaign`
 writes a whole campaign directory from them, for tests and benchmarks.
 
+A cable with a :class:`~stcs_ident.model.Damper` among its true attachments
+has non-proportional damping and complex modes: its records are made by
+complex modal superposition of a finite-element model that carries the
+dashpots exactly (:mod:`~stcs_ident.simulate.damped_response`), with the
+same excitations and disturbances; ``damping`` is then the cable's own
+(intrinsic) part. Without a damper nothing of that runs.
+
 Field-like disturbances (coloured loading, a drifting tension, pink noise,
 mains hum, offsets, float32 samples) are off by default and given as one
 :class:`~stcs_ident.simulate.disturbances.FieldConditions`; without them a
@@ -37,10 +44,11 @@ import numpy as np
 from ..errors import ModelError
 from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
-from ..model import Attachment, Cable, real_number
+from ..model import Attachment, Cable, has_dampers, real_number
 from ..spectra.record import Record
 from ..spectra.record import sampling_rate as record_sampling_rate
 from .conditions import FieldConditions, RecordTruth
+from .damped_response import damped_record
 from .disturbances import (
     apply_sensor_disturbances,
     check_field,
@@ -143,7 +151,8 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
     damping : float or sequence of float
         Modal damping ratio(s), 0 < ζ < 1: one for all modes, or one per
         mode from mode 1 (at least as many as modes simulated; extra
-        entries are ignored).
+        entries are ignored). With dampers, the cable's own (intrinsic)
+        damping of its undamped modes; the dashpots add theirs.
     impulses : sequence of Impulse
         Blows, evaluated exactly.
     ambient : Ambient or None
@@ -207,7 +216,8 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
 
     The parameters are :func:`simulate_record`'s. The
     :class:`~stcs_ident.simulate.disturbances.RecordTruth` gives the true
-    model's frequencies and, under a tension drift, the relative tension at
+    model's frequencies and damping ratios (with dampers, the complex
+    modes' |s|/2π and −Re(s)/|s|) and, under a tension drift, the relative tension at
     every sample, each mode's sensitivity to it, the instantaneous and the
     time-averaged frequencies.
     """
@@ -226,6 +236,9 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
     names = _channel_names(channel_names, len(x))
     if field is not None:
         check_field(field, len(x), fs, ambient is not None)
+    if has_dampers(atts):
+        return _damped(cable, atts, tension, x, fs, n_samples, names, damping, impulses, ambient, snr_db, n_modes,
+                       seed, field, progress)
     shapes = modal_basis(cable, atts, tension, fs, n_modes)
     zeta = modal_damping(damping, len(shapes.frequencies))
     rng = np.random.default_rng(seed)
@@ -237,7 +250,7 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
                                      uncorrelated_length=UNCORRELATED_LENGTH)
         force_sqrt = matrix_sqrt(cov)
     kicks = [(imp.time, shapes([imp.position])[0] * imp.magnitude) for imp in impulses]
-    truth = RecordTruth(np.asarray(shapes.frequencies, dtype=float), tension, fs, n_samples)
+    truth = RecordTruth(np.asarray(shapes.frequencies, dtype=float), tension, fs, n_samples, damping=zeta)
     lowpass = field.ambient_lowpass if field is not None else None
     drift = field.drift if field is not None else None
     if lowpass is None and drift is None:
@@ -246,11 +259,30 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
         if drift is not None:
             d = relative_tension(drift, n_samples, fs, own_rng)
             s = tension_sensitivities(cable, atts, tension, len(shapes.frequencies))
-            truth = RecordTruth(truth.frequencies, tension, fs, n_samples, d, s)
+            truth = RecordTruth(truth.frequencies, tension, fs, n_samples, d, s, damping=zeta)
         clean = superpose_field(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng,
                                 force_filter=None if lowpass is None else lowpass_force_filter(lowpass, fs),
                                 relative_tension=truth.relative_tension, sensitivities=truth.sensitivities,
                                 progress=progress)
+    signal = _with_noise(clean, snr_db, rng)
+    if field is not None:
+        signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
+    return Record(signal, fs, names, x), truth
+
+
+def _damped(cable, atts, tension, x, fs, n_samples, names, damping, impulses, ambient, snr_db, n_modes, seed, field,
+            progress) -> tuple[Record, RecordTruth]:
+    """simulate_record_with_truth for a cable with dampers: complex modes (:mod:`.damped_response`)."""
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
+                                or n_modes < 1):
+        raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
+    modal_damping(damping, 1)  # its checks before any work
+    rng = np.random.default_rng(seed)
+    own_rng = field_rng(rng) if field is not None else None
+    load = None if ambient is None else (ambient.rms_pressure, ambient.correlation_length, UNCORRELATED_LENGTH)
+    clean, truth = damped_record(cable, atts, tension, x, fs, n_samples, damping=lambda n: modal_damping(damping, n),
+                                 n_modes=n_modes, band_fraction=NYQUIST_FRACTION, impulses=impulses,
+                                 ambient_load=load, field=field, rng=rng, field_rng=own_rng, progress=progress)
     signal = _with_noise(clean, snr_db, rng)
     if field is not None:
         signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)

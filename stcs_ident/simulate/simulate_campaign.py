@@ -25,7 +25,7 @@ from ..campaign_io import CAMPAIGN_FILE, campaign_to_toml
 from ..errors import ModelError
 from ..files import whole_directory
 from ..forward.dsm import natural_frequencies
-from ..model import Cable, Campaign, Test
+from ..model import Attachment, Cable, Campaign, Damper, Test, has_dampers
 from .conditions import FieldConditions
 from .disturbances import write_record_as
 from .effects import Effects, true_model
@@ -59,7 +59,9 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
     ``campaign.toml`` describing the **nominal** campaign only (its cable,
     setups and the selected tests, each with ``record`` and without
     ``frequencies``), and ``truth.json`` with the true parameters and
-    natural frequencies per test (not referenced by the campaign). The
+    natural frequencies per test (not referenced by the campaign; for a
+    setup with dampers, the complex modes' frequencies |s|/2π, their damping
+    ratios under ``"mode_damping"`` and each damper's ``"coefficient"``). The
     directory appears whole or not at all: it is built beside ``out_dir``
     under a temporary name, then renamed.
 
@@ -147,25 +149,38 @@ def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effect
                                                       effects=effects, seed=stream, field=field, **options)
     write_record_as(record, path, float32=field is not None and field.float32)
     cable, atts, tension = true_model(campaign.cable, attachments, test.tension, effects)
-    shapes = modal_basis(cable, atts, tension, options["sampling_rate"], options["n_modes"])
-    n = len(shapes.frequencies)
+    damped = has_dampers(atts)
+    if damped:  # the complex modes' |s|/2π, as the record holds them
+        frequencies = record_truth.frequencies
+    else:
+        frequencies = modal_basis(cable, atts, tension, options["sampling_rate"], options["n_modes"]).frequencies
+    n = len(frequencies)
     truth = {
         "name": test.name, "setup": test.setup, "stated_tension": test.tension, "tension": tension,
         "effects": effects.to_dict() if effects else {}, "effect_names": effects.names if effects else [],
         "cable": _cable_json(cable),
-        "attachments": [{"name": a.name, "position": a.position, "mass": a.mass, "stiffness": a.stiffness}
-                        for a in atts],
+        "attachments": [_attachment_json(a) for a in atts],
         "modes": list(range(1, n + 1)),
-        "frequencies": [float(f) for f in shapes.frequencies],
+        "frequencies": [float(f) for f in frequencies],
         "nominal_frequencies": [float(f) for f in natural_frequencies(campaign.cable, attachments, test.tension, n)],
         "damping": [float(z) for z in modal_damping(options["damping"], n)],
     }
+    if damped:
+        # "damping" above is the cable's own (intrinsic) part; the complex modes' ratios are the record's.
+        truth["mode_damping"] = [float(z) for z in record_truth.damping]
     if field is not None:
         truth["field"] = field.to_dict()
         if record_truth.drifts:
             truth["time_averaged_frequencies"] = [float(f) for f in record_truth.mean_frequencies]
             truth["mean_tension"] = record_truth.mean_tension
     return truth
+
+
+def _attachment_json(a: Attachment) -> dict:
+    out = {"name": a.name, "position": a.position, "mass": a.mass, "stiffness": a.stiffness}
+    if isinstance(a, Damper):
+        out["coefficient"] = a.coefficient
+    return out
 
 
 def _cable_json(cable: Cable) -> dict:
