@@ -23,7 +23,7 @@ import numpy as np
 from .plots import new_figure, save_figure
 
 _SYMBOL = {"tension": "H", "EI": "EI", "length": "l", "mass_per_length": "m", "position": "x", "mass": "M",
-           "stiffness": "s"}
+           "stiffness": "s", "coefficient": "c"}
 
 
 def parameter_label(p) -> str:

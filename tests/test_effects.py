@@ -20,7 +20,7 @@ from stcs_ident.diagnose import diagnose
 from stcs_ident.effects.base import Effect, Option, Quantity, Truth, positive_ratio
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify.problem import Measurement
-from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.simulate.effects import Effects, true_model
 
 PACKAGE = Path(stcs_ident.__file__).parent
@@ -29,6 +29,13 @@ BUILT_IN = effects.names()
 
 CABLE = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5)
 W1 = Attachment("W1", 2.7, mass=15.0)
+#: A damper near end A, optimal for mode 1 (η = c π x_d/(l √(H m)) = 1 at 4e5 N), for the damper effects.
+D1 = Damper("D1", 0.2, coefficient=math.sqrt(4e5 * 30.0) / (math.pi * 0.2 / 8.0))
+
+
+def _points(name: str) -> list:
+    """The recorded attachments of the samples: W1, and D1 for the damper effects."""
+    return [W1, D1] if name.startswith("damper") else [W1]
 
 
 # --------------------------------------------------------------------------
@@ -64,9 +71,10 @@ def test_each_effect_name_is_defined_in_exactly_one_module_of_the_effects_packag
 
 
 def test_no_other_list_of_effect_names_remains_in_the_package():
-    """Outside stcs_ident/effects/ no code string names an effect. ``tension`` and ``length`` are left out
-    of the check: they are also the names of identification parameters and solver overrides."""
-    only_effects = set(BUILT_IN) - {"tension", "length"}
+    """Outside stcs_ident/effects/ no code string names an effect. ``tension``, ``length`` and ``damper`` are
+    left out of the check: they are also the names of identification parameters, solver overrides and the
+    campaign's ``[[setup.damper]]`` table."""
+    only_effects = set(BUILT_IN) - {"tension", "length", "damper"}
     for path, tree in _modules():
         rel = path.relative_to(PACKAGE).as_posix()
         if rel.startswith("effects/"):
@@ -107,6 +115,8 @@ SAMPLES = {
     "unmodeled_support": ((1e4, 5.0), (1e4, math.nan)),
     "end_restraint": ((1e5, math.inf), (1.0,)),
     "length": (1.01, 0.0),
+    "damper": ((1e4, 5.0), (-1.0, 5.0)),
+    "damper_coefficient": ({"D1": 2e3}, {"D1": -1.0}),
 }
 
 
@@ -130,8 +140,8 @@ def test_every_effect_changes_the_true_model_and_round_trips_to_json(name):
     good, bad = SAMPLES[name]
     hidden = Effects(**{effect.truth_key: good})
     assert hidden.names == [name]
-    nominal = true_model(CABLE, [W1], 4e5, None)
-    true = true_model(CABLE, [W1], 4e5, hidden)
+    nominal = true_model(CABLE, _points(name), 4e5, None)
+    true = true_model(CABLE, _points(name), 4e5, hidden)
     assert true != nominal
     f0 = batch_frequencies(*nominal, 4)
     f1 = batch_frequencies(*true, 4)
@@ -145,9 +155,10 @@ def test_every_effect_changes_the_true_model_and_round_trips_to_json(name):
 
 @pytest.mark.parametrize("name", BUILT_IN)
 def test_every_effect_frees_parameters_and_reports_them_in_its_own_units(name):
-    campaign = Campaign("c", CABLE, (Setup("S", (W1,)),), (Test("T1", "S", 4e5), Test("T2", "S", 5e5)))
+    points = _points(name)
+    campaign = Campaign("c", CABLE, (Setup("S", tuple(points)),), (Test("T1", "S", 4e5), Test("T2", "S", 5e5)))
     d = diagnose(campaign, effects=name, max_effects=1, workers=1,
-                 picked={t.name: Measurement(t, np.arange(1, 7), batch_frequencies(CABLE, [W1], t.tension, 6),
+                 picked={t.name: Measurement(t, np.arange(1, 7), batch_frequencies(CABLE, points, t.tension, 6),
                                              1e-4 * np.ones(6), "given") for t in campaign.tests})
     fit = d.fits[(name,)]
     values, sigmas = d.parameters(fit)

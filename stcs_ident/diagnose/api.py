@@ -19,6 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from ..compare import ForwardResult, compare_forward
+from ..effects import registry
 from ..errors import InputError
 from ..identify.problem import Measurement, gather_measurements
 from ..model import Campaign
@@ -104,7 +105,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     usable = []
     for e in names:
         why = applicable(campaign, measured_tests, e)
-        if why is None:
+        if why is None or (requested and registry.get(e).opt_in and registry.tolerance(campaign, e) != 0):
             usable.append(e)
         elif requested:
             raise InputError(why, field="effects")

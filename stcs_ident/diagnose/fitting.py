@@ -308,7 +308,7 @@ def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None
     """
     start = problem.start.copy()
     for j, p in enumerate(problem.parameters):
-        if p.slots and p.kind in ("mass", "stiffness"):
+        if p.slots and p.kind in ("mass", "stiffness", "coefficient"):
             start[j] = 0.01 * problem.upper[j]
     rows = [start] if nominal or not seeds else []
     for seed in seeds:

@@ -249,7 +249,7 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
 
 
 #: Parameter kinds that give an effect without a tolerance its size.
-AMPLITUDES = ("mass", "stiffness", "end_stiffness")
+AMPLITUDES = ("mass", "stiffness", "coefficient", "end_stiffness")
 
 
 def insignificant(fit: HypothesisFit) -> tuple[str, ...]:

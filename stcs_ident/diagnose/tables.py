@@ -16,7 +16,7 @@ from ..formatting import percent_error
 
 #: Units of the effect parameters (the keys of ``Diagnosis.parameters``).
 UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",
-         "mass": "kg", "position": "m", "stiffness": "N/m"}
+         "mass": "kg", "position": "m", "stiffness": "N/m", "coefficient": "N s/m"}
 #: Files of the report, besides the figures.
 CSV_FILES = ("ranking.csv", "frequencies.csv", "gain.csv", "nominal_comparison.csv", "cause.csv")
 

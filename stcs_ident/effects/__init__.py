@@ -20,6 +20,8 @@ from . import (
     attachment_mass,
     attachment_position,
     bending_stiffness,
+    damper,
+    damper_coefficient,
     end_restraint,
     length,
     tension,
@@ -42,7 +44,7 @@ from .registry import (
 )
 
 for _module in (tension, bending_stiffness, attachment_position, attachment_mass, unmodeled_mass, unmodeled_support,
-                end_restraint, length):
+                end_restraint, length, damper, damper_coefficient):
     register(_module.EFFECT)
 
 __all__ = [

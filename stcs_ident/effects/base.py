@@ -149,6 +149,9 @@ class Effect:
     truth_key: ClassVar[str] = ""
     #: The ``simulate`` option that hides it (None: none).
     option: ClassVar[Option | None] = None
+    #: Considered by the diagnosis when asked for by name even where :meth:`applicable` gives a reason
+    #: (a reason why it is not considered by default).
+    opt_in: ClassVar[bool] = False
 
     def __repr__(self) -> str:
         return f"<effect {self.name}>"

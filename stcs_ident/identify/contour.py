@@ -46,7 +46,8 @@ SCALED_BANDS = ("the misfit is {misfit:.3g} times the stated frequency uncertain
 #: Grid ranges by kind (variable units), clipped to the bounds.
 DEFAULT_RANGES = {
     "tension": (0.9, 1.1), "EI": (0.5, 1.5), "length": (0.97, 1.03), "mass_per_length": (0.9, 1.1),
-    "position": (0.9, 1.1), "mass": (0.5, 1.5), "stiffness": (0.5, 1.5), "end_stiffness": (0.0, 1.0),
+    "position": (0.9, 1.1), "mass": (0.5, 1.5), "stiffness": (0.5, 1.5), "coefficient": (0.5, 1.5),
+    "end_stiffness": (0.0, 1.0),
 }
 #: Points per side of the finer grid laid over a small region.
 ZOOM_POINTS = 101

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..model import Campaign, Test
+from ..model import Campaign, Damper, Test
 
 #: Kinds of parameter, what they belong to and the override they change.
 KINDS = {
@@ -44,6 +44,7 @@ KINDS = {
     "position": ("attachment", "positions"),
     "mass": ("attachment", "masses"),
     "stiffness": ("attachment", "stiffnesses"),
+    "coefficient": ("attachment", "coefficients"),
     "end_stiffness": ("end", None),
 }
 
@@ -52,6 +53,7 @@ KINDS = {
 ALIASES = {
     "ei": "EI",
     "attachment_stiffness": "stiffness",
+    "damper": "coefficient",
     "rotational_stiffness": "end_stiffness",
 }
 
@@ -72,6 +74,7 @@ DEFAULT_BOUNDS = {
     "mass_per_length": (0.5, 2.0),
     "mass": (0.0, 10.0),
     "stiffness": (0.0, 100.0),
+    "coefficient": (0.01, 100.0),
     "end_stiffness": (0.0, 1.0),
 }
 
@@ -315,9 +318,11 @@ def _expand(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | 
 def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
                            default: tuple[float, float]) -> list[Parameter]:
     setups = list(dict.fromkeys(t.setup for t in tests))
-    found = [(s, i, a) for s in setups for i, a in enumerate(campaign.setup(s).attachments)]
+    found = [(s, i, a) for s in setups for i, a in enumerate(campaign.setup(s).attachments)
+             if kind != "coefficient" or isinstance(a, Damper)]
     if not found:
-        raise InputError(f"{name}: the setups of the selected tests have no attachment", field="params")
+        noun = "damper" if kind == "coefficient" else "attachment"
+        raise InputError(f"{name}: the setups of the selected tests have no {noun}", field="params")
     counts: dict[str, int] = {}
     for _, _, a in found:
         counts[a.name] = counts.get(a.name, 0) + 1
@@ -333,7 +338,7 @@ def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str,
     out = []
     cable = campaign.cable
     for s, i, a, label in chosen:
-        nominal = {"position": a.position, "mass": a.mass, "stiffness": a.stiffness}[kind]
+        nominal = getattr(a, kind)
         if kind == "position":
             lo, hi = _POSITION_MARGIN * cable.length / nominal, (1 - _POSITION_MARGIN) * cable.length / nominal
             out.append(Parameter(kind, label, nominal, nominal, lo, hi, setup=s, index=i))
@@ -342,12 +347,20 @@ def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str,
             out.append(Parameter(kind, label, nominal, nominal, *default, setup=s, index=i))
             continue
         # Zero nominal: the variable is the value itself, bounded by the cable's own scale.
-        if kind == "mass":
+        if kind == "coefficient":
+            upper = coefficient_upper(campaign)
+        elif kind == "mass":
             upper = cable.mass_per_length * cable.length
         else:
             upper = 100.0 * _mean_tension(campaign) / cable.length
         out.append(Parameter(kind, label, 0.0, 1.0, 0.0, upper, setup=s, index=i))
     return out
+
+
+def coefficient_upper(campaign: Campaign) -> float:
+    """Largest dashpot worth a search (N s/m): 1000 √(H m), thirty times the optimum of mode 1 for a
+    damper at 1 % of the length (η = c π x_d/(l √(H m)) = 1)."""
+    return 1e3 * math.sqrt(_mean_tension(campaign) * campaign.cable.mass_per_length)
 
 
 def _mean_tension(campaign: Campaign) -> float:

@@ -192,8 +192,8 @@ class Problem:
                 raise InputError(f"{q.name} belongs to none of the selected tests", field="params")
         self._atts = {m.name: campaign.setup(m.test.setup).attachments for m in self.measurements}
         self._nominal_atts = {
-            name: {KINDS[k][1]: np.array([getattr(a, k) for a in atts], float)
-                   for k in ("position", "mass", "stiffness")}
+            name: {KINDS[k][1]: np.array([getattr(a, k, 0.0) for a in atts], float)
+                   for k in ("position", "mass", "stiffness", "coefficient")}
             for name, atts in self._atts.items()
         }
         groups: dict[str, list[int]] = {}
