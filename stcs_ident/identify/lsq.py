@@ -118,14 +118,15 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
                                   stacklevel=4)
     before = problem.predict(problem.start)
     after = problem.predict(x)
+    damping = problem.damping_columns(before, after)
     tests, k = [], 0
-    for m in problem.measurements:
+    for i, m in enumerate(problem.measurements):
         sl = slice(k, k + m.modes.size)
         k += m.modes.size
         reference = {label: np.array([dict(zip(m.test.modes or (), values)).get(int(k), np.nan) for k in m.modes])
                      for label, values in m.test.reference}
         tests.append(TestFit(m.name, m.test.setup, tuple(int(v) for v in m.modes), m.frequencies, m.uncertainty,
-                             m.source, before[sl], after[sl], reference))
+                             m.source, before[sl], after[sl], reference, damping[i]))
     return IdentificationResult(
         method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
         uncertainty=sigma if uncertainty is None else np.asarray(uncertainty, float),

@@ -21,7 +21,8 @@ import numpy as np
 
 from ..errors import ComputationError, InputError, ModelError
 from ..forward import batch_frequencies
-from ..model import Campaign, Test
+from ..forward.damped import batch_complex_modes
+from ..model import Campaign, Test, has_dampers
 from .parameters import KINDS, Parameter, overrides_for
 
 #: Relative step of the numerical Jacobian (the solver is accurate to 1e-12).
@@ -32,6 +33,11 @@ JACOBIAN_STEP = 1e-6
 #: relative at g = 1.25e-3 l on a hanger (ξ ≈ 11), 2e-4 at 1.25e-5 l, and a non-finite matrix at
 #: 2e-10 l. At 1e-3 l (8 mm on an 8 m hanger) the model stays accurate to a few 1e-9.
 MIN_GAP = 1e-3
+#: Spread (absolute) of a cable's own damping ratio across modes, added in quadrature to a measured
+#: damping ratio's σ: the model holds the dampers' damping and one own ratio for all modes (a nuisance
+#: profiled out), while a cable's own damping varies from mode to mode by a few 1e-4 (aerodynamic
+#: damping ∝ 1/f, friction at the anchorages).
+DAMPING_SPREAD = 3e-4
 
 
 @dataclass(frozen=True)
@@ -49,6 +55,9 @@ class Measurement:
     source : str
         Where the uncertainty comes from: ``"spectra"``, ``"table rounding
         (0.01 Hz / sqrt 12)"`` or ``"given"``.
+    damping, damping_uncertainty : ndarray or None
+        Measured damping ratios and their 1σ, ordered by ``modes`` (NaN
+        where not measured); used with a damper in the model.
     """
 
     test: Test
@@ -56,6 +65,8 @@ class Measurement:
     frequencies: np.ndarray
     uncertainty: np.ndarray
     source: str
+    damping: np.ndarray | None = None
+    damping_uncertainty: np.ndarray | None = None
 
     def __post_init__(self):
         where = f"test[{self.test.name}]"
@@ -74,6 +85,21 @@ class Measurement:
         object.__setattr__(self, "modes", modes[order])
         object.__setattr__(self, "frequencies", freqs[order])
         object.__setattr__(self, "uncertainty", unc[order])
+        if (self.damping is None) != (self.damping_uncertainty is None):
+            raise InputError("damping ratios need their uncertainties", field=f"{where}.damping")
+        if self.damping is not None:
+            zeta = np.broadcast_to(np.asarray(self.damping, float), freqs.shape)[order]
+            zeta_unc = np.broadcast_to(np.asarray(self.damping_uncertainty, float), freqs.shape)[order]
+            object.__setattr__(self, "damping", zeta)
+            object.__setattr__(self, "damping_uncertainty", zeta_unc)
+
+    @property
+    def damping_used(self) -> np.ndarray:
+        """Which modes have a usable damping ratio (finite, with a finite σ > 0)."""
+        if self.damping is None:
+            return np.zeros(self.modes.size, bool)
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(self.damping) & np.isfinite(self.damping_uncertainty) & (self.damping_uncertainty > 0)
 
     @property
     def name(self) -> str:
@@ -113,7 +139,11 @@ def as_measurement(test: Test, picked) -> Measurement:
         raise InputError("picked frequencies need modes, frequencies and uncertainty", field=f"test[{test.name}]")
     if len(modes) == 0:
         raise InputError("no mode was picked from the record", field=f"test[{test.name}].record")
-    return Measurement(test, np.array(modes), np.array(freqs), np.array(unc), "spectra")
+    zeta, zeta_unc = getattr(picked, "damping", None), getattr(picked, "damping_uncertainty", None)
+    if zeta is None or zeta_unc is None:
+        zeta = zeta_unc = None
+    return Measurement(test, np.array(modes), np.array(freqs), np.array(unc), "spectra",
+                       None if zeta is None else np.array(zeta, float), None if zeta is None else np.array(zeta_unc, float))
 
 
 def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
@@ -176,11 +206,18 @@ class Problem:
     """
 
     def __init__(self, campaign: Campaign, measurements: Sequence[Measurement], parameters: Sequence[Parameter],
-                 tension_model: str = "uniform"):
+                 tension_model: str = "uniform", use_damping: bool | None = None):
         self.campaign = campaign
         self.measurements = list(measurements)
         self.parameters = tuple(parameters)
         self.tension_model = tension_model
+        damped = any(has_dampers(campaign.setup(m.test.setup).attachments) for m in self.measurements)
+        measured = any(m.damping_used.any() for m in self.measurements)
+        #: Whether measured damping ratios are data (default: with a damper in the model and a ratio measured).
+        self.use_damping = (damped and measured) if use_damping is None else bool(use_damping and measured)
+        self._zeta_used = [m.damping_used if self.use_damping else np.zeros(m.modes.size, bool)
+                           for m in self.measurements]
+        self.n_frequencies = int(sum(m.modes.size for m in self.measurements))
         n, p = self.n_data, len(self.parameters)
         if p == 0:
             raise InputError("no free parameter", field="params")
@@ -200,15 +237,19 @@ class Problem:
         for i, m in enumerate(self.measurements):
             groups.setdefault(m.test.setup, []).append(i)
         self._groups = list(groups.values())
-        self.measured = np.concatenate([m.frequencies for m in self.measurements])
-        self.sigma = np.concatenate([m.uncertainty for m in self.measurements])
+        self.measured = np.concatenate([m.frequencies for m in self.measurements]
+                                       + [m.damping[u] for m, u in zip(self.measurements, self._zeta_used) if u.any()])
+        self.sigma = np.concatenate([m.uncertainty for m in self.measurements]
+                                    + [np.hypot(m.damping_uncertainty[u], DAMPING_SPREAD)
+                                       for m, u in zip(self.measurements, self._zeta_used) if u.any()])
         self.lower = np.array([q.lower for q in self.parameters])
         self.upper = np.array([q.upper for q in self.parameters])
         self.start = np.array([q.start for q in self.parameters])
 
     @property
     def n_data(self) -> int:
-        return int(sum(m.modes.size for m in self.measurements))
+        """Frequencies, and the damping ratios when they are data."""
+        return self.n_frequencies + int(sum(u.sum() for u in self._zeta_used))
 
     @property
     def names(self) -> list[str]:
@@ -233,6 +274,7 @@ class Problem:
         k = X.shape[0]
         cable = self.campaign.cable
         out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
+        zeta = [np.full((k, int(u.sum())), np.nan) for u in self._zeta_used]
         # One solver call per setup: the tests of a setup differ only in their overrides' values.
         for group in self._groups:
             first = self.measurements[group[0]]
@@ -245,28 +287,68 @@ class Problem:
             sub = {key: v[ok] for key, v in ov.items()}
             tension = sub.pop("tension")
             n_modes = max(int(self.measurements[i].modes.max()) for i in group)
+            damped = self.use_damping and any(self._zeta_used[i].any() for i in group)
             try:
-                F = self._solve(self._atts[first.name], tension, n_modes, sub)
+                F, Z = self._solve(self._atts[first.name], tension, n_modes, sub, damped)
             except ModelError as err:
                 raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
             full = np.full((ok.size, n_modes), np.nan)
             full[ok] = F
+            if damped:
+                full_zeta = np.full((ok.size, n_modes), np.nan)
+                full_zeta[ok] = Z
             for j, i in enumerate(group):
-                out[i] = full[j * k:(j + 1) * k, self.measurements[i].modes - 1]
-        F = np.concatenate(out, axis=1)
+                m = self.measurements[i]
+                out[i] = full[j * k:(j + 1) * k, m.modes - 1]
+                if damped:
+                    zeta[i] = full_zeta[j * k:(j + 1) * k, m.modes[self._zeta_used[i]] - 1]
+        F = np.concatenate(out + [z for z in zeta if z.shape[1]], axis=1)
+        if self.n_data > self.n_frequencies:
+            F[:, self.n_frequencies:] += self._own_damping(F[:, self.n_frequencies:])
         return F[0] if single else F
 
-    def _solve(self, atts, tension: np.ndarray, n_modes: int, overrides: dict) -> np.ndarray:
-        """The solver on many rows; a row whose roots do not converge (an extreme trial point of a
-        fit) becomes NaN instead of failing the whole batch."""
+    def damping_columns(self, before: np.ndarray, after: np.ndarray) -> list[dict[str, np.ndarray]]:
+        """Per measurement, the measured damping ratios, their σ and the model's ``before`` and ``after`` (two
+        :meth:`predict` rows), by mode, NaN where not measured; empty dicts when damping is not data."""
+        out, k = [], self.n_frequencies
+        for m, used in zip(self.measurements, self._zeta_used):
+            if not self.use_damping:
+                out.append({})
+                continue
+            columns = {"measured": np.where(used, m.damping, np.nan), "uncertainty": np.where(used, m.damping_uncertainty,
+                                                                                             np.nan)}
+            for key, row in (("before", before), ("after", after)):
+                columns[key] = np.full(m.modes.size, np.nan)
+                columns[key][used] = row[k:k + int(used.sum())]
+            k += int(used.sum())
+            out.append(columns)
+        return out
+
+    def _own_damping(self, model: np.ndarray) -> np.ndarray:
+        """The cable's own damping ratio per row, (k, 1): the weighted mean of measured − model damping ratios
+        (≥ 0), profiled out as a linear nuisance (the model's ratios are the dampers' alone)."""
+        measured = self.measured[self.n_frequencies:]
+        w = self.sigma[self.n_frequencies:] ** -2
+        own = np.sum(w * (measured - model), axis=1, keepdims=True) / np.sum(w)
+        return np.maximum(own, 0.0)
+
+    def _solve(self, atts, tension: np.ndarray, n_modes: int, overrides: dict,
+               damped: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+        """Frequencies (and, when ``damped``, damping ratios) on many rows; a row whose roots do not converge
+        (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
         cable = self.campaign.cable
         try:
-            return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model, **overrides)
+            if damped:
+                s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model, **overrides)
+                return np.abs(s) / (2 * math.pi), -s.real / np.abs(s)
+            return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
+                                     **overrides), None
         except ComputationError:
             if tension.size == 1:
-                return np.full((1, n_modes), np.nan)
-        return np.concatenate([self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()})
-                               for i in range(tension.size)])
+                return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
+        rows = [self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()}, damped)
+                for i in range(tension.size)]
+        return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows]) if damped else None
 
     def residuals(self, x) -> np.ndarray:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""

@@ -47,6 +47,11 @@ class TestFit:
         Frequencies computed by others for the same modes (the test's
         ``reference`` columns, e.g. the paper's own corrected values), NaN
         where missing.
+    damping : dict of str to ndarray
+        With a damper and measured damping ratios: ``measured``,
+        ``uncertainty``, ``before`` and ``after`` ratios per mode (NaN where
+        not measured; the model's include the fitted own damping of the
+        cable). Empty otherwise.
     """
 
     __test__ = False
@@ -60,6 +65,7 @@ class TestFit:
     before: np.ndarray
     after: np.ndarray
     reference: dict[str, np.ndarray] = field(default_factory=dict)
+    damping: dict[str, np.ndarray] = field(default_factory=dict)
 
     def reference_error(self, label: str) -> np.ndarray:
         """(reference − measured) / measured × 100 for one reference column."""
@@ -200,7 +206,8 @@ class IdentificationResult:
                  "before": _floats(t.before), "after": _floats(t.after),
                  "before_error": _floats(t.before_error), "after_error": _floats(t.after_error),
                  "uncertainty": _floats(t.uncertainty), "uncertainty_source": t.source,
-                 "reference": {k: _floats(v) for k, v in t.reference.items()}}
+                 "reference": {k: _floats(v) for k, v in t.reference.items()},
+                 **({"damping": {k: _floats(v) for k, v in t.damping.items()}} if t.damping else {})}
                 for t in self.tests
             ],
             "correlation": None if self.correlation is None else

@@ -53,6 +53,12 @@ def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
     return head, rows, labels
 
 
+def _damping_rows(t) -> list[list[str]]:
+    z = t.damping
+    return [[str(k)] + [number(100 * z[key][i], "{:.3f}") for key in ("measured", "uncertainty", "before", "after")]
+            for i, k in enumerate(t.modes) if math.isfinite(z["measured"][i])]
+
+
 def _parameter_lines(result) -> list[list[str]]:
     out = []
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
@@ -93,6 +99,10 @@ def format_result(result, style: str = "text") -> str:
         lines += [f"#### {title}", ""] if md else [f"Test {title}"]
         lines += table_lines(head, rows, style)
         lines.append("")
+        if t.damping:
+            lines += [f"Damping ratios of {t.name} (%; the model's include the cable's own, fitted)", ""]
+            lines += table_lines(["mode", "measured", "± 1 sd", "before", "corrected"], _damping_rows(t), style)
+            lines.append("")
     if md and result.notes:
         lines += ["Notes:", ""] + [f"- {n}" for n in result.notes] + [""]
     elif not md:

@@ -35,7 +35,7 @@ class TestSpectra:
     ----------
     name, record : test name and record path
     modes, frequencies, uncertainty : assigned peaks, ordered by mode (Hz)
-    damping : damping ratios (NaN where not estimated)
+    damping, damping_uncertainty : damping ratios and their 1σ (NaN where not estimated)
     channels : per mode, the channels in which the peak was seen
     doubtful : per mode, True where the mode number is doubtful
     unassigned : (frequency, uncertainty) of peaks left without a number
@@ -57,6 +57,7 @@ class TestSpectra:
     dropped: tuple[tuple[str, str], ...]
     peaks: PeakResult
     numbering: Numbering
+    damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
 
     def to_dataframe(self) -> pd.DataFrame:
         return pd.DataFrame({
@@ -117,6 +118,8 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         doubtful=tuple(bool(numbering.doubtful[i]) for i in order),
         unassigned=tuple((float(freqs[i]), float(unc[i])) for i in range(len(peaks)) if numbering.modes[i] == 0),
         dropped=tuple(record.dropped), peaks=result, numbering=numbering,
+        damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
+                                      for i in order]),
     )
 
 
