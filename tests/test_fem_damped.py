@@ -7,10 +7,13 @@ x_d/(2l) at η = 1. The asymptote differs from the exact model by O(x_d/l): 2-3 
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
-from stcs_ident.errors import ModelError
+from stcs_ident.errors import ComputationError, ModelError
+from stcs_ident.forward import fem_damped
 from stcs_ident.forward.fem import fe_modes
 from stcs_ident.forward.fem_damped import fe_complex_modes
 from stcs_ident.model import Attachment, Boundary, Cable, Damper
@@ -64,8 +67,8 @@ def test_a_strongly_damped_beam_converges_as_the_mesh_is_refined_without_driftin
     damper = Damper("D", 0.03 * length, coefficient=5 * np.sqrt(tension * m) / (np.pi * 0.03), stiffness=2e4,
                     mass=10.0)
     s = [fe_complex_modes(cable, [damper], tension, 4, n_elements=n, grading=2.0).s for n in (100, 200, 400, 800)]
-    change = [np.max(np.abs(b / a - 1)) for a, b in zip(s[:-1], s[1:])]
-    assert all(later < earlier / 8 for earlier, later in zip(change[:-1], change[1:]))
+    change = [np.max(np.abs(b / a - 1)) for a, b in itertools.pairwise(s)]
+    assert all(later < earlier / 8 for earlier, later in itertools.pairwise(change))
     assert change[-1] < 1e-6
 
 
@@ -80,6 +83,23 @@ def test_an_overdamped_pair_is_not_a_mode():
     assert np.all(modes.s.imag > 0)
     assert np.all(modes.damping < 0.05)  # 0.008-0.03 measured
     assert np.all(np.diff(np.abs(modes.s)) > 0)
+
+
+def test_a_root_missed_by_the_first_solve_is_caught_by_the_second(monkeypatch):
+    """The band check is live: hide mode 2 (and its conjugate) from the solve shifted to 0, and the solve
+    shifted to -|s_N|/2 finds it and refuses."""
+    solve = fem_damped._roots_near
+
+    def hiding(model, C, omega0, shift, k):
+        roots = solve(model, C, omega0, shift, k)
+        if shift != 0:
+            return roots
+        second = np.sort(np.abs(roots[roots.imag > 0]))[1]
+        return roots[np.abs(np.abs(roots) - second) > 1e-9 * second]
+
+    monkeypatch.setattr(fem_damped, "_roots_near", hiding)
+    with pytest.raises(ComputationError, match="missed by the other"):
+        fe_complex_modes(Cable(L, M, 0.0), [Damper("D", XD, coefficient=1e5)], H, 4, n_elements=100)
 
 
 def test_a_damper_outside_the_span_is_refused_naming_it():
