@@ -1,0 +1,116 @@
+"""The complex-mode solver's machinery (issue 13): compiled kernel against the numpy reference, the
+undamped limit with the sag term, the count certificate, and what routes through it.
+
+The physics (Krenk's curve, the finite-element reference on random cables) is checked in test_damped.py and
+test_damped_reference.py; here: that the two code paths agree to round-off, that the certificate does fail
+when a mode is lost, and that a damper reaches every caller of ``batch_frequencies``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stcs_ident.errors import ComputationError
+from stcs_ident.forward import batch_frequencies, damped, natural_frequencies
+from stcs_ident.forward.damped import batch_complex_modes, certify_count, complex_modes, follow_roots
+from stcs_ident.forward.dsm import build_batch
+from stcs_ident.forward.roots import solve_modes
+from stcs_ident.model import Attachment, Boundary, Cable, Damper
+
+STAY = Cable(200.0, 80.0, 5.0e5, EA=2.0e9, inclination=math.radians(30.0))
+H = 5.0e6
+#: Mode 1's optimal dashpot for a damper at 4 m (η = c π x_d/(l √(H m)) = 1).
+C_OPT = math.sqrt(H * 80.0) / (math.pi * 4.0 / 200.0)
+
+
+def _numpy(monkeypatch):
+    monkeypatch.setattr(damped, "_damped_kernel", None)
+
+
+@pytest.mark.skipif(damped._damped_kernel is None, reason="the compiled kernel is not built")
+@pytest.mark.parametrize("scale", [1e-2, 1.0, 100.0])
+@pytest.mark.parametrize("beam", [True, False])
+def test_the_compiled_kernel_equals_the_numpy_reference(monkeypatch, scale, beam):
+    """Same numerics in C and numpy: equal to round-off (1e-13 of |s|: the last digits of the secant's stop),
+    one damper small, optimal or beyond it, and two dampers with an attachment."""
+    cable = STAY if beam else Cable(200.0, 80.0, 0.0, EA=2.0e9, inclination=math.radians(30.0))
+    atts = [Damper("D1", 4.0, 10.0, coefficient=scale * C_OPT), Attachment("W", 61.0, 40.0, 2e3),
+            Damper("D2", 196.0, coefficient=0.3 * scale * C_OPT)]
+    compiled = batch_complex_modes(cable, atts, H, 10)
+    _numpy(monkeypatch)
+    reference = batch_complex_modes(cable, atts, H, 10)
+    np.testing.assert_allclose(compiled, reference, rtol=1e-13, atol=0)
+
+
+def test_without_a_dashpot_the_solver_is_the_undamped_one_with_sag():
+    atts = [Attachment("W", 61.0, 40.0, 2e3)]
+    s = batch_complex_modes(STAY, atts, H, 8)
+    assert np.all(s.real == 0)
+    np.testing.assert_array_equal(np.abs(s) / (2 * math.pi), natural_frequencies(STAY, atts, H, 8))
+
+
+def test_a_vanishing_dashpot_approaches_the_undamped_modes_with_sag():
+    """A dashpot of 1e-6 N s/m moves nothing by more than 1e-12 (its first-order shift is ~1e-14)."""
+    s = batch_complex_modes(STAY, [Damper("D1", 4.0, 10.0, coefficient=1e-6)], H, 6)
+    f0 = natural_frequencies(STAY, [Attachment("D1", 4.0, 10.0)], H, 6)
+    np.testing.assert_allclose(np.abs(s) / (2 * math.pi), f0, rtol=1e-12)
+    assert np.all(-s.real / np.abs(s) < 1e-9)
+
+
+@pytest.mark.parametrize("path", ["compiled", "numpy"])
+def test_very_large_dashpots_at_both_ends_are_followed_to_the_pinned_roots(monkeypatch, path):
+    """Dashpots of 100 × the optimum at both ends: each mode's path passes its maximum damping early in the
+    continuation and ends near the root with both damper nodes pinned (within the little damping left)."""
+    if path == "numpy":
+        _numpy(monkeypatch)
+    atts = [Damper("D1", 4.0, coefficient=100 * C_OPT), Damper("D2", 195.0, coefficient=100 * C_OPT)]
+    modes = complex_modes(STAY, atts, H, 10)
+    pinned = natural_frequencies(STAY, [Attachment("D1", 4.0, stiffness=1e12), Attachment("D2", 195.0,
+                                                                                          stiffness=1e12)], H, 10)
+    np.testing.assert_allclose(modes.frequency, pinned, rtol=2e-3)  # what damping is left moves |s| this much
+    assert np.all(modes.damping < 2e-3)
+
+
+def test_the_certificate_fails_when_a_mode_is_lost():
+    """A root replaced by a copy of its neighbour (a path that jumped) must be caught."""
+    atts = [Damper("D1", 4.0, coefficient=C_OPT)]
+    _, [(batch, _)] = build_batch(STAY, atts, H)
+    omega = solve_modes(batch, np.zeros(7, int), np.arange(1, 8))
+    pinned = damped._pinned_roots(batch, np.array([0]), 7)[0]
+    s = follow_roots(batch, 0, omega, pinned)
+    certify_count(batch, 0, omega, s, 6)  # the true roots pass
+    lost = s.copy()
+    lost[3] = lost[2]
+    with pytest.raises(ComputationError, match="lost"):
+        certify_count(batch, 0, omega, lost, 6)
+    moved = s.copy()
+    moved[3] = s[3] + 0.7 * (s[4] - s[3])  # not a root: the count inside is right, but on the wrong points
+    moved[3] = complex(moved[3].real, 2 * s[6].imag)  # pushed out of the rectangle
+    with pytest.raises(ComputationError):
+        certify_count(batch, 0, omega, moved, 6)
+
+
+def test_batch_frequencies_with_a_damper_gives_the_complex_modes_frequencies():
+    """identify, diagnose and numbering call batch_frequencies: a damper reaches them as |s|/2π, and a
+    coefficient override turns a plain attachment into a damper."""
+    atts = [Damper("D1", 4.0, coefficient=C_OPT)]
+    f = batch_frequencies(STAY, atts, [H, 1.1 * H], 5)
+    for row, tension in zip(f, [H, 1.1 * H]):
+        np.testing.assert_allclose(row, complex_modes(STAY, atts, tension, 5).frequency, rtol=1e-14)
+    plain = [Attachment("D1", 4.0)]
+    np.testing.assert_allclose(batch_frequencies(STAY, plain, H, 5, coefficients=[[C_OPT]])[0], f[0], rtol=1e-14)
+
+
+def test_an_elastic_end_and_a_damper_with_a_spring_and_a_mass():
+    """Every kind of term at once (end spring, damper spring and mass, an attachment) on both code paths'
+    certificate: the solve succeeds and the damping ratios lie below Krenk's bound x_d/(2l) (a spring and
+    a mass on the damper only lower what it can add)."""
+    cable = Cable(150.0, 60.0, 2e5, EA=1.5e9, inclination=math.radians(25.0),
+                  boundary_a=Boundary(1e7), boundary_b=Boundary.clamped())
+    atts = [Damper("D1", 3.0, 15.0, 2e4, coefficient=2e5), Attachment("W", 70.0, 25.0)]
+    modes = complex_modes(cable, atts, 3.5e6, 8)
+    assert np.all(modes.damping > 0) and np.all(modes.damping < 3.0 / (2 * 150.0))
+    assert np.all(np.diff(modes.frequency) > 0)
