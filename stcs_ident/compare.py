@@ -19,8 +19,8 @@ from scipy.optimize import minimize_scalar
 
 from .formatting import percent_error
 from .forward import batch_frequencies
-from .forward.damped import complex_modes
 from .forward import reference as closed_form
+from .forward.damped import complex_modes
 from .model import Campaign, Test, has_dampers
 from .settings import Settings
 

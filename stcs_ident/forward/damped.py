@@ -253,7 +253,7 @@ def _follow_in_steps(det, s0: complex, first: complex, reach: float, k: int) -> 
             guess = s + first * (t1 - t)
         else:  # linear in log t
             guess = s + (s - previous[1]) * math.log(t1 / t) / math.log(t / previous[0])
-        s1 = _secant(lambda z: det(z, t1), s, det(s, t1), guess)
+        s1 = _secant(lambda z, t1=t1: det(z, t1), s, det(s, t1), guess)
         if s1 is None or abs(s1 - s) > reach:
             ratio = math.sqrt(ratio)
             if ratio < MIN_RATIO:
@@ -297,7 +297,7 @@ def winding_number(f, corners: Sequence[complex], per_edge: int = 32) -> int:
         coarse = np.flatnonzero((np.abs(step) > MAX_ARG_STEP) | ~(ratio < 1.0))
         if coarse.size == 0:
             total = step.sum() / (2 * math.pi)
-            return int(round(total))
+            return round(total)
         if z.size + coarse.size > MAX_CONTOUR_POINTS:
             raise ComputationError("the count of damped modes did not resolve (the determinant's phase varies too "
                                    "fast on the contour)")
