@@ -4,8 +4,9 @@
  * form of elements.py, the sag term of assembly.py) at ω = −i s, plus t c s on each damper's
  * displacement; its determinant's zeros (scaled, LU with partial pivoting) are followed from the
  * undamped roots to t = 1 (in one step from a Möbius model of the path, else by geometric steps
- * in t, shortened on failure, the secant method as corrector), and the count is certified by the argument principle on a rectangle, the phase
- * followed by recursive bisection of the edges (no step of more than π/4). It exists because
+ * in t, shortened on failure, the secant method as corrector; a path that falls onto another's
+ * root solved again from its pinned end with the roots found divided out), and the count is certified by the argument
+ * principle on a quadrilateral (damping ratio below 0.5), the phase followed by recursive bisection of the edges (no step of more than π/4). It exists because
  * numpy's per-call overhead dominates these small problems; damped.py stays the reference and the
  * tests compare the two.
  */
@@ -21,6 +22,10 @@
 #define START 0.01
 #define GROWTH 4.0
 #define MIN_RATIO (1 + 1e-6)
+#define DUPLICATE 1e-8
+#define NEAR 16
+#define MAX_MODES 512
+#define MAX_DAMPING 0.5
 #define JUMP 0.25
 #define MAX_ARG_STEP (M_PI / 4)
 #define MAX_CONTOUR_POINTS 200000
@@ -193,10 +198,18 @@ static cplx cdet(const Problem *P, long long cfg, cplx s, double t) {
     return det;
 }
 
-/* A root by the secant method from a (value fa) and b; 0 and *root, or −1. */
-static int secant(const Problem *P, long long cfg, double t, cplx a, cplx fa, cplx b, cplx *root) {
+/* det K(z) divided by (z − r) for the n roots r of defl (none when n = 0). */
+static cplx fdefl(const Problem *P, long long cfg, cplx z, double t, const cplx *defl, int n) {
+    cplx f = cdet(P, cfg, z, t);
+    for (int j = 0; j < n; j++) f /= z - defl[j];
+    return f;
+}
+
+/* A root by the secant method from a (value fa) and b, deflated by defl; 0 and *root, or −1. */
+static int secant_d(const Problem *P, long long cfg, double t, cplx a, cplx fa, cplx b, const cplx *defl, int n,
+                    cplx *root) {
     for (int it = 0; it < SECANT_ITER; it++) {
-        cplx fb = cdet(P, cfg, b, t);
+        cplx fb = fdefl(P, cfg, b, t, defl, n);
         if (!isfinite(creal(fb)) || !isfinite(cimag(fb))) return -1;
         if (fb == 0.0) { *root = b; return 0; }
         if (fb == fa) return -1;
@@ -205,6 +218,10 @@ static int secant(const Problem *P, long long cfg, double t, cplx a, cplx fa, cp
         if (cabs(step) <= SECANT_RTOL * cabs(b)) { *root = b; return 0; }
     }
     return -1;
+}
+
+static int secant(const Problem *P, long long cfg, double t, cplx a, cplx fa, cplx b, cplx *root) {
+    return secant_d(P, cfg, t, a, fa, b, NULL, 0, root);
 }
 
 /* The root from s0 at t = 0 to t = 1 by geometric steps in t; 0, or −1. */
@@ -242,11 +259,29 @@ static int follow(const Problem *P, long long cfg, const double *omega, const do
         cplx f1 = cdet(P, cfg, s0, 1.0);
         cplx first = -f1 * 2 * h / (cdet(P, cfg, s0 + h, 0.0) - cdet(P, cfg, s0 - h, 0.0));
         cplx guess = s0 + 1.0 / (1.0 / first + 1.0 / (I * (pinned[k] - omega[k])));
-        if (secant(P, cfg, 1.0, s0, f1, guess, &s) == 0 && cabs(s - guess) <= reach) {
-            out[k] = s;
-            continue;
+        if (secant(P, cfg, 1.0, s0, f1, guess, &s) != 0 || cabs(s - guess) > reach)
+            if (follow_in_steps(P, cfg, s0, first, reach, &s) != 0) return -(k + 1);
+        int fell = 0;
+        for (int j = 0; j < k; j++) fell |= cabs(out[j] - s) <= DUPLICATE * cabs(s);
+        if (fell) {  /* another path's root (a near crossing): the nearby roots divided out, from the start */
+            cplx near[MAX_MODES];
+            int n_near = 0;
+            for (int j = 0; j < k && n_near < MAX_MODES; j++)
+                if (cabs(out[j] - s0) < NEAR * reach) near[n_near++] = out[j];
+            cplx end = I * pinned[k];
+            double left = 0.3 * cabs(end - s0);  /* off the axis: poles sit on it */
+            cplx starts[2][2] = {{end - left, 0.5 * (s0 + end) - left}, {s0, guess}};
+            int ok = 0;
+            for (int a = 0; a < 2 && !ok; a++) {
+                if (secant_d(P, cfg, 1.0, starts[a][0], fdefl(P, cfg, starts[a][0], 1.0, near, n_near), starts[a][1],
+                             near, n_near, &s) != 0 || !(cimag(s) > 0))
+                    continue;
+                ok = 1;
+                for (int j = 0; j < k; j++) ok &= cabs(out[j] - s) > DUPLICATE * cabs(s);
+            }
+            if (!ok) return -(k + 1);
         }
-        if (follow_in_steps(P, cfg, s0, first, reach, &out[k]) != 0) return -(k + 1);
+        out[k] = s;
     }
     return 0;
 }
@@ -265,9 +300,10 @@ static int phase(Contour *C, cplx a, cplx fa, cplx b, cplx fb, double *total) {
     return phase(C, mid, fm, b, fb, total);
 }
 
-/* Turns of det K around 0 along the rectangle [left, right] × [lo, hi] (counter-clockwise); 0 or −1. */
-static int winding(const Problem *P, long long cfg, double lo, double hi, double left, double right, int *turns) {
-    cplx corners[5] = {right + I * lo, right + I * hi, left + I * hi, left + I * lo, right + I * lo};
+/* Turns of det K around 0 along the quadrilateral Im s in [lo, hi], −slope Im s < Re s < right
+ * (counter-clockwise); 0 or −1. */
+static int winding(const Problem *P, long long cfg, double lo, double hi, double slope, double right, int *turns) {
+    cplx corners[5] = {right + I * lo, right + I * hi, (-slope + I) * hi, (-slope + I) * lo, right + I * lo};
     Contour C = {P, cfg, 0};
     double total = 0.0;
     cplx z0 = corners[0], f0 = cdet(P, cfg, z0, 1.0);
@@ -290,14 +326,17 @@ static int solve_config(const Problem *P, long long cfg, const double *omega, co
     int n = n_modes + 1;
     if (follow(P, cfg, omega, pinned, n, s) != 0) return 1;
     if (!certify) return 0;
-    double top0 = cimag(s[n_modes - 1]), top1 = cimag(s[n_modes]);
-    if (!(top1 > top0)) return 2;
-    double lo = 0.25 * omega[0], hi = 0.5 * (top0 + top1), left = -hi, right = 0.05 * omega[0];
+    double top = cimag(s[0]), above = cimag(s[n_modes]);
+    for (int k = 1; k < n_modes; k++) if (cimag(s[k]) > top) top = cimag(s[k]);
+    if (!(above > top)) return 2;
+    double lo = 0.25 * omega[0], hi = 0.5 * (top + above), right = 0.05 * omega[0];
+    double slope = MAX_DAMPING / sqrt(1 - MAX_DAMPING * MAX_DAMPING);
     int inside = 0;
     for (int k = 0; k < n; k++)
-        if (cimag(s[k]) > lo && cimag(s[k]) < hi && creal(s[k]) > left && creal(s[k]) < right) inside++;
+        if (cimag(s[k]) > lo && cimag(s[k]) < hi && creal(s[k]) < right && creal(s[k]) > -slope * cimag(s[k]))
+            inside++;
     int turns;
-    if (winding(P, cfg, lo, hi, left, right, &turns) != 0) return 3;
+    if (winding(P, cfg, lo, hi, slope, right, &turns) != 0) return 3;
     int zeros = turns + clamped_count(P, cfg, hi) - clamped_count(P, cfg, lo);
     if (zeros != inside) return 4;
     for (int a = 0; a < n; a++)

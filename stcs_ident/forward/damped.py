@@ -15,15 +15,18 @@ How every mode is found, and none missed
    (a Möbius model of the path as the start of the secant method on det K(s)), else by geometric steps
    in t, each shortened whenever the secant method fails or jumps farther than a quarter of the
    distance to the neighbouring undamped roots.
-3. The count is certified by the argument principle: on the rectangle Im s ∈ [ω₁/4, ω_top],
-   Re s ∈ [−ω_top, ω₁/20] (ω_top midway between the last requested mode and the next), the winding number
-   of det K(s) plus the number of its poles inside (the clamped-segment frequencies, which are real: the
-   J0 count of the undamped solver) is the number of eigenvalues inside. It must equal the number found
-   there, and no two paths may end on one root; otherwise a ComputationError says a mode was lost.
-   The phase of det K is followed with adaptive refinement (no step of more than π/4).
+   A path that ends on a root already found (two modes crossing closely) is solved again, from its
+   pinned end, with the nearby roots found so far divided out of det K.
+3. The count is certified by the argument principle: on the quadrilateral Im s ∈ [ω₁/4, ω_top],
+   −Re s < 0.577 Im s (damping ratio below 0.5), Re s < ω₁/20 (ω_top midway between the highest
+   requested mode and the next), the winding number of det K(s) plus the number of its poles inside (the
+   clamped-segment frequencies, which are real: the J0 count of the undamped solver) is the number of
+   eigenvalues inside. It must equal the number found there, and no two paths may end on one root;
+   otherwise a ComputationError says a mode was lost. The phase of det K is followed with adaptive
+   refinement (no step of more than π/4).
 
-The rectangle covers every mode up to the band's top with a damping ratio below about 0.7 (beyond the
-left edge lie only modes damped more than that, which no record shows as a peak).
+The count covers every mode up to the band's top with a damping ratio below 0.5 (more damped roots, which
+no record shows as a peak, and a path's overdamped end on the real axis, are left out of it).
 
 Without a dashpot the result is the undamped solver's, bit for bit (s = iω, damping 0).
 """
@@ -56,6 +59,9 @@ GROWTH = 4.0  # largest ratio of consecutive t
 MIN_RATIO = 1 + 1e-6
 JUMP = 0.25  # of the distance to the neighbouring undamped roots: a longer step is refused
 MAX_ARG_STEP = math.pi / 4  # phase change between neighbouring contour points
+MAX_DAMPING = 0.5  # the count covers the modes damped less than this
+DUPLICATE = 1e-8  # two roots closer than this (relative) are one
+NEAR = 16  # roots within this many reaches of a path's start are divided out when it fell onto one
 MAX_CONTOUR_POINTS = 200_000
 
 
@@ -235,10 +241,26 @@ def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray) -> n
         first = -f1 * 2 * h / (det(s0 + h, 0.0) - det(s0 - h, 0.0))  # the first-order shift
         guess = s0 + 1 / (1 / first + 1 / (1j * (pinned[k] - w)))
         s = _secant(lambda z: det(z, 1.0), s0, f1, guess)
-        if s is not None and abs(s - guess) <= reach[k]:
-            out[k] = s
-            continue
-        out[k] = _follow_in_steps(det, s0, first, reach[k], k)
+        if s is None or abs(s - guess) > reach[k]:
+            s = _follow_in_steps(det, s0, first, reach[k], k)
+        if np.any(np.abs(out[:k] - s) <= DUPLICATE * abs(s)):
+            # another path's root (a near crossing of two modes): that root divided out, from the same start
+            found = out[:k][np.abs(out[:k] - s0) < NEAR * reach[k]]
+
+            def deflated(z, found=found):
+                return det(z, 1.0) / np.prod(z - found)
+
+            s = None
+            end, left = 1j * pinned[k], 0.3 * abs(1j * pinned[k] - s0)  # off the axis: poles sit on it
+            for a, b in ((end - left, 0.5 * (s0 + end) - left), (s0, guess)):  # near its pinned end first
+                s = _secant(deflated, a, deflated(a), b)
+                if s is not None and s.imag > 0 and not np.any(np.abs(out[:k] - s) <= DUPLICATE * abs(s)):
+                    break
+                s = None
+            if s is None:
+                raise ComputationError(f"the damped mode {k + 1} near {w / (2 * math.pi):.6g} Hz fell onto another "
+                                       "mode's root and was not found apart from it")
+        out[k] = s
     return out
 
 
@@ -268,15 +290,15 @@ def _follow_in_steps(det, s0: complex, first: complex, reach: float, k: int) -> 
 
 def certify_count(batch, config: int, omega: np.ndarray, s: np.ndarray, n_modes: int) -> None:
     """The argument-principle check of the module docstring; raises ComputationError on a mismatch."""
-    top_pair = s[n_modes - 1:n_modes + 1].imag
-    if not top_pair[1] > top_pair[0]:
+    top, above = s[:n_modes].imag.max(), s[n_modes].imag
+    if not above > top:
         raise ComputationError("the damped modes are not ordered in frequency at the top of the band; ask for one "
                                "mode more or fewer")
-    lo, hi = 0.25 * omega[0], 0.5 * (top_pair[0] + top_pair[1])
-    left, right = -hi, 0.05 * omega[0]
-    inside = np.count_nonzero((s.imag > lo) & (s.imag < hi) & (s.real > left) & (s.real < right))
+    lo, hi, right = 0.25 * omega[0], 0.5 * (top + above), 0.05 * omega[0]
+    slope = MAX_DAMPING / math.sqrt(1 - MAX_DAMPING**2)  # the left edge: Re s = −slope Im s, ζ = MAX_DAMPING
+    inside = np.count_nonzero((s.imag > lo) & (s.imag < hi) & (s.real < right) & (s.real > -slope * s.imag))
     turns = winding_number(lambda z: determinant(batch, config, z), [right + 1j * lo, right + 1j * hi,
-                                                                      left + 1j * hi, left + 1j * lo])
+                                                                      (-slope + 1j) * hi, (-slope + 1j) * lo])
     _, _, J0 = batch.evaluate(np.array([config, config]), np.array([lo, hi]))
     zeros = turns + int(J0[1] - J0[0])
     if zeros != inside or np.unique(np.round(s / hi, 9)).size < s.size:
