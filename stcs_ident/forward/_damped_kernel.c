@@ -14,6 +14,7 @@
 #include <Python.h>
 #include <complex.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define MAX_DOF 64
@@ -22,14 +23,16 @@
 #define START 0.01
 #define GROWTH 4.0
 #define MIN_RATIO (1 + 1e-6)
+#define SMOOTH 0.5
 #define DUPLICATE 1e-8
 #define NEAR 16
 #define MAX_MODES 512
 #define MAX_DAMPING 0.5
+#define DEFLATE 8
+#define SEARCH_DEPTH 30
 #define JUMP 0.25
 #define MAX_ARG_STEP (M_PI / 4)
 #define MAX_CONTOUR_POINTS 200000
-#define PER_EDGE 32
 
 typedef double complex cplx;
 
@@ -234,8 +237,9 @@ static int follow_in_steps(const Problem *P, long long cfg, cplx s0, cplx first,
     if (secant(P, cfg, t, s0, cdet(P, cfg, s0, t), s0 + first * t, &s) != 0) return -1;
     while (t < 1.0) {
         double t1 = t * ratio < 1.0 ? t * ratio : 1.0;
-        cplx guess = have_prev ? s + (s - prev_s) * (log(t1 / t) / log(t / prev_t)) : s + first * (t1 - t);
-        if (secant(P, cfg, t1, s, cdet(P, cfg, s, t1), guess, &s1) != 0 || cabs(s1 - s) > reach) {
+        cplx guess = have_prev ? s + (s - prev_s) * ((t1 - t) / (t - prev_t)) : s + first * (t1 - t);
+        if (secant(P, cfg, t1, s, cdet(P, cfg, s, t1), guess, &s1) != 0 || cabs(s1 - s) > reach
+            || cabs(s1 - guess) > SMOOTH * cabs(guess - s)) {
             ratio = sqrt(ratio);
             if (ratio < MIN_RATIO) return -1;
             continue;
@@ -248,8 +252,9 @@ static int follow_in_steps(const Problem *P, long long cfg, cplx s0, cplx first,
     return 0;
 }
 
-/* Each undamped root omega[k] followed to t = 1; 0, or −(k+1) for a mode that could not be followed. */
+/* Each undamped root omega[k] followed to t = 1; the number of modes that could not be followed (NaN). */
 static int follow(const Problem *P, long long cfg, const double *omega, const double *pinned, int n, cplx *out) {
+    int lost = 0;
     for (int k = 0; k < n; k++) {
         double below = omega[k] - (k > 0 ? omega[k - 1] : 0.0);
         double above = k + 1 < n ? omega[k + 1] - omega[k] : (n > 1 ? omega[k] - omega[k - 1] : omega[k]);
@@ -259,15 +264,20 @@ static int follow(const Problem *P, long long cfg, const double *omega, const do
         cplx f1 = cdet(P, cfg, s0, 1.0);
         cplx first = -f1 * 2 * h / (cdet(P, cfg, s0 + h, 0.0) - cdet(P, cfg, s0 - h, 0.0));
         cplx guess = s0 + 1.0 / (1.0 / first + 1.0 / (I * (pinned[k] - omega[k])));
-        if (secant(P, cfg, 1.0, s0, f1, guess, &s) != 0 || cabs(s - guess) > reach)
-            if (follow_in_steps(P, cfg, s0, first, reach, &s) != 0) return -(k + 1);
+        double tight = SMOOTH * cabs(guess - s0) < reach ? SMOOTH * cabs(guess - s0) : reach;
+        if (secant(P, cfg, 1.0, s0, f1, guess, &s) != 0 || cabs(s - guess) > tight)
+            if (follow_in_steps(P, cfg, s0, first, reach, &s) != 0) {
+                out[k] = NAN;
+                lost++;
+                continue;
+            }
         int fell = 0;
-        for (int j = 0; j < k; j++) fell |= cabs(out[j] - s) <= DUPLICATE * cabs(s);
+        for (int j = 0; j < k; j++) fell |= cabs(out[j] - s) <= DUPLICATE * cabs(s);  /* NaN: false */
         if (fell) {  /* another path's root (a near crossing): the nearby roots divided out, from the start */
             cplx near[MAX_MODES];
             int n_near = 0;
             for (int j = 0; j < k && n_near < MAX_MODES; j++)
-                if (cabs(out[j] - s0) < NEAR * reach) near[n_near++] = out[j];
+                if (cabs(out[j] - s0) < NEAR * reach) near[n_near++] = out[j];  /* NaN: left out */
             cplx end = I * pinned[k];
             double left = 0.3 * cabs(end - s0);  /* off the axis: poles sit on it */
             cplx starts[2][2] = {{end - left, 0.5 * (s0 + end) - left}, {s0, guess}};
@@ -279,11 +289,15 @@ static int follow(const Problem *P, long long cfg, const double *omega, const do
                 ok = 1;
                 for (int j = 0; j < k; j++) ok &= cabs(out[j] - s) > DUPLICATE * cabs(s);
             }
-            if (!ok) return -(k + 1);
+            if (!ok) {
+                out[k] = NAN;
+                lost++;
+                continue;
+            }
         }
         out[k] = s;
     }
-    return 0;
+    return lost;
 }
 
 typedef struct { const Problem *P; long long cfg; long points; } Contour;
@@ -300,49 +314,182 @@ static int phase(Contour *C, cplx a, cplx fa, cplx b, cplx fb, double *total) {
     return phase(C, mid, fm, b, fb, total);
 }
 
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Where on the edge a → b (0 <= u < 1) the phase is first sampled (as damped.edge_parameters): at most
+ * spacing apart and, on an edge crossing the imaginary axis, ever closer to it. Returns the count, or −1. */
+static int edge_parameters(cplx a, cplx b, double spacing, double **u_out) {
+    int n = (int)ceil(cabs(b - a) / spacing);
+    if (n < 8) n = 8;
+    double *u = malloc(sizeof(double) * (size_t)(n + 80));
+    if (!u) return -1;
+    for (int k = 0; k < n; k++) u[k] = (double)k / n;
+    int m = n;
+    double ar = creal(a), br = creal(b);
+    if (cimag(a) == cimag(b) && fmin(ar, br) < 0 && 0 < fmax(ar, br)) {
+        for (int k = 1; k <= 40; k++)
+            for (int sgn = -1; sgn <= 1; sgn += 2) {
+                double v = (sgn * spacing * ldexp(1.0, -k) - ar) / (br - ar);
+                if (v >= 0 && v < 1) u[m++] = v;
+            }
+        qsort(u, (size_t)m, sizeof(double), cmp_double);
+        int w = 1;
+        for (int k = 1; k < m; k++) if (u[k] != u[w - 1]) u[w++] = u[k];
+        m = w;
+    }
+    *u_out = u;
+    return m;
+}
+
 /* Turns of det K around 0 along the quadrilateral Im s in [lo, hi], −slope Im s < Re s < right
- * (counter-clockwise); 0 or −1. */
-static int winding(const Problem *P, long long cfg, double lo, double hi, double slope, double right, int *turns) {
+ * (counter-clockwise), sampled every spacing; 0 or −1. */
+static int winding(const Problem *P, long long cfg, double lo, double hi, double slope, double right, double spacing,
+                   int *turns) {
     cplx corners[5] = {right + I * lo, right + I * hi, (-slope + I) * hi, (-slope + I) * lo, right + I * lo};
     Contour C = {P, cfg, 0};
     double total = 0.0;
     cplx z0 = corners[0], f0 = cdet(P, cfg, z0, 1.0);
     cplx z = z0, fz = f0;
-    for (int e = 0; e < 4; e++)
-        for (int k = 1; k <= PER_EDGE; k++) {
-            cplx zn = (e == 3 && k == PER_EDGE) ? z0 : corners[e] + (corners[e + 1] - corners[e]) * ((double)k / PER_EDGE);
-            cplx fn = (e == 3 && k == PER_EDGE) ? f0 : cdet(P, cfg, zn, 1.0);
-            if (phase(&C, z, fz, zn, fn, &total) != 0) return -1;
+    for (int e = 0; e < 4; e++) {
+        double *u;
+        int m = edge_parameters(corners[e], corners[e + 1], spacing, &u);
+        if (m < 0) return -1;
+        for (int k = 1; k <= m; k++) {
+            int last = k == m;
+            cplx zn = last ? corners[e + 1] : corners[e] + (corners[e + 1] - corners[e]) * u[k];
+            cplx fn = (last && e == 3) ? f0 : cdet(P, cfg, zn, 1.0);
+            if (phase(&C, z, fz, zn, fn, &total) != 0) { free(u); return -1; }
             z = zn; fz = fn;
         }
+        free(u);
+    }
     *turns = (int)lround(total / (2 * M_PI));
     return 0;
 }
 
-/* Status: 0 ok, 1 a path failed, 2 modes unordered at the band's top, 3 the contour did not resolve,
- * 4 the count disagrees (a mode lost), 5 two paths on one root. */
+typedef struct { double lo, right, slope, spacing; } Region;
+
+static int in_region(cplx z, const Region *R, double lo, double hi) {
+    return cimag(z) > lo && cimag(z) < hi && creal(z) < R->right && creal(z) > -R->slope * cimag(z);
+}
+
+/* Eigenvalues in the band (lo, hi) of the region: winding number plus poles (J0); 0 or −1. */
+static int count_zeros(const Problem *P, long long cfg, const Region *R, double lo, double hi, int *zeros) {
+    int turns;
+    if (winding(P, cfg, lo, hi, R->slope, R->right, R->spacing, &turns) != 0) return -1;
+    *zeros = turns + clamped_count(P, cfg, hi) - clamped_count(P, cfg, lo);
+    return 0;
+}
+
+static int is_known(cplx z, const cplx *known, int nk) {
+    for (int j = 0; j < nk; j++) if (cabs(known[j] - z) <= DUPLICATE * cabs(z)) return 1;
+    return 0;
+}
+
+/* The one eigenvalue of the band that known lacks (as damped._locate); 0 and *root, or −1. */
+static int locate(const Problem *P, long long cfg, const Region *R, double lo, double hi, const cplx *known, int nk,
+                  cplx *root) {
+    double mid = 0.5 * (lo + hi);
+    cplx near[DEFLATE];
+    int nn = 0;
+    int used[MAX_MODES] = {0};
+    for (; nn < DEFLATE && nn < nk; nn++) {  /* the nearest known roots, divided out */
+        int best = -1;
+        for (int j = 0; j < nk && j < MAX_MODES; j++)
+            if (!used[j] && (best < 0 || cabs(known[j] - I * mid) < cabs(known[best] - I * mid))) best = j;
+        if (best < 0) break;
+        used[best] = 1;
+        near[nn] = known[best];
+    }
+    static const double zetas[5] = {1e-4, 1e-3, 0.01, 0.1, 0.3};
+    for (int k = 0; k < 5; k++) {
+        cplx a = -zetas[k] * mid + I * mid, b = a + 0.1 * I * (hi - lo);
+        if (secant_d(P, cfg, 1.0, a, fdefl(P, cfg, a, 1.0, near, nn), b, near, nn, root) == 0
+            && in_region(*root, R, lo, hi) && !is_known(*root, known, nk))
+            return 0;
+    }
+    return -1;
+}
+
+/* A point near the middle of (lo, hi), 2 % of the band from any known root's Im (as damped._split). */
+static double split(double lo, double hi, const cplx *known, int nk) {
+    static const double u[9] = {0.5, 0.45, 0.55, 0.4, 0.6, 0.35, 0.65, 0.3, 0.7};
+    for (int k = 0; k < 9; k++) {
+        double mid = lo + u[k] * (hi - lo);
+        int clear = 1;
+        for (int j = 0; j < nk; j++) clear &= fabs(cimag(known[j]) - mid) >= 0.02 * (hi - lo);
+        if (clear) return mid;
+    }
+    return lo + 0.5 * (hi - lo);
+}
+
+/* The eigenvalues of the band that known lacks, appended to known (as damped._search); 0 or −1. */
+static int search(const Problem *P, long long cfg, const Region *R, double lo, double hi, cplx *known, int *nk,
+                  int depth) {
+    int zeros, have = 0;
+    if (count_zeros(P, cfg, R, lo, hi, &zeros) != 0) return -1;
+    for (int j = 0; j < *nk; j++) have += in_region(known[j], R, lo, hi);
+    int missing = zeros - have;
+    if (missing <= 0) return 0;
+    if (*nk >= MAX_MODES) return -1;
+    if (missing == 1 && locate(P, cfg, R, lo, hi, known, *nk, &known[*nk]) == 0) {
+        (*nk)++;
+        return 0;
+    }
+    if (depth >= SEARCH_DEPTH) return -1;
+    double mid = split(lo, hi, known, *nk);
+    if (search(P, cfg, R, lo, mid, known, nk, depth + 1) != 0) return -1;
+    return search(P, cfg, R, mid, hi, known, nk, depth + 1);
+}
+
+static int cmp_imag(const void *a, const void *b) {
+    double x = cimag(*(const cplx *)a), y = cimag(*(const cplx *)b);
+    return (x > y) - (x < y);
+}
+
+/* The first n_modes + 1 eigenvalues by Im s, certified (as damped.complete); s holds the paths' ends
+ * (NaN where lost) and gets the result. 0, or a status of solve_config. */
+static int complete(const Problem *P, long long cfg, const double *omega, cplx *s, int n_modes) {
+    Region R = {0.25 * omega[0], 0.5 * omega[0], MAX_DAMPING / sqrt(1 - MAX_DAMPING * MAX_DAMPING), 0.25 * omega[0]};
+    cplx roots[MAX_MODES];
+    int nr = 0;
+    for (int k = 0; k <= n_modes; k++)
+        if (isfinite(creal(s[k])) && isfinite(cimag(s[k])) && in_region(s[k], &R, R.lo, INFINITY)
+            && !is_known(s[k], roots, nr) && nr < MAX_MODES)
+            roots[nr++] = s[k];
+    double hi = 0.0;
+    for (int round = 0; round < 2 * n_modes + 8; round++) {
+        qsort(roots, (size_t)nr, sizeof(cplx), cmp_imag);
+        if (nr > n_modes) {
+            hi = 0.5 * (cimag(roots[n_modes - 1]) + cimag(roots[n_modes]));
+        } else {
+            double top = nr ? cimag(roots[nr - 1]) : omega[0];
+            if (hi > top) top = hi;
+            hi = top + 0.618 * (top - R.lo) / (nr > 0 ? nr : 1);
+        }
+        int zeros, inside = 0;
+        if (count_zeros(P, cfg, &R, R.lo, hi, &zeros) != 0) return 3;
+        for (int j = 0; j < nr; j++) inside += cimag(roots[j]) < hi;
+        if (zeros < inside) return 4;
+        if (zeros == inside && nr > n_modes) {
+            for (int k = 0; k <= n_modes; k++) s[k] = roots[k];
+            return 0;
+        }
+        if (zeros > inside && search(P, cfg, &R, R.lo, hi, roots, &nr, 0) != 0) return 6;
+    }
+    return 6;
+}
+
+/* Status: 0 ok, 1 a path failed and certification is off, 3 the contour did not resolve, 4 the count is
+ * below the roots found, 6 a lost mode was not found again. */
 static int solve_config(const Problem *P, long long cfg, const double *omega, const double *pinned, int n_modes,
                         int certify, cplx *s) {
-    int n = n_modes + 1;
-    if (follow(P, cfg, omega, pinned, n, s) != 0) return 1;
-    if (!certify) return 0;
-    double top = cimag(s[0]), above = cimag(s[n_modes]);
-    for (int k = 1; k < n_modes; k++) if (cimag(s[k]) > top) top = cimag(s[k]);
-    if (!(above > top)) return 2;
-    double lo = 0.25 * omega[0], hi = 0.5 * (top + above), right = 0.05 * omega[0];
-    double slope = MAX_DAMPING / sqrt(1 - MAX_DAMPING * MAX_DAMPING);
-    int inside = 0;
-    for (int k = 0; k < n; k++)
-        if (cimag(s[k]) > lo && cimag(s[k]) < hi && creal(s[k]) < right && creal(s[k]) > -slope * cimag(s[k]))
-            inside++;
-    int turns;
-    if (winding(P, cfg, lo, hi, slope, right, &turns) != 0) return 3;
-    int zeros = turns + clamped_count(P, cfg, hi) - clamped_count(P, cfg, lo);
-    if (zeros != inside) return 4;
-    for (int a = 0; a < n; a++)
-        for (int b = a + 1; b < n; b++)
-            if (cabs(s[a] - s[b]) < 1e-9 * hi) return 5;
-    return 0;
+    int lost = follow(P, cfg, omega, pinned, n_modes + 1, s);
+    if (!certify) return lost ? 1 : 0;
+    return complete(P, cfg, omega, s, n_modes);
 }
 
 static int get_buffer(PyObject *obj, Py_buffer *view, const char *name) {

@@ -13,17 +13,22 @@ How every mode is found, and none missed
    which certifies their count.
 2. Each is followed as the dashpots grow from 0 to their values (t = 0 … 1, c → t c): first in one step
    (a Möbius model of the path as the start of the secant method on det K(s)), else by geometric steps
-   in t, each shortened whenever the secant method fails or jumps farther than a quarter of the
-   distance to the neighbouring undamped roots.
+   in t, each shortened whenever the secant method fails, jumps farther than a quarter of the
+   distance to the neighbouring undamped roots, or lands farther from the prediction than half the step
+   (another root: the damper's own overdamped modes cross the cable modes' paths).
    A path that ends on a root already found (two modes crossing closely) is solved again, from its
    pinned end, with the nearby roots found so far divided out of det K.
 3. The count is certified by the argument principle: on the quadrilateral Im s ∈ [ω₁/4, ω_top],
-   −Re s < 0.577 Im s (damping ratio below 0.5), Re s < ω₁/20 (ω_top midway between the highest
+   −Re s < 0.577 Im s (damping ratio below 0.5), Re s < ω₁/2 (ω_top midway between the highest
    requested mode and the next), the winding number of det K(s) plus the number of its poles inside (the
    clamped-segment frequencies, which are real: the J0 count of the undamped solver) is the number of
-   eigenvalues inside. It must equal the number found there, and no two paths may end on one root;
-   otherwise a ComputationError says a mode was lost. The phase of det K is followed with adaptive
-   refinement (no step of more than π/4).
+   eigenvalues inside. The phase of det K is sampled every ω₁/4 and, where an edge crosses the imaginary
+   axis, ever closer to it (poles lie on the axis, lightly damped roots beside it: a pole or root passed
+   closer than the samples' spacing would turn the phase by 2π unseen), then refined until no step
+   changes it by more than π/4. When the count exceeds the roots found (a path ended on one of the damper's own overdamped
+   roots, which cross the cable modes' paths when the damper has a mass, or failed), the band is halved
+   until each half lacks one root, found by the secant method with the known roots divided out; when it
+   is below them, or the search fails, a ComputationError says so. The modes are returned by Im s.
 
 The count covers every mode up to the band's top with a damping ratio below 0.5 (more damped roots, which
 no record shows as a peak, and a path's overdamped end on the real axis, are left out of it).
@@ -58,10 +63,14 @@ START = 0.01  # the first step's first-order shift, in units of the reach
 GROWTH = 4.0  # largest ratio of consecutive t
 MIN_RATIO = 1 + 1e-6
 JUMP = 0.25  # of the distance to the neighbouring undamped roots: a longer step is refused
+SMOOTH = 0.5  # a corrector landing farther from the prediction than this fraction of the step is refused
+# (it found another root: the damper's own overdamped modes cross the cable modes' paths)
 MAX_ARG_STEP = math.pi / 4  # phase change between neighbouring contour points
 MAX_DAMPING = 0.5  # the count covers the modes damped less than this
 DUPLICATE = 1e-8  # two roots closer than this (relative) are one
 NEAR = 16  # roots within this many reaches of a path's start are divided out when it fell onto one
+SEARCH_DEPTH = 30  # halvings of the band in the search for a lost mode
+DEFLATE = 8  # known roots divided out when locating a lost one
 MAX_CONTOUR_POINTS = 200_000
 
 
@@ -131,13 +140,15 @@ def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension
         s = 1j * omega
         damped = np.flatnonzero(batch.dashpots.any(axis=1))
         pinned = _pinned_roots(batch, damped, n_modes + 1) if damped.size else None
-        if damped.size and use_kernel() and batch.n_dof <= 64:
+        if damped.size and use_kernel() and batch.n_dof <= 64 and n_modes < MAX_KERNEL_MODES:
             s[damped] = _solve_compiled(batch, damped, omega, pinned, n_modes, certify)
         else:
             for i, c in enumerate(damped):
-                s[c] = follow_roots(batch, int(c), omega[c], pinned[i])
+                s[c] = follow_roots(batch, int(c), omega[c], pinned[i], tolerant=certify)
                 if certify:
-                    certify_count(batch, int(c), omega[c], s[c], n_modes)
+                    s[c] = complete(batch, int(c), omega[c], s[c], n_modes)
+        if damped.size:
+            s[damped] = np.take_along_axis(s[damped], np.argsort(s[damped].imag, axis=1), axis=1)
         out[sel] = s[:, :n_modes]
     return out.reshape(shape + (n_modes,))
 
@@ -149,12 +160,11 @@ def use_kernel() -> bool:
 
 _FAILURES = {
     1: "a damped mode could not be followed as the dampers grow",
-    2: "the damped modes are not ordered in frequency at the top of the band; ask for one mode more or fewer",
     3: "the count of damped modes did not resolve (the determinant's phase varies too fast on the contour)",
-    4: "the argument principle counts another number of damped modes than were found: a mode was lost",
-    5: "two damped modes' paths ended on one root: a mode was lost",
+    4: "the argument principle counts fewer damped modes than were found",
+    6: "a damped mode was lost and not found again",
 }
-
+MAX_KERNEL_MODES = 511  # the kernel's fixed buffers
 
 PIN = 1e8  # a pinning spring, in units of the scaled matrix's entries (order one): roots within ~1e-8
 
@@ -194,11 +204,13 @@ def determinant(batch, config: int, s: np.ndarray, t: float = 1.0) -> np.ndarray
     """det of the scaled K(s) of configuration ``config``, the dashpots scaled by ``t``, at points ``s``."""
     s = np.asarray(s, dtype=complex)
     idx = np.full(s.size, config)
-    K, _ = batch.assemble(idx, -1j * s)
+    with np.errstate(all="ignore"):  # far out on a contour an entry may overflow: a non-finite value is refined
+        K, _ = batch.assemble(idx, -1j * s)
     v = batch.v_dof[1:-1]
     K[:, v, v] += t * batch.dashpots[config] * s[:, None]
     scale = batch._scale[config]
-    return np.linalg.det(K * scale[:, None] * scale[None, :])
+    with np.errstate(all="ignore"):
+        return np.linalg.det(K * scale[:, None] * scale[None, :])
 
 
 def _secant(f, a: complex, fa: complex, b: complex) -> complex | None:
@@ -218,7 +230,7 @@ def _secant(f, a: complex, fa: complex, b: complex) -> complex | None:
     return None
 
 
-def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray) -> np.ndarray:
+def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray, tolerant: bool = False) -> np.ndarray:
     """Each undamped root ``omega`` (rad/s) followed as the dashpots grow to their values (complex s).
 
     First in one step. As t grows from 0 to ∞, a root moves from s₀ = iω to iω∞, the root with the
@@ -241,9 +253,15 @@ def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray) -> n
         first = -f1 * 2 * h / (det(s0 + h, 0.0) - det(s0 - h, 0.0))  # the first-order shift
         guess = s0 + 1 / (1 / first + 1 / (1j * (pinned[k] - w)))
         s = _secant(lambda z: det(z, 1.0), s0, f1, guess)
-        if s is None or abs(s - guess) > reach[k]:
-            s = _follow_in_steps(det, s0, first, reach[k], k)
-        if np.any(np.abs(out[:k] - s) <= DUPLICATE * abs(s)):
+        if s is None or abs(s - guess) > min(reach[k], SMOOTH * abs(guess - s0)):
+            try:
+                s = _follow_in_steps(det, s0, first, reach[k], k)
+            except ComputationError:
+                if not tolerant:
+                    raise
+                out[k] = np.nan  # lost: :func:`complete` searches for it
+                continue
+        if np.any(np.abs(out[:k] - s) <= DUPLICATE * abs(s)):  # (NaN compares false)
             # another path's root (a near crossing of two modes): that root divided out, from the same start
             found = out[:k][np.abs(out[:k] - s0) < NEAR * reach[k]]
 
@@ -257,9 +275,11 @@ def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray) -> n
                 if s is not None and s.imag > 0 and not np.any(np.abs(out[:k] - s) <= DUPLICATE * abs(s)):
                     break
                 s = None
-            if s is None:
+            if s is None and not tolerant:
                 raise ComputationError(f"the damped mode {k + 1} near {w / (2 * math.pi):.6g} Hz fell onto another "
                                        "mode's root and was not found apart from it")
+            if s is None:
+                s = np.nan
         out[k] = s
     return out
 
@@ -273,10 +293,10 @@ def _follow_in_steps(det, s0: complex, first: complex, reach: float, k: int) -> 
         t1 = min(1.0, t * ratio)
         if previous is None:
             guess = s + first * (t1 - t)
-        else:  # linear in log t
-            guess = s + (s - previous[1]) * math.log(t1 / t) / math.log(t / previous[0])
+        else:  # the secant through the last two points
+            guess = s + (s - previous[1]) * (t1 - t) / (t - previous[0])
         s1 = _secant(lambda z, t1=t1: det(z, t1), s, det(s, t1), guess)
-        if s1 is None or abs(s1 - s) > reach:
+        if s1 is None or abs(s1 - s) > reach or abs(s1 - guess) > SMOOTH * abs(guess - s):
             ratio = math.sqrt(ratio)
             if ratio < MIN_RATIO:
                 break
@@ -288,33 +308,137 @@ def _follow_in_steps(det, s0: complex, first: complex, reach: float, k: int) -> 
     return s
 
 
-def certify_count(batch, config: int, omega: np.ndarray, s: np.ndarray, n_modes: int) -> None:
-    """The argument-principle check of the module docstring; raises ComputationError on a mismatch."""
-    top, above = s[:n_modes].imag.max(), s[n_modes].imag
-    if not above > top:
-        raise ComputationError("the damped modes are not ordered in frequency at the top of the band; ask for one "
-                               "mode more or fewer")
-    lo, hi, right = 0.25 * omega[0], 0.5 * (top + above), 0.05 * omega[0]
-    slope = MAX_DAMPING / math.sqrt(1 - MAX_DAMPING**2)  # the left edge: Re s = −slope Im s, ζ = MAX_DAMPING
-    inside = np.count_nonzero((s.imag > lo) & (s.imag < hi) & (s.real < right) & (s.real > -slope * s.imag))
+def _region(omega: np.ndarray) -> tuple[float, float, float]:
+    """The count's region below its top: Im s > ω₁/4, Re s < ω₁/2, damping ratio below MAX_DAMPING (its right
+    edge half a mode spacing of a string from the axis, and sampled every ω₁/4)."""
+    return 0.25 * omega[0], 0.5 * omega[0], MAX_DAMPING / math.sqrt(1 - MAX_DAMPING**2)
+
+
+def count_zeros(batch, config: int, lo: float, hi: float, right: float, slope: float) -> int:
+    """Eigenvalues with Im s in (lo, hi), Re s < right and −Re s < slope Im s: the winding number of det K
+    plus its poles inside (the clamped-segment frequencies between lo and hi, J0)."""
     turns = winding_number(lambda z: determinant(batch, config, z), [right + 1j * lo, right + 1j * hi,
-                                                                      (-slope + 1j) * hi, (-slope + 1j) * lo])
+                                                                      (-slope + 1j) * hi, (-slope + 1j) * lo],
+                           spacing=0.5 * right)
     _, _, J0 = batch.evaluate(np.array([config, config]), np.array([lo, hi]))
-    zeros = turns + int(J0[1] - J0[0])
-    if zeros != inside or np.unique(np.round(s / hi, 9)).size < s.size:
-        raise ComputationError(f"the damped modes below {hi / (2 * math.pi):.6g} Hz number {zeros} by the argument "
-                               f"principle, but {inside} were found: a mode was lost")
+    return turns + int(J0[1] - J0[0])
 
 
-def winding_number(f, corners: Sequence[complex], per_edge: int = 32) -> int:
-    """Turns of f(z) around 0 along the closed polygon ``corners`` (counter-clockwise), phase-tracked."""
-    z = np.concatenate([a + (b - a) * np.linspace(0.0, 1.0, per_edge, endpoint=False)
-                        for a, b in zip(corners, list(corners[1:]) + [corners[0]])])
+def _inside(s: np.ndarray, lo: float, hi: float, right: float, slope: float) -> np.ndarray:
+    return (s.imag > lo) & (s.imag < hi) & (s.real < right) & (s.real > -slope * s.imag)
+
+
+def complete(batch, config: int, omega: np.ndarray, s: np.ndarray, n_modes: int) -> np.ndarray:
+    """The first ``n_modes`` + 1 eigenvalues (by Im s) of the region, certified by the argument principle;
+    a mode the paths lost (a path that ended on a damper's own overdamped root, or failed) is searched for
+    by halving the band. Raises ComputationError when the count cannot be met."""
+    lo, right, slope = _region(omega)
+    roots = _unique(s[np.isfinite(s)])
+    roots = roots[_inside(roots, lo, np.inf, right, slope)]
+    hi = 0.0
+    for _ in range(2 * n_modes + 8):
+        roots = roots[np.argsort(roots.imag)]
+        if roots.size > n_modes:
+            hi = 0.5 * (roots[n_modes - 1].imag + roots[n_modes].imag)
+        else:  # top modes lost: look above the highest found, a mean spacing further each time
+            top = max(hi, roots[-1].imag if roots.size else omega[0])
+            hi = top + 0.618 * (top - lo) / max(roots.size, 1)  # (not a fraction that halving returns to top)
+        zeros = count_zeros(batch, config, lo, hi, right, slope)
+        inside = int(np.count_nonzero(roots.imag < hi))
+        if zeros < inside:
+            raise ComputationError(f"the damped modes below {hi / (2 * math.pi):.6g} Hz number {zeros} by the "
+                                   f"argument principle, but {inside} were found")
+        if zeros == inside and roots.size > n_modes:
+            return roots[:n_modes + 1]
+        if zeros > inside:
+            roots = _unique(np.concatenate([roots, _search(batch, config, lo, hi, right, slope, roots)]))
+    raise ComputationError(f"a damped mode below {hi / (2 * math.pi):.6g} Hz was lost and not found again")
+
+
+def _unique(s: np.ndarray) -> np.ndarray:
+    s = s[np.argsort(s.imag)]
+    if s.size < 2:
+        return s
+    keep = np.ones(s.size, bool)
+    for i in range(1, s.size):
+        keep[i] = np.all(np.abs(s[:i][keep[:i]] - s[i]) > DUPLICATE * abs(s[i]))
+    return s[keep]
+
+
+def _search(batch, config: int, lo: float, hi: float, right: float, slope: float, known: np.ndarray,
+            depth: int = 0) -> np.ndarray:
+    """The eigenvalues in the band (lo, hi) of the region that ``known`` lacks, by halving the band."""
+    missing = count_zeros(batch, config, lo, hi, right, slope) - int(np.count_nonzero(
+        _inside(known, lo, hi, right, slope)))
+    if missing <= 0:
+        return np.empty(0, complex)
+    if missing == 1:
+        root = _locate(batch, config, lo, hi, right, slope, known)
+        if root is not None:
+            return np.array([root])
+    if depth >= SEARCH_DEPTH:
+        raise ComputationError(f"a damped mode between {lo / (2 * math.pi):.6g} and {hi / (2 * math.pi):.6g} Hz "
+                               "was lost and not found again")
+    mid = _split(lo, hi, known)
+    below = _search(batch, config, lo, mid, right, slope, known, depth + 1)
+    above = _search(batch, config, mid, hi, right, slope, np.concatenate([known, below]), depth + 1)
+    return np.concatenate([below, above])
+
+
+def _split(lo: float, hi: float, known: np.ndarray) -> float:
+    """A point between lo and hi near the middle, at least 2 % of the band from any known root's Im s (a root
+    on a band's edge is counted in neither half)."""
+    for u in (0.5, 0.45, 0.55, 0.4, 0.6, 0.35, 0.65, 0.3, 0.7):
+        mid = lo + u * (hi - lo)
+        if not np.any(np.abs(known.imag - mid) < 0.02 * (hi - lo)):
+            return mid
+    return lo + 0.5 * (hi - lo)
+
+
+def _locate(batch, config: int, lo: float, hi: float, right: float, slope: float, known: np.ndarray):
+    """The one eigenvalue of the band (lo, hi) that ``known`` lacks: the secant method on det K with the
+    known roots divided out, from a few damping ratios at mid-band; None if it is not found there."""
+    mid = 0.5 * (lo + hi)
+
+    near = known[np.argsort(np.abs(known - 1j * mid))[:DEFLATE]]  # the nearest: the rest vary slowly
+
+    def deflated(z):
+        return determinant(batch, config, np.array([z]))[0] / np.prod(z - near)
+
+    for zeta in (1e-4, 1e-3, 0.01, 0.1, 0.3):
+        a = complex(-zeta * mid, mid)
+        b = a + 0.1j * (hi - lo)
+        root = _secant(deflated, a, deflated(a), b)
+        if root is not None and _inside(np.array([root]), lo, hi, right, slope)[0] and not np.any(
+                np.abs(known - root) <= DUPLICATE * abs(root)):
+            return root
+    return None
+
+
+def edge_parameters(a: complex, b: complex, spacing: float) -> np.ndarray:
+    """Where on the edge a → b (0 ≤ u < 1) the phase is first sampled: at most ``spacing`` apart and, on an
+    edge that crosses the imaginary axis, ever closer to it (Re s = ±spacing 2⁻ᵏ, k = 1 … 40): the poles
+    of det K lie on the axis and the lightly damped roots beside it, at any distance from the crossing."""
+    u = np.linspace(0.0, 1.0, max(8, math.ceil(abs(b - a) / spacing)), endpoint=False)
+    if a.imag == b.imag and min(a.real, b.real) < 0 < max(a.real, b.real):
+        x = spacing * 2.0 ** -np.arange(1, 41)
+        x = np.concatenate([-x, x])
+        u = np.concatenate([u, (x - a.real) / (b.real - a.real)])
+        u = np.unique(u[(u >= 0) & (u < 1)])
+    return u
+
+
+def winding_number(f, corners: Sequence[complex], spacing: float) -> int:
+    """Turns of f(z) around 0 along the closed polygon ``corners`` (counter-clockwise), phase-tracked from
+    the points of :func:`edge_parameters`, refined until no step changes the phase by more than π/4 (or
+    the modulus by more than a factor e)."""
+    ends = list(corners[1:]) + [corners[0]]
+    z = np.concatenate([a + (b - a) * edge_parameters(a, b, spacing) for a, b in zip(corners, ends)])
     z = np.append(z, z[0])
     v = f(z)
     while True:
         step = np.angle(v[1:] / v[:-1])
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.abs(np.log(np.abs(v[1:] / v[:-1])))
         coarse = np.flatnonzero((np.abs(step) > MAX_ARG_STEP) | ~(ratio < 1.0))
         if coarse.size == 0:
