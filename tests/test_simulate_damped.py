@@ -27,11 +27,11 @@ from stcs_ident.simulate import (
     LowPassLoading,
     PinkNoise,
     TensionDrift,
+    damped_response,
     simulate_record,
     simulate_record_with_truth,
     true_model,
 )
-from stcs_ident.simulate import damped_response
 from stcs_ident.simulate.damped_modes import damped_modes
 from stcs_ident.simulate.damped_response import stationary_state_covariance
 from stcs_ident.simulate.modal_response import modal_force_covariance, stationary_covariance, zoh_transition
