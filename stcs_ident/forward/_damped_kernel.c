@@ -265,7 +265,8 @@ static int follow(const Problem *P, long long cfg, const double *omega, const do
         cplx first = -f1 * 2 * h / (cdet(P, cfg, s0 + h, 0.0) - cdet(P, cfg, s0 - h, 0.0));
         cplx guess = s0 + 1.0 / (1.0 / first + 1.0 / (I * (pinned[k] - omega[k])));
         double tight = SMOOTH * cabs(guess - s0) < reach ? SMOOTH * cabs(guess - s0) : reach;
-        if (secant(P, cfg, 1.0, s0, f1, guess, &s) != 0 || cabs(s - guess) > tight)
+        cplx near_guess = guess + 1e-3 * (guess - s0);  /* the secant from the prediction: local */
+        if (secant(P, cfg, 1.0, guess, cdet(P, cfg, guess, 1.0), near_guess, &s) != 0 || cabs(s - guess) > tight)
             if (follow_in_steps(P, cfg, s0, first, reach, &s) != 0) {
                 out[k] = NAN;
                 lost++;
@@ -319,20 +320,30 @@ static int cmp_double(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-/* Where on the edge a → b (0 <= u < 1) the phase is first sampled (as damped.edge_parameters): at most
- * spacing apart and, on an edge crossing the imaginary axis, ever closer to it. Returns the count, or −1. */
+/* Where on the edge a → b (0 <= u < 1) the phase is first sampled (as damped.edge_parameters): spacing
+ * apart near the imaginary axis, a quarter of the distance to it farther out, and, on an edge crossing
+ * the axis, ever closer to it. Returns the count, or −1. */
 static int edge_parameters(cplx a, cplx b, double spacing, double **u_out) {
-    int n = (int)ceil(cabs(b - a) / spacing);
-    if (n < 8) n = 8;
-    double *u = malloc(sizeof(double) * (size_t)(n + 80));
+    double length = cabs(b - a);
+    int cap = 64, m = 0;
+    double *u = malloc(sizeof(double) * (size_t)(cap + 80));
     if (!u) return -1;
-    for (int k = 0; k < n; k++) u[k] = (double)k / n;
-    int m = n;
+    for (double at = 0.0; at < 1.0;) {
+        if (m == cap) {
+            cap *= 2;
+            double *v = realloc(u, sizeof(double) * (size_t)(cap + 80));
+            if (!v) { free(u); return -1; }
+            u = v;
+        }
+        u[m++] = at;
+        double x = fabs(creal(a + (b - a) * at)), step = 0.25 * x > spacing ? 0.25 * x : spacing;
+        at += step / length;
+    }
     double ar = creal(a), br = creal(b);
     if (cimag(a) == cimag(b) && fmin(ar, br) < 0 && 0 < fmax(ar, br)) {
-        for (int k = 1; k <= 40; k++)
+        for (int k = 1; k <= 20; k++)
             for (int sgn = -1; sgn <= 1; sgn += 2) {
-                double v = (sgn * spacing * ldexp(1.0, -k) - ar) / (br - ar);
+                double v = (sgn * spacing * ldexp(1.0, -2 * k) - ar) / (br - ar);
                 if (v >= 0 && v < 1) u[m++] = v;
             }
         qsort(u, (size_t)m, sizeof(double), cmp_double);

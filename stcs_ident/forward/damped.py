@@ -22,8 +22,8 @@ How every mode is found, and none missed
    −Re s < 0.577 Im s (damping ratio below 0.5), Re s < ω₁/2 (ω_top midway between the highest
    requested mode and the next), the winding number of det K(s) plus the number of its poles inside (the
    clamped-segment frequencies, which are real: the J0 count of the undamped solver) is the number of
-   eigenvalues inside. The phase of det K is sampled every ω₁/4 and, where an edge crosses the imaginary
-   axis, ever closer to it (poles lie on the axis, lightly damped roots beside it: a pole or root passed
+   eigenvalues inside. The phase of det K is sampled every ω₁/4 near the imaginary axis (a quarter of
+   the distance to it farther out) and, where an edge crosses the axis, ever closer to it (poles lie on the axis, lightly damped roots beside it: a pole or root passed
    closer than the samples' spacing would turn the phase by 2π unseen), then refined until no step
    changes it by more than π/4. When the count exceeds the roots found (a path ended on one of the damper's own overdamped
    roots, which cross the cable modes' paths when the damper has a mass, or failed), the band is halved
@@ -237,7 +237,7 @@ def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray, tole
     dampers' nodes pinned (``pinned``: its k-th root for the k-th mode, by interlacing). For one damper
     the path is a Möbius map of t (det K is linear in t, and the dynamic stiffness the damper sees has a
     zero at s₀ and a pole at iω∞), so 1/(s − s₀) = 1/(t δ₁) + 1/(iω∞ − s₀), δ₁ the first-order shift:
-    the secant method's start. If that fails or lands farther than ``JUMP`` times the distance to the
+    the secant method's start (with a point beside it: a start at s₀ wandered off to other roots). If that fails or lands farther than ``JUMP`` times the distance to the
     neighbouring roots from the prediction, by geometric steps in t (:func:`_follow_in_steps`).
     """
     gaps = np.diff(np.concatenate(([0.0], omega, [2 * omega[-1] - omega[-2] if omega.size > 1 else 2 * omega[0]])))
@@ -252,7 +252,7 @@ def follow_roots(batch, config: int, omega: np.ndarray, pinned: np.ndarray, tole
         f1 = det(s0, 1.0)
         first = -f1 * 2 * h / (det(s0 + h, 0.0) - det(s0 - h, 0.0))  # the first-order shift
         guess = s0 + 1 / (1 / first + 1 / (1j * (pinned[k] - w)))
-        s = _secant(lambda z: det(z, 1.0), s0, f1, guess)
+        s = _secant(lambda z: det(z, 1.0), guess, det(guess, 1.0), guess + 1e-3 * (guess - s0))  # local
         if s is None or abs(s - guess) > min(reach[k], SMOOTH * abs(guess - s0)):
             try:
                 s = _follow_in_steps(det, s0, first, reach[k], k)
@@ -416,12 +416,20 @@ def _locate(batch, config: int, lo: float, hi: float, right: float, slope: float
 
 
 def edge_parameters(a: complex, b: complex, spacing: float) -> np.ndarray:
-    """Where on the edge a → b (0 ≤ u < 1) the phase is first sampled: at most ``spacing`` apart and, on an
-    edge that crosses the imaginary axis, ever closer to it (Re s = ±spacing 2⁻ᵏ, k = 1 … 40): the poles
-    of det K lie on the axis and the lightly damped roots beside it, at any distance from the crossing."""
-    u = np.linspace(0.0, 1.0, max(8, math.ceil(abs(b - a) / spacing)), endpoint=False)
+    """Where on the edge a → b (0 ≤ u < 1) the phase is first sampled: ``spacing`` apart near the imaginary
+    axis, a quarter of the distance to it farther out (the roots there are damped, so det K varies on that
+    scale), and, on an edge that crosses the axis, ever closer to it (Re s = ±spacing 4⁻ᵏ, k = 1 … 20):
+    the poles of det K lie on the axis and the lightly damped roots beside it, at any distance from the
+    crossing."""
+    length = abs(b - a)
+    u, at = [], 0.0
+    while at < 1.0:
+        u.append(at)
+        z = a + (b - a) * at
+        at += max(spacing, 0.25 * abs(z.real)) / length
+    u = np.array(u)
     if a.imag == b.imag and min(a.real, b.real) < 0 < max(a.real, b.real):
-        x = spacing * 2.0 ** -np.arange(1, 41)
+        x = spacing * 4.0 ** -np.arange(1, 21)
         x = np.concatenate([-x, x])
         u = np.concatenate([u, (x - a.real) / (b.real - a.real)])
         u = np.unique(u[(u >= 0) & (u < 1)])
