@@ -29,6 +29,7 @@ from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
     HypothesisFit,
     aicc,
+    data,
     failed_fit,
     fit_hypothesis,
     fit_nominal,
@@ -111,7 +112,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             raise InputError(why, field="effects")
         else:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
-    n = sum(m.modes.size for m in measurements)
+    n = data(campaign, measurements, settings.tension_model).n_data  # the frequencies (and damping ratios)
     sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
     baseline = tuple(e for e in BASELINE if applicable(campaign, measured_tests, e) is None)
     for e in baseline:  # fitted as the reference of the gain even when not among the effects considered
@@ -155,10 +156,9 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             if progress is not None:
                 progress(done, total, " + ".join(s) if s else "nominal")
     if needs_model_error(fits, n):
-        measured = np.concatenate([m.frequencies for m in measurements])
-        sigma = np.concatenate([m.uncertainty for m in measurements])
+        reference = data(campaign, measurements, settings.tension_model)  # the frequencies (and damping ratios)
         for fit in fits.values():
-            with_model_error(fit, measured, sigma)
+            with_model_error(fit, reference.measured, reference.sigma)
     selection = select(fits, n, settings.max_effects)
     test_cv = _test_cv(fits, selection, measurements, settings.tension_model)
     comparison = nominal_comparison(campaign, measurements, given, settings)

@@ -32,7 +32,8 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
     hyp = fit.hypothesis
     full = hypothesis_problem(hyp, measurements, tension_model)
     x_full = fit.result.estimate
-    measured = full.measured
+    nf = full.n_frequencies  # the frequencies (the damping ratios, when data, follow them)
+    measured = full.measured[:nf]
     modes = np.concatenate([m.modes for m in measurements])
     predicted = np.full(measured.size, np.nan)
     for mode in np.unique(modes):
@@ -50,7 +51,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
         x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
         x[used] = x_sub
         left = modes == mode
-        predicted[left] = full.predict(x)[left]
+        predicted[left] = full.predict(x)[:nf][left]
     if not np.all(np.isfinite(predicted)):
         return None
     return rms_percent(predicted, measured)
@@ -87,4 +88,4 @@ def cross_validate_tests(fit: HypothesisFit, measurements: Sequence[Measurement]
     predicted = np.concatenate(predicted)
     if not np.all(np.isfinite(predicted)):
         return None
-    return rms_percent(predicted, full.measured)
+    return rms_percent(predicted, full.measured[:full.n_frequencies])

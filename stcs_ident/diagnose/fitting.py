@@ -31,7 +31,7 @@ from .. import effects as registry
 from ..formatting import PARAMETER_UNITS
 from ..forward import batch_frequencies
 from ..identify.lsq import fit_lsq, local_fit
-from ..identify.parameters import fixity
+from ..identify.parameters import fixity, parse_parameters
 from ..identify.problem import Measurement, Problem
 from ..identify.result import IdentificationResult
 from ..model import Attachment, Campaign, Test
@@ -255,13 +255,25 @@ def nominal_prediction(campaign: Campaign, measurements: Sequence[Measurement], 
     return np.concatenate(out)
 
 
+def data(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> Problem:
+    """The diagnosis's data as a problem of the nominal model (the stated tensions free, at their start):
+    the frequencies and, with a damper in the model and measured damping ratios, those ratios (every
+    hypothesis is judged on the same data, the nominal model included)."""
+    tests = [m.test for m in measurements]
+    return Problem(campaign, measurements, parse_parameters(campaign, tests, "tension"), tension_model)
+
+
 def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> HypothesisFit:
-    measured = np.concatenate([m.frequencies for m in measurements])
-    sigma = np.concatenate([m.uncertainty for m in measurements])
-    f = nominal_prediction(campaign, measurements, tension_model)
+    problem = data(campaign, measurements, tension_model)
+    if problem.use_damping:
+        f = problem.predict(problem.start)
+    else:
+        f = nominal_prediction(campaign, measurements, tension_model)
+    measured, sigma = problem.measured, problem.sigma
     terms = ((f - measured) / sigma) ** 2
     chi2 = float(np.sum(terms))
-    rms = rms_percent(f, measured)
+    nf = problem.n_frequencies
+    rms = rms_percent(f[:nf], measured[:nf])
     hyp = Hypothesis((), campaign, (), ())
     return HypothesisFit(hyp, None, f, chi2, aicc(chi2, measured.size, 0), rms, cv_rms_error=rms, terms=terms,
                          sigma=sigma)
@@ -410,7 +422,8 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
                                     for p, v in zip(problem.parameters, result.estimate)}, tension_model)
     penalty = prior_penalty(hyp, result.estimate, result.uncertainty, located)
     fit = HypothesisFit(hyp, result, predicted, chi2, aicc(chi2 + penalty, n, len(hyp.parameters)),
-                        rms_percent(predicted, problem.measured), notes=notes, profile=sorted(profile),
+                        rms_percent(predicted[:problem.n_frequencies], problem.measured[:problem.n_frequencies]),
+                        notes=notes, profile=sorted(profile),
                         minima=minima, penalty=penalty, terms=terms, sigma=problem.sigma)
     return fit
 

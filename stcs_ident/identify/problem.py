@@ -33,6 +33,11 @@ JACOBIAN_STEP = 1e-6
 #: relative at g = 1.25e-3 l on a hanger (ξ ≈ 11), 2e-4 at 1.25e-5 l, and a non-finite matrix at
 #: 2e-10 l. At 1e-3 l (8 mm on an 8 m hanger) the model stays accurate to a few 1e-9.
 MIN_GAP = 1e-3
+#: Whether the trial points of a fit certify the count of their complex modes. Off: a fit evaluates
+#: thousands of nearby configurations, each mode followed from its certified undamped root (a lost path
+#: makes the row NaN, a point the fit avoids), and the count costs 40-70 % more per point; forward,
+#: spectra's numbering and the reports certify.
+FIT_CERTIFY = False
 #: Spread (absolute) of a cable's own damping ratio across modes, added in quadrature to a measured
 #: damping ratio's σ: the model holds the dampers' damping and one own ratio for all modes (a nuisance
 #: profiled out), while a cable's own damping varies from mode to mode by a few 1e-4 (aerodynamic
@@ -338,9 +343,10 @@ class Problem:
         (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
         cable = self.campaign.cable
         try:
-            if damped:
-                s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model, **overrides)
-                return np.abs(s) / (2 * math.pi), -s.real / np.abs(s)
+            if damped or _dashpots(atts, overrides):  # the fit's trial points: uncertified (see FIT_CERTIFY)
+                s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model,
+                                        certify=FIT_CERTIFY, **overrides)
+                return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
             return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
                                      **overrides), None
         except ComputationError:
@@ -389,6 +395,13 @@ class Problem:
         r = (self.predict(np.atleast_2d(X)) - self.measured) / self.sigma
         c = np.sum(r**2, axis=1)
         return np.where(np.isfinite(c), c, np.inf)
+
+
+def _dashpots(atts, overrides) -> bool:
+    """Whether a dashpot is on (a damper, or a ``coefficients`` override)."""
+    if "coefficients" in overrides:
+        return bool(np.any(np.asarray(overrides["coefficients"]) != 0))
+    return any(getattr(a, "coefficient", 0.0) for a in atts)
 
 
 def valid_rows(ov: dict[str, np.ndarray], length: float, nominal_positions: np.ndarray) -> np.ndarray:

@@ -1,0 +1,108 @@
+"""Hidden damper effects (issue 13): records → spectra → diagnosis must name the effect, exactly.
+
+On the two benches of tests/diagnose_cases.py (a short stiff hanger, ξ ≈ 11, and a long inclined stay
+with sag), with a viscous damper near end A whose dashpot is mode 1's optimum (η₁ = 1):
+
+- ``damper_coefficient``: the damper leaks, its true dashpot 30 % of the recorded one; the diagnosis with
+  its default vocabulary (both damper effects apply: the setup has a damper) must name it alone and
+  recover the dashpot within 25 % (as the other amplitudes of the vocabulary);
+- ``damper``: the campaign lacks the damper; asked for every effect (a missing damper is considered when
+  asked for by name on a cable without one), the diagnosis of the hanger must name it alone;
+- a damped hanger without any hidden effect gives an empty cause.
+With a recorded damper the diagnosis judges the measured damping ratios beside the frequencies (the
+nominal model and every hypothesis alike); without one, frequencies only. Single-effect
+hypotheses only (``max_effects=1``): every complex-mode evaluation costs about three undamped ones, and
+the pairs of the vocabulary are tested in test_diagnose_hidden.py; with pairs the leaking damper of the
+hanger is named alike (84 s instead of 7).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import pytest
+from diagnose_cases import BENCHES, MAX_MODES
+
+from stcs_ident import effects as registry
+from stcs_ident.campaign_io import load_campaign
+from stcs_ident.diagnose import diagnose
+from stcs_ident.diagnose.hypotheses import applicable
+from stcs_ident.model import Campaign, Damper, Setup, Test
+from stcs_ident.simulate.effects import Effects
+from stcs_ident.simulate.simulate import Impulse
+from stcs_ident.simulate.simulate_campaign import simulate_campaign
+from stcs_ident.spectra.pipeline import analyse_test
+
+#: Damper position as a fraction of the length.
+AT = 0.02
+
+
+def _damper(bench: str) -> Damper:
+    b = BENCHES[bench]
+    xd = AT * b.length
+    c = math.sqrt(b.tensions[0] * b.cable.mass_per_length) * b.length / (math.pi * xd)
+    return Damper("D1", xd, coefficient=c)
+
+
+def _campaign(bench: str, with_damper: bool) -> Campaign:
+    b = BENCHES[bench]
+    points = (b.attachment, _damper(bench)) if with_damper else (b.attachment,)
+    tests = tuple(Test(f"T{i + 1}", "S", h) for i, h in enumerate(b.tensions))
+    return Campaign(f"{bench}-damped", b.cable, (Setup("S", points),), tests)
+
+
+def _diagnose(tmp_path, bench: str, nominal: Campaign, hidden: Effects | None, seed: int = 0, **options):
+    b = BENCHES[bench]
+    length = b.length
+    out = tmp_path / f"{bench}-{seed}"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a numbering warning on a shifted record is reported, not an error here
+        simulate_campaign(nominal, out, positions=[0.23 * length, 0.5 * length, 0.71 * length],
+                          duration=b.duration, sampling_rate=b.sampling_rate, damping=0.005,
+                          impulses=(Impulse(0.5, 0.17 * length, 1.0),), snr_db=30.0, effects=hidden, seed=seed)
+        campaign = load_campaign(out)
+        picked = {t.name: analyse_test(campaign, t, max_modes=MAX_MODES) for t in campaign.tests}
+        return diagnose(campaign, picked=picked, **options)
+
+
+def _cause(d) -> dict:
+    return d.summary()["cause"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("bench", list(BENCHES))
+def test_a_leaking_damper_is_named_and_sized(tmp_path, bench):
+    nominal = _campaign(bench, with_damper=True)
+    true = 0.3 * _damper(bench).coefficient
+    cause = _cause(_diagnose(tmp_path, bench, nominal, Effects(damper_coefficients={"D1": true}), max_effects=1))
+    assert cause["effects"] == ["damper_coefficient"], cause["statement"]
+    found = cause["parameters"]["damper_coefficient"]["coefficient"]["D1"]
+    assert found == pytest.approx(true, rel=0.25)
+
+
+@pytest.mark.slow
+def test_a_missing_damper_on_the_hanger_is_named(tmp_path):
+    """Named from the frequencies alone (a cable without a recorded damper has no damping ratios in its
+    diagnosis). Its size is not checked: the frequencies fix the dashpot only to a factor of about two (29
+    kN s/m found for 55), and on the stay they do not tell it from a tension change (named: tension) —
+    both need the damping ratios in the diagnosis of a cable without a recorded damper."""
+    nominal = _campaign("hanger", with_damper=False)
+    damper = _damper("hanger")
+    cause = _cause(_diagnose(tmp_path, "hanger", nominal, Effects(extra_damper=(damper.coefficient, damper.position)),
+                             effects=[e for e in registry.names() if e != "damper_coefficient"], max_effects=1))
+    assert cause["effects"] == ["damper"], cause["statement"]
+
+
+@pytest.mark.slow
+def test_a_healthy_damped_hanger_has_no_cause(tmp_path):
+    cause = _cause(_diagnose(tmp_path, "hanger", _campaign("hanger", with_damper=True), None, seed=3,
+                             max_effects=1))
+    assert cause["effects"] == [], cause["statement"]
+
+
+def test_the_missing_damper_is_not_considered_unless_asked_on_a_cable_without_one():
+    plain = _campaign("hanger", with_damper=False)
+    assert applicable(plain, plain.tests, "damper") is not None
+    assert applicable(_campaign("hanger", with_damper=True), plain.tests, "damper") is None
+    assert applicable(plain, plain.tests, "damper_coefficient") is not None
