@@ -70,7 +70,7 @@ def plot_complex_shapes(shapes, length: float, dampers: Sequence[float], n_modes
     ax_m.set_ylabel("|φ(x)| (peak 1)")
     ax_m.legend(fontsize=8, loc="upper right")
     ax_m.set_title("Complex mode shapes: modulus and phase (red dashed: damper)", fontsize=10)
-    ax_p.set_ylabel("phase (deg, modulo 180, from mid-span)")
+    ax_p.set_ylabel("phase (deg, from mid-span)")
     ax_p.set_xlabel("position from end A (m)")
     return {"figure": fig, "axes": (ax_m, ax_p), "lines": lines}
 
