@@ -124,3 +124,23 @@ def test_an_elastic_end_and_a_damper_with_a_spring_and_a_mass():
     modes = complex_modes(cable, atts, 3.5e6, 8)
     assert np.all(modes.damping > 0) and np.all(modes.damping < 3.0 / (2 * 150.0))
     assert np.all(np.diff(modes.frequency) > 0)
+
+
+def test_complex_mode_shapes_reduce_to_the_real_ones_and_carry_a_phase_with_a_damper():
+    """As the dashpot vanishes the complex shapes are the undamped mass-normalised ones up to a complex
+    factor (1e-8: the null vector's accuracy); at mode 1's optimum the shape near the damper leads or lags
+    mid-span by a fraction of a right angle (45° for Krenk's η = 1), where a real shape has none."""
+    from stcs_ident.forward.damped_shapes import complex_mode_shapes
+    from stcs_ident.forward.shapes import mode_shapes
+
+    x = np.linspace(0.0, STAY.length, 401)
+    complex_ = complex_mode_shapes(STAY, [Damper("D1", 4.0, coefficient=1e-3)], H, 4)(x)
+    real = mode_shapes(STAY, [Attachment("D1", 4.0)], H, 4)(x)
+    factor = (real * complex_).sum(axis=0) / (real**2).sum(axis=0)
+    np.testing.assert_allclose(complex_, real * factor, atol=1e-8)
+    shapes = complex_mode_shapes(STAY, [Damper("D1", 4.0, coefficient=C_OPT)], H, 1)
+    near, mid = shapes(np.array([4.0, STAY.length / 2]))[:, 0]
+    lag = abs(math.degrees(np.angle(near / mid)))
+    assert 10.0 < lag < 80.0, lag
+    assert shapes.damping[0] == pytest.approx(complex_modes(STAY, [Damper("D1", 4.0, coefficient=C_OPT)], H, 1)
+                                              .damping[0], rel=1e-12)

@@ -20,7 +20,7 @@ from ..errors import ComputationError
 from ..model import Attachment, Cable
 from .damped import batch_complex_modes
 from .dsm import build_batch
-from .shapes import _segment_slice
+from .shapes import segment_solutions
 
 __all__ = ["ComplexShapes", "complex_mode_shapes"]
 
@@ -84,7 +84,6 @@ def complex_mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension
     atts = sorted(attachments, key=lambda a: a.position)
     roots = batch_complex_modes(cable, atts, float(tension), n_modes, tension_model=tension_model)
     _, [(batch, _)] = build_batch(cable, atts, float(tension), tension_model=tension_model)
-    topo = batch.topology
     nodes = np.concatenate([[0.0], [a.position for a in atts], [cable.length]])
     idx = np.zeros(1, dtype=np.int64)
     segments, coefficients, particular = [], [], []
@@ -100,21 +99,7 @@ def complex_mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension
             raise ComputationError(f"the damped mode at {abs(s) / (2 * math.pi):.6g} Hz is not a null vector of "
                                    "the nodal unknowns (its nodes all rest)")
         z = scale * vh[-1].conj()
-        dof = np.append(z, 0.0).__getitem__  # index −1 (a fixed dof) reads 0
-        h = z[batch.h_dof] if topo.n_h else np.zeros(0)
-        gamma = batch.w[0] / (batch.H[0] * batch.m[0] * omega[0] ** 2)
-        part = np.zeros(topo.n_segments, dtype=complex)
-        objs, per_seg = [], []
-        for j in range(topo.n_segments):
-            hj = 0.0 if topo.n_h == 0 else (h[0] if topo.tension_model == "uniform" else h[j])
-            part[j] = gamma * hj
-            one = _segment_slice(seg, j)
-            objs.append(one)
-            v1, v2 = dof(batch.v_dof[j]) - part[j], dof(batch.v_dof[j + 1]) - part[j]
-            if topo.string:
-                per_seg.append(one.shape_coefficients(v1, v2))
-            else:
-                per_seg.append(one.shape_coefficients(v1, dof(batch.t_dof[j]), v2, dof(batch.t_dof[j + 1])))
+        objs, per_seg, part = segment_solutions(batch, seg, z, omega[0])
         segments.append(objs)
         coefficients.append(per_seg)
         particular.append(part)

@@ -142,28 +142,36 @@ def _mode_shapes(cable, attachments, tension, n_modes, tension_model) -> ModeSha
                 "its shape is not defined by the nodal values"
             )
         z = s * vec[:, order[0]]
-        dof = np.append(z, 0.0).__getitem__  # index −1 (a fixed dof) reads 0
         h = z[batch.h_dof] if topo.n_h else np.zeros(0)
-        gamma = batch.w[0] / (batch.H[0] * batch.m[0] * omega[0] ** 2)
-        per_seg = []
-        part = np.zeros(topo.n_segments)
-        objs = []
-        for j in range(topo.n_segments):
-            hj = 0.0 if topo.n_h == 0 else (h[0] if topo.tension_model == "uniform" else h[j])
-            part[j] = gamma * hj
-            one = _segment_slice(seg, j)
-            objs.append(one)
-            v1, v2 = dof(batch.v_dof[j]) - part[j], dof(batch.v_dof[j + 1]) - part[j]
-            if topo.string:
-                per_seg.append(one.shape_coefficients(v1, v2))
-            else:
-                per_seg.append(one.shape_coefficients(v1, dof(batch.t_dof[j]), v2, dof(batch.t_dof[j + 1])))
+        objs, per_seg, part = segment_solutions(batch, seg, z, omega[0])
         segments.append(objs)
         coefficients.append(per_seg)
         particular.append(part)
         h_all.append(h)
     shapes = ModeShapes(np.asarray(freqs), np.array(h_all), nodes, segments, coefficients, np.array(particular))
     return _normalised(shapes, cable, atts)
+
+
+def segment_solutions(batch, seg, z: np.ndarray, omega) -> tuple[list, list, np.ndarray]:
+    """Each segment's exact solution for the nodal unknowns ``z`` (null vector of K at ``omega``, real or
+    complex): the segments as scalars, their homogeneous coefficients and the particular part γ ĥ."""
+    topo = batch.topology
+    dof = np.append(z, 0.0).__getitem__  # index −1 (a fixed dof) reads 0
+    h = z[batch.h_dof] if topo.n_h else np.zeros(0)
+    gamma = batch.w[0] / (batch.H[0] * batch.m[0] * omega**2)
+    part = np.zeros(topo.n_segments, dtype=np.result_type(z, omega))
+    objs, per_seg = [], []
+    for j in range(topo.n_segments):
+        hj = 0.0 if topo.n_h == 0 else (h[0] if topo.tension_model == "uniform" else h[j])
+        part[j] = gamma * hj
+        one = _segment_slice(seg, j)
+        objs.append(one)
+        v1, v2 = dof(batch.v_dof[j]) - part[j], dof(batch.v_dof[j + 1]) - part[j]
+        if topo.string:
+            per_seg.append(one.shape_coefficients(v1, v2))
+        else:
+            per_seg.append(one.shape_coefficients(v1, dof(batch.t_dof[j]), v2, dof(batch.t_dof[j + 1])))
+    return objs, per_seg, part
 
 
 def _segment_slice(seg, j):
