@@ -10,6 +10,7 @@ few errors may exceed 3σ; no mains-hum line may be reported as a mode.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import math
 import sys
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from case_pool import map_cases
 
 HELD_OUT_SEED = 3
 
@@ -30,6 +32,7 @@ CASES = [
 ]
 
 
+@functools.cache
 def _harness():
     path = Path(__file__).resolve().parents[1] / "benchmarks" / "calibrate_spectra.py"
     spec = importlib.util.spec_from_file_location("calibrate_spectra", path)
@@ -43,12 +46,20 @@ def _binomial_se(p: float, n: int) -> float:
     return math.sqrt(p * (1 - p) / n)
 
 
+def _run(case: tuple[str, str, int, int]) -> dict:
+    harness = _harness()
+    return harness.run_case(harness.build_case(*case))
+
+
 @pytest.fixture(scope="module")
 def results():
-    harness = _harness()
+    _harness()  # loaded once, before the workers fork
+    cases = [(group, cable, HELD_OUT_SEED, i) for group, cable, n in CASES for i in range(n)]
+    # The records are independent: run on the CPUs available, in order (tests/case_pool.py).
+    done = map_cases(_run, cases)
     out = {}
-    for group, cable, n in CASES:
-        out[(group, cable)] = [harness.run_case(harness.build_case(group, cable, HELD_OUT_SEED, i)) for i in range(n)]
+    for (group, cable, _, _), result in zip(cases, done):
+        out.setdefault((group, cable), []).append(result)
     return out
 
 
