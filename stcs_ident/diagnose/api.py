@@ -15,6 +15,7 @@ import itertools
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from ..compare import ForwardResult, compare_forward
 from ..effects import registry
 from ..errors import InputError
 from ..identify.problem import Measurement, gather_measurements
-from ..model import Campaign
+from ..model import Campaign, has_dampers
 from ..notes import Note
 from ..settings import Settings
 from .cross_validation import cross_validate, cross_validate_tests
@@ -112,6 +113,12 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             raise InputError(why, field="effects")
         else:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
+    # The damping ratios are data, for the nominal model and every hypothesis alike, where a damper is in
+    # question: a recorded damper, or a missing one asked for.
+    with_damping = (any(has_dampers(campaign.setup(m.test.setup).attachments) for m in measurements)
+                    or any("coefficient" in (registry.get(e).parameter_kind, getattr(registry.get(e), "amount_kind", None))
+                           for e in usable))
+    measurements = [replace(m, damping_is_data=with_damping) for m in measurements]
     n = data(campaign, measurements, settings.tension_model).n_data  # the frequencies (and damping ratios)
     sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
     baseline = tuple(e for e in BASELINE if applicable(campaign, measured_tests, e) is None)

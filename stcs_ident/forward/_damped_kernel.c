@@ -29,6 +29,7 @@
 #define MAX_MODES 512
 #define MAX_DAMPING 0.5
 #define DEFLATE 8
+#define LINE_POINTS 64
 #define SEARCH_DEPTH 30
 #define JUMP 0.25
 #define MAX_ARG_STEP (M_PI / 4)
@@ -416,8 +417,18 @@ static int locate(const Problem *P, long long cfg, const Region *R, double lo, d
         near[nn] = known[best];
     }
     static const double zetas[5] = {1e-4, 1e-3, 0.01, 0.1, 0.3};
-    for (int k = 0; k < 5; k++) {
-        cplx a = -zetas[k] * mid + I * mid, b = a + 0.1 * I * (hi - lo);
+    cplx best = I * mid;  /* the smallest |det K| across the band's middle, away from the known roots */
+    double smallest = INFINITY;
+    for (int j = 0; j < LINE_POINTS; j++) {
+        cplx z = mid * (I - R->slope * (double)j / (LINE_POINTS - 1));
+        int clear = 1;
+        for (int i = 0; i < nn; i++) clear &= cabs(z - near[i]) >= 0.02 * mid;
+        if (!clear) continue;
+        double v = cabs(cdet(P, cfg, z, 1.0));
+        if (v < smallest) { smallest = v; best = z; }
+    }
+    for (int k = 0; k < 6; k++) {
+        cplx a = k < 5 ? -zetas[k] * mid + I * mid : best, b = a + 0.1 * I * (hi - lo);
         if (secant_d(P, cfg, 1.0, a, fdefl(P, cfg, a, 1.0, near, nn), b, near, nn, root) == 0
             && in_region(*root, R, lo, hi) && !is_known(*root, known, nk))
             return 0;

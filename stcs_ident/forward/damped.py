@@ -71,6 +71,7 @@ DUPLICATE = 1e-8  # two roots closer than this (relative) are one
 NEAR = 16  # roots within this many reaches of a path's start are divided out when it fell onto one
 SEARCH_DEPTH = 30  # halvings of the band in the search for a lost mode
 DEFLATE = 8  # known roots divided out when locating a lost one
+LINE_POINTS = 64  # samples across the band's middle where a lost root is sought
 MAX_CONTOUR_POINTS = 200_000
 
 
@@ -397,7 +398,8 @@ def _split(lo: float, hi: float, known: np.ndarray) -> float:
 
 def _locate(batch, config: int, lo: float, hi: float, right: float, slope: float, known: np.ndarray):
     """The one eigenvalue of the band (lo, hi) that ``known`` lacks: the secant method on det K with the
-    known roots divided out, from a few damping ratios at mid-band; None if it is not found there."""
+    known roots divided out, from a few damping ratios at mid-band and from the smallest |det K| across it;
+    None if it is not found there."""
     mid = 0.5 * (lo + hi)
 
     near = known[np.argsort(np.abs(known - 1j * mid))[:DEFLATE]]  # the nearest: the rest vary slowly
@@ -405,8 +407,11 @@ def _locate(batch, config: int, lo: float, hi: float, right: float, slope: float
     def deflated(z):
         return determinant(batch, config, np.array([z]))[0] / np.prod(z - near)
 
-    for zeta in (1e-4, 1e-3, 0.01, 0.1, 0.3):
-        a = complex(-zeta * mid, mid)
+    line = mid * (1j - slope * np.linspace(0.0, 1.0, LINE_POINTS))  # across the band's middle
+    values = np.abs(determinant(batch, config, line))  # its smallest away from the known roots
+    values[np.any(np.abs(line[:, None] - near[None, :]) < 0.02 * mid, axis=1)] = np.inf
+    starts = [complex(-zeta * mid, mid) for zeta in (1e-4, 1e-3, 0.01, 0.1, 0.3)] + [line[np.argmin(values)]]
+    for a in starts:
         b = a + 0.1j * (hi - lo)
         root = _secant(deflated, a, deflated(a), b)
         if root is not None and _inside(np.array([root]), lo, hi, right, slope)[0] and not np.any(

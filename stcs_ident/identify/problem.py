@@ -63,6 +63,10 @@ class Measurement:
     damping, damping_uncertainty : ndarray or None
         Measured damping ratios and their 1σ, ordered by ``modes`` (NaN
         where not measured); used with a damper in the model.
+    damping_is_data : bool or None
+        Whether a :class:`Problem` of these measurements takes the damping
+        ratios as data (the diagnosis decides it once for every hypothesis);
+        None: with a damper in the model.
     """
 
     test: Test
@@ -72,6 +76,7 @@ class Measurement:
     source: str
     damping: np.ndarray | None = None
     damping_uncertainty: np.ndarray | None = None
+    damping_is_data: bool | None = None
 
     def __post_init__(self):
         where = f"test[{self.test.name}]"
@@ -217,6 +222,9 @@ class Problem:
         self.parameters = tuple(parameters)
         self.tension_model = tension_model
         damped = any(has_dampers(campaign.setup(m.test.setup).attachments) for m in self.measurements)
+        decided = {m.damping_is_data for m in self.measurements} - {None}
+        if use_damping is None and decided:
+            use_damping = True in decided
         measured = any(m.damping_used.any() for m in self.measurements)
         #: Whether measured damping ratios are data (default: with a damper in the model and a ratio measured).
         self.use_damping = (damped and measured) if use_damping is None else bool(use_damping and measured)
