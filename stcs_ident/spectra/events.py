@@ -22,9 +22,7 @@ from rest (a simulation's filter transient) rises steadily. Measured: no
 onset in 340 noise and ambient records (white, low-pass, band-pass 1–6 Hz,
 lightly damped modes) but two band-pass records that start from rest. An
 onset must also raise the mean square acceleration of the next 0.5 s by
-3 dB over the previous second, which rejects isolated spikes in one sensor
-(each candidate is confirmed on its own, before the two scales' candidates
-are merged into one onset per blow).
+3 dB over the previous second, which rejects isolated spikes in one sensor.
 
 Each event is then the free decay from the end of the most energetic
 frame after its onset (the blow is over) up to one frame before the next
@@ -142,9 +140,7 @@ def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.nd
     if energy.size < 8:
         return []
     history = max(4, round(scale[1] * sampling_rate / frame))
-    # A jump is seen up to PERSIST − 1 frames before the blow's frame (its mean of PERSIST frames holds it):
-    # the blow is over FORCE_SEARCH after its frame, wherever the jump was first seen.
-    search = max(1, int(np.ceil(FORCE_SEARCH * sampling_rate / frame))) + PERSIST - 1
+    search = max(1, int(np.ceil(FORCE_SEARCH * sampling_rate / frame)))
     onsets = []
     for k in _jumps(energy, history, scale[3]):
         peak = k + int(np.argmax(energy[k : k + search]))
@@ -214,15 +210,11 @@ def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]
     fine = _scale_onsets(x, sampling_rate, FINE, difference=True)
     coarse_energy = _frame_energy(x, _frame_length(COARSE, sampling_rate))
     coarse = _scale_onsets(x, sampling_rate, COARSE, coarse_energy)
+    merged = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
     onsets = []
-    if fine or coarse:  # (an ambient record has none: the normalised power is not needed)
-        # Each candidate confirmed before they are merged: at a low sampling rate a jump is seen up to
-        # PERSIST − 1 frames (0.8 s at 20 Hz) before the blow, so the earliest candidate's CONFIRM_AFTER
-        # may end before the blow; merged first, it took the later ones with it (a blow of 46 dB lost).
+    if merged:  # (an ambient record has none: the normalised power is not needed)
         x2 = _normalised_power(x)
-        fine = [o for o in fine if _confirmed(x2, o, sampling_rate)]
-        coarse = [o for o in coarse if _confirmed(x2, o, sampling_rate)]
-        onsets = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
+        onsets = [o for o in merged if _confirmed(x2, o, sampling_rate)]
     if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, coarse_energy):
         frame = _frame_length(COARSE, sampling_rate)
         onsets.insert(0, _Onset(sample=0, frame=frame, start=0))
