@@ -22,7 +22,9 @@ from rest (a simulation's filter transient) rises steadily. Measured: no
 onset in 340 noise and ambient records (white, low-pass, band-pass 1–6 Hz,
 lightly damped modes) but two band-pass records that start from rest. An
 onset must also raise the mean square acceleration of the next 0.5 s by
-3 dB over the previous second, which rejects isolated spikes in one sensor.
+3 dB over the previous second, which rejects isolated spikes in one sensor
+(each candidate is confirmed on its own, before the two scales' candidates
+are merged into one onset per blow).
 
 Each event is then the free decay from the end of the most energetic
 frame after its onset (the blow is over) up to one frame before the next
@@ -210,11 +212,16 @@ def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]
     fine = _scale_onsets(x, sampling_rate, FINE, difference=True)
     coarse_energy = _frame_energy(x, _frame_length(COARSE, sampling_rate))
     coarse = _scale_onsets(x, sampling_rate, COARSE, coarse_energy)
-    merged = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
     onsets = []
-    if merged:  # (an ambient record has none: the normalised power is not needed)
+    if fine or coarse:  # (an ambient record has none: the normalised power is not needed)
+        # Each candidate confirmed before they are merged: at a low sampling rate a jump is seen up to
+        # PERSIST − 1 frames (0.8 s at 20 Hz) before the blow, so the earliest candidate's CONFIRM_AFTER
+        # may end before the blow; merged first, it took the later ones with it (a blow of 46 dB lost).
+        # Where every candidate is confirmed (a blow seen at most CONFIRM_AFTER early) nothing changes.
         x2 = _normalised_power(x)
-        onsets = [o for o in merged if _confirmed(x2, o, sampling_rate)]
+        fine = [o for o in fine if _confirmed(x2, o, sampling_rate)]
+        coarse = [o for o in coarse if _confirmed(x2, o, sampling_rate)]
+        onsets = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
     if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, coarse_energy):
         frame = _frame_length(COARSE, sampling_rate)
         onsets.insert(0, _Onset(sample=0, frame=frame, start=0))
