@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import stcs_ident
-from stcs_ident.model import Cable, Damper
+from stcs_ident.core.model import Cable, Damper
 from stcs_ident.simulate import (
     Ambient,
     FieldConditions,

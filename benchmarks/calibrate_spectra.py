@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import stcs_ident
-from stcs_ident.model import Attachment, Cable
+from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.simulate import (
     Ambient,
     FieldConditions,

@@ -36,7 +36,7 @@ from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.damped_shapes import complex_mode_shapes
 from stcs_ident.identify import identify
 from stcs_ident.identify.problem import Measurement
-from stcs_ident.model import Attachment, Cable, Campaign, Damper, Setup, Test
+from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 
 STAY = Cable(200.0, 80.0, 5.0e5, EA=2.0e9, inclination=math.radians(30.0))
 H = 5.0e6
@@ -193,8 +193,8 @@ def universal_series():
 
 
 def write_report(directory: Path, bias_rows, ident_rows, forward) -> None:
-    from stcs_ident.files import atomic_file, write_figure
-    from stcs_ident.plots_damped import plot_complex_shapes, plot_tension_bias, plot_universal_curve
+    from stcs_ident.core.files import atomic_file, write_figure
+    from stcs_ident.report.damped_figures import plot_complex_shapes, plot_tension_bias, plot_universal_curve
 
     directory.mkdir(parents=True, exist_ok=True)
     write_figure(plot_universal_curve(universal_series())["figure"], directory / "universal_curve.png")

@@ -30,7 +30,7 @@ import time
 
 from common import CHECKOUT, print_header
 
-from stcs_ident.campaign_io import load_campaign
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.api import default_workers
 from stcs_ident.identify import identify

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 from common import CHECKOUT, print_header, timed
 
-from stcs_ident.campaign_io import load_campaign
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies
 from stcs_ident.identify import Problem, fit_contour, fit_lsq, gather_measurements, parse_parameters
@@ -55,7 +55,7 @@ def write_figures(directory: Path) -> None:
     """han2020 figures: case1-L4 (tension, EI) and the weight positions of cases 2 and 3."""
     from stcs_ident.identify import identify
     from stcs_ident.identify.corrected import corrected_campaign
-    from stcs_ident.plots_identify import save_identify_figures
+    from stcs_ident.report.identify_figures import save_identify_figures
 
     campaign = load_campaign(ROOT / "campaigns" / "han2020")
     lsq = identify(campaign, [TEST], "tension,EI")

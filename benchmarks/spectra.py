@@ -113,7 +113,7 @@ class Case:
 
 
 def structures():
-    from stcs_ident.model import Attachment, Cable
+    from stcs_ident.core.model import Attachment, Cable
 
     hanger = Structure(
         name="hanger",

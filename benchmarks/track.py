@@ -40,8 +40,8 @@ from common import print_header
 def campaigns(root: Path) -> dict:
     from fuzz_inputs import BASE_TOML, _frequencies
 
-    from stcs_ident.campaign_io import load_campaign
-    from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+    from stcs_ident.io.campaign import load_campaign
+    from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 
     (root / "hanger").mkdir(parents=True)
     (root / "hanger" / "campaign.toml").write_text(BASE_TOML.replace('record = "records/T2.h5"\n', "")
@@ -64,7 +64,7 @@ def make_archive(path: Path, n_records: int, cables: dict) -> float:
 
 def run_track(archive: Path, out: Path, workers: int) -> tuple[float, float, int]:
     """Wall time, peak resident memory (MB, its largest process), exit status of a `track` child process."""
-    command = [sys.executable, "-c", "import sys; from stcs_ident.cli import main; sys.exit(main(sys.argv[1:]))",
+    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
                "track", str(archive), "--out", str(out), "--workers", str(workers)]
     with tempfile.TemporaryFile("w+") as err:
         started = time.perf_counter()

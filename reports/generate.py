@@ -23,8 +23,8 @@ import json
 import sys
 from pathlib import Path
 
-from stcs_ident.cli import main
-from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.cli.main import main
+from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.simulate.effects import Effects
 from stcs_ident.simulate.simulate import Impulse
 from stcs_ident.simulate.simulate_campaign import simulate_campaign

@@ -2,7 +2,7 @@
 
 Every generated case is a campaign directory (``campaign.toml``, a short
 record) and a command line. :func:`run_case` runs it in-process through
-``stcs_ident.cli.main`` under a time limit and classifies the outcome:
+``stcs_ident.cli.main.main`` under a time limit and classifies the outcome:
 
 - ``ok``: exit 0;
 - ``refused``: exit 2 with one line on standard error that names the
@@ -119,7 +119,7 @@ class Outcome:
 def _frequencies() -> str:
     """The base campaign's first test: 5 frequencies of the nominal model."""
     from stcs_ident.forward import batch_frequencies
-    from stcs_ident.model import Attachment, Cable
+    from stcs_ident.core.model import Attachment, Cable
 
     cable = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5, EA=3.0e8, inclination=np.radians(10.0))
     f = batch_frequencies(cable, (Attachment("W1", 2.7, 15.0),), 4.0e5, 5)
@@ -350,7 +350,7 @@ class _Timeout(Exception):
 
 def run_case(case: Case, time_limit: float = 30.0) -> Outcome:
     """Run ``case`` in-process; classify its outcome (see the module docstring)."""
-    from stcs_ident.cli import main
+    from stcs_ident.cli.main import main
 
     before = _digest(case.directory)
     err, out = io.StringIO(), io.StringIO()

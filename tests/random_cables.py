@@ -2,7 +2,7 @@
 
 import math
 
-from stcs_ident.model import Attachment, Boundary, Cable
+from stcs_ident.core.model import Attachment, Boundary, Cable
 
 
 def random_end(rng, EI, length):

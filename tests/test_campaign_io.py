@@ -1,4 +1,4 @@
-"""Tests of campaign.toml reading and writing (stcs_ident.campaign_io)."""
+"""Tests of campaign.toml reading and writing (stcs_ident.io.campaign)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from stcs_ident.campaign_io import campaign_to_toml, load_campaign
-from stcs_ident.errors import CampaignError, InputError
-from stcs_ident.model import Attachment, Boundary, Cable, Campaign, Setup, Test
+from stcs_ident.io.campaign import campaign_to_toml, load_campaign
+from stcs_ident.core.errors import CampaignError, InputError
+from stcs_ident.core.model import Attachment, Boundary, Cable, Campaign, Setup, Test
 
 HAN2020 = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
 

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stcs_ident.cli import main
+from stcs_ident.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 HAN = ROOT / "campaigns" / "han2020"
@@ -155,7 +155,7 @@ def simulated(tmp_path_factory):
 
 
 def test_simulate_writes_a_nominal_campaign_with_records(simulated):
-    from stcs_ident.campaign_io import load_campaign
+    from stcs_ident.io.campaign import load_campaign
 
     campaign = load_campaign(simulated)
     assert [t.name for t in campaign.tests] == ["case1-L4", "case2-L5"]
@@ -241,7 +241,7 @@ def test_bad_published_table_exits_2(tmp_path, capsys, table, field):
 
 def test_version_help_and_examples(capsys):
     from stcs_ident import __version__
-    from stcs_ident.cli import EXAMPLES, build_parser
+    from stcs_ident.cli.main import EXAMPLES, build_parser
 
     with pytest.raises(SystemExit) as out:
         main(["--version"])

@@ -13,12 +13,12 @@ import math
 import numpy as np
 import pytest
 
-from stcs_ident.errors import ComputationError
+from stcs_ident.core.errors import ComputationError
 from stcs_ident.forward import batch_frequencies, damped, natural_frequencies
 from stcs_ident.forward.damped import batch_complex_modes, complete, complex_modes, follow_roots
 from stcs_ident.forward.dsm import build_batch
 from stcs_ident.forward.roots import solve_modes
-from stcs_ident.model import Attachment, Boundary, Cable, Damper
+from stcs_ident.core.model import Attachment, Boundary, Cable, Damper
 
 STAY = Cable(200.0, 80.0, 5.0e5, EA=2.0e9, inclination=math.radians(30.0))
 H = 5.0e6

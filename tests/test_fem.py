@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from stcs_ident.errors import ModelError
+from stcs_ident.core.errors import ModelError
 from stcs_ident.forward.fem import fe_frequencies, fe_matrices, fe_modes
-from stcs_ident.model import Attachment, Boundary, Cable
+from stcs_ident.core.model import Attachment, Boundary, Cable
 
 PINNED = Boundary.pinned()
 CLAMPED = Boundary.clamped()

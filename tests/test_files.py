@@ -7,7 +7,7 @@ import stat
 import pandas as pd
 import pytest
 
-from stcs_ident import files
+from stcs_ident.core import files
 
 
 @pytest.fixture
@@ -48,8 +48,8 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
 def test_the_report_files_get_the_mode_of_the_umask(tmp_path, umask_027):
     from matplotlib.figure import Figure
 
-    from stcs_ident.identify.tables import write_csv
-    from stcs_ident.plots import save_figure
+    from stcs_ident.report.identify_tables import write_csv
+    from stcs_ident.report.plots import save_figure
 
     class Result:  # only what write_csv reads
         def to_dataframe(self):
@@ -106,7 +106,7 @@ def test_simulate_killed_at_any_moment_leaves_nothing_half_written(tmp_path):
     (campaign / "campaign.toml").write_text(BASE_TOML.replace('record = "records/T2.h5"\n', "")
                                             .format(f=_frequencies()), encoding="utf-8")
     out = tmp_path / "sim"
-    command = [sys.executable, "-c", "import sys; from stcs_ident.cli import main; sys.exit(main(sys.argv[1:]))",
+    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
                "simulate", str(campaign), "--out", str(out), "--duration", "20", "--overwrite"]
     assert subprocess.run(command, check=False, capture_output=True).returncode == 0
     expected = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))

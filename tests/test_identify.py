@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from stcs_ident.errors import InputError
+from stcs_ident.core.errors import InputError
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify import IdentifiabilityWarning, Measurement, identify, parse_parameters
 from stcs_ident.identify.corrected import corrected_campaign
-from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 
 CABLE = Cable(length=19.715, mass_per_length=16.6, EI=117338.3, EA=4.1382e8)
 SETUPS = (
@@ -202,7 +202,7 @@ def test_summary_is_the_interface_json():
 
 
 def test_tables_in_the_papers_form(tmp_path):
-    from stcs_ident.identify.tables import format_result, parameters_table, write_csv
+    from stcs_ident.report.identify_tables import format_result, parameters_table, write_csv
 
     campaign, picked = synthetic("bare", 1.02, 0.9, tensions=(1.0e6, 1.2e6), n_modes=6)
     result = identify(campaign, None, "tension,EI", picked=picked)

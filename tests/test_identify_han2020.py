@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stcs_ident.campaign_io import load_campaign
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.identify import identify
-from stcs_ident.plots_identify import plot_contours, plot_errors, plot_surfaces, save_identify_figures
+from stcs_ident.report.identify_figures import plot_contours, plot_errors, plot_surfaces, save_identify_figures
 
 ROOT = Path(__file__).resolve().parents[1]
 LEVELS = ("case1-L4", "case1-L5")

@@ -16,10 +16,10 @@ import pytest
 from case_pool import map_cases
 from scipy import signal, stats
 
-from stcs_ident.errors import InputError
+from stcs_ident.core.errors import InputError
 from stcs_ident.spectra.crb import crb_decay_rate, crb_frequency
 from stcs_ident.spectra.peaks import PeakResult, find_peaks
-from stcs_ident.spectra.record import Record
+from stcs_ident.core.record import Record
 
 # ----------------------------------------------------------------------------------------------
 # Synthetic records
@@ -449,7 +449,7 @@ def _stay_record_at_a_node(impulse, ambient, snr_db, damping, seed, conditions):
     """A record of calibrate_spectra's stay (120 m, 64 Hz, 600 s, 3 sensors) with one blow, and the true means."""
     import math
 
-    from stcs_ident.model import Attachment, Cable
+    from stcs_ident.core.model import Attachment, Cable
     from stcs_ident.simulate import simulate_record_with_truth
 
     cable = Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9, inclination=math.radians(30))

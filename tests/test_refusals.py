@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from fuzz_inputs import BASE_TOML, _frequencies, _record
 
-from stcs_ident.cli import main
+from stcs_ident.cli.main import main
 
 
 @pytest.fixture

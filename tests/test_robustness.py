@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 
 from stcs_ident.diagnose import api, diagnose
-from stcs_ident.diagnose.tables import ranking_table
-from stcs_ident.errors import ComputationError
+from stcs_ident.report.diagnose_tables import ranking_table
+from stcs_ident.core.errors import ComputationError
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.forward.assembly import negative_pivots
 from stcs_ident.forward.elements import BeamSegment
-from stcs_ident.identify.parameters import parse_parameters
+from stcs_ident.core.parameters import parse_parameters
 from stcs_ident.identify.problem import MIN_GAP, Measurement, Problem
 from stcs_ident.identify.uncertainty import covariance
-from stcs_ident.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 
 EI, H, M = 2.0e6, 4.0e6, 60.0
 
@@ -123,7 +123,7 @@ def test_every_cable_within_the_model_s_bands_solves():
     """Random cables across the model's value bands (log-uniform, half of them at the bands' corners): every
     solve ends with positive, finite, increasing frequencies. Together with the bands' refusal of what lies
     outside (tests/test_refusals.py), no campaign value reaches the solver that it cannot carry."""
-    from stcs_ident.model import BANDS, Boundary
+    from stcs_ident.core.model import BANDS, Boundary
 
     rng = np.random.default_rng(11)
 

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks
 
-from stcs_ident.campaign_io import load_campaign
-from stcs_ident.errors import ModelError
+from stcs_ident.io.campaign import load_campaign
+from stcs_ident.core.errors import ModelError
 from stcs_ident.forward import natural_frequencies
-from stcs_ident.model import Attachment, Boundary, Cable, Campaign, Setup, Test
+from stcs_ident.core.model import Attachment, Boundary, Cable, Campaign, Setup, Test
 from stcs_ident.simulate.effects import Effects, true_model
 from stcs_ident.simulate.modal_response import (
     exponential_gram,
@@ -345,7 +345,7 @@ def nominal_campaign():
 
 
 def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign):
-    io = pytest.importorskip("stcs_ident.spectra.io_hdf5")
+    io = pytest.importorskip("stcs_ident.io.records.hdf5")
     from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     effects = {"T2/b": Effects(tension_ratio=0.97, extra_mass=(10.0, 13.0))}
@@ -377,7 +377,7 @@ def test_simulate_campaign_writes_a_nominal_campaign(tmp_path, nominal_campaign)
 
 
 def test_simulate_campaign_refuses_a_non_empty_directory(tmp_path, nominal_campaign):
-    pytest.importorskip("stcs_ident.spectra.io_hdf5")
+    pytest.importorskip("stcs_ident.io.records.hdf5")
     from stcs_ident.simulate.simulate_campaign import simulate_campaign
 
     out = tmp_path / "sim"

@@ -18,7 +18,7 @@ import scipy.sparse.linalg as spla
 
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.fem_assembly import fe_matrices
-from stcs_ident.model import Attachment, Cable, Damper
+from stcs_ident.core.model import Attachment, Cable, Damper
 from stcs_ident.simulate import (
     Ambient,
     Effects,
@@ -333,7 +333,7 @@ def test_a_damped_campaign_s_truth_has_the_complex_modes(tmp_path):
     """truth.json of a setup with a damper: the complex modes' |s|/2π, their ζ and the damper's dashpot."""
     import json
 
-    from stcs_ident.model import Campaign, Setup, Test
+    from stcs_ident.core.model import Campaign, Setup, Test
     from stcs_ident.simulate import TRUTH_FILE, simulate_campaign
 
     campaign = Campaign("c", STAY, (Setup("s", (DAMPER,)),), (Test("t", "s", H),))

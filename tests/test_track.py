@@ -22,8 +22,8 @@ import pandas as pd
 import pytest
 from fuzz_inputs import BASE_TOML, _frequencies
 
-from stcs_ident.campaign_io import load_campaign
-from stcs_ident.cli import main
+from stcs_ident.io.campaign import load_campaign
+from stcs_ident.cli.main import main
 from stcs_ident.simulate.archive import ArchiveOptions, TensionChange, simulate_archive
 from stcs_ident.track.api import track
 from stcs_ident.track.events import analyse_history
@@ -179,8 +179,8 @@ def test_the_cli_tracks_an_archive_it_simulated(tmp_path, capsys):
     capsys.readouterr()
     assert main(["track", str(arch), "--out", str(arch / "C1")]) == 2  # an output over the inputs
     assert "option '--out'" in capsys.readouterr().err
-    from stcs_ident.cli import build_parser
-    from stcs_ident.cli_track import ARCHIVE_EXAMPLE
+    from stcs_ident.cli.main import build_parser
+    from stcs_ident.cli.track import ARCHIVE_EXAMPLE
 
     args = build_parser().parse_args(ARCHIVE_EXAMPLE.split()[1:])  # the help's example is a valid command line
     assert args.archive == 3 and args.cables == 3 and args.tension_change.startswith("C2,")

@@ -1,7 +1,7 @@
 """Hypotheses: the nominal model extended by effects of the registry.
 
 Each registered effect (:mod:`stcs_ident.effects`) becomes free parameters
-of the identification step (:mod:`stcs_ident.identify.parameters`), shared
+of the identification step (:mod:`stcs_ident.core.parameters`), shared
 across tests as the effect declares (a tension one per test, EI by all
 tests, an attachment's position by the tests of its setup).
 
@@ -22,8 +22,8 @@ import numpy as np
 
 from .. import effects as registry
 from ..effects.base import POSITION_MARGIN
-from ..identify.parameters import Parameter
-from ..model import Attachment, Campaign, Test
+from ..core.parameters import Parameter
+from ..core.model import Attachment, Campaign, Test
 
 __all__ = ["CLEARANCE", "POSITION_MARGIN", "Hypothesis", "applicable", "build", "clear_position", "free_positions",
            "hypothesis_sets", "parse_effects", "recorded_attachments", "unmodeled_name"]

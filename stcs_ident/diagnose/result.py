@@ -1,7 +1,7 @@
 """The diagnosis result: the data of the ``diagnose`` step and its JSON (``.summary()``).
 
 The terminal summary and the report are made from it by
-:mod:`stcs_ident.diagnose.report`, which this module does not import.
+:mod:`stcs_ident.report.diagnose`, which this module does not import.
 """
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import effects as registry
-from ..compare import ForwardResult
+from ..forward.compare import ForwardResult
 from ..effects.base import Context
-from ..formatting import percent_error
+from ..core.formatting import percent_error
 from ..identify.problem import Measurement
-from ..model import Cable, Campaign
-from ..settings import Settings
+from ..core.model import Cable, Campaign
+from ..core.settings import Settings
 from .fitting import HypothesisFit
 from .selection import Selection, baseline_fit, ranking
 

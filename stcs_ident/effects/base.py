@@ -14,7 +14,7 @@ An effect declares
   ``quantities`` (JSON keys with units, and whether there is one value per
   test, per attachment or one for the cable);
 - how it frees parameters of the identification (:meth:`Effect.free_parameters`:
-  by default the :mod:`stcs_ident.identify.parameters` kind ``parameter_kind``);
+  by default the :mod:`stcs_ident.core.parameters` kind ``parameter_kind``);
 - the default ``tolerance`` of the nominal value it changes (how well a
   user usually knows it), or None;
 - how it changes the true model of the simulator (:meth:`Effect.check_truth`,
@@ -38,10 +38,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import InputError, ModelError
-from ..formatting import plus_minus as pm  # the effects' words use the reports' ± format
-from ..identify.parameters import Parameter, parse_parameters
-from ..model import Attachment, Cable, Campaign, Test
+from ..core.errors import InputError, ModelError
+from ..core.formatting import plus_minus as pm  # the effects' words use the reports' ± format
+from ..core.parameters import Parameter, parse_parameters
+from ..core.model import Attachment, Cable, Campaign, Test
 
 #: Positions stay this fraction of the length away from the anchorages (as in identify).
 POSITION_MARGIN = 1e-3
@@ -141,7 +141,7 @@ class Effect:
     tolerance: ClassVar[Tolerance | None] = None
     #: Part of the source paper's correction (tension and EI re-estimated), the gain's baseline.
     baseline: ClassVar[bool] = False
-    #: Kind of identification parameter it frees (:data:`stcs_ident.identify.parameters.KINDS`).
+    #: Kind of identification parameter it frees (:data:`stcs_ident.core.parameters.KINDS`).
     parameter_kind: ClassVar[str | None] = None
     #: True for an attachment the nominal model lacks (position scanned by the diagnosis).
     unmodeled: ClassVar[bool] = False

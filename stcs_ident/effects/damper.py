@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 
-from ..identify.parameters import coefficient_upper
-from ..model import Damper
+from ..core.parameters import coefficient_upper
+from ..core.model import Damper
 from .base import Option, Quantity, UnmodeledAttachment
 
 
@@ -43,7 +43,7 @@ class UnmodeledDamper(UnmodeledAttachment):
     def check_truth(self, value, field):
         checked = super().check_truth(value, field)
         if checked is not None and not (checked[0] > 0 and math.isfinite(checked[0])):
-            from ..errors import ModelError
+            from ..core.errors import ModelError
 
             raise ModelError(f"needs a dashpot > 0, got {value!r}", field=field)
         return checked

@@ -9,8 +9,8 @@ ratios, which the diagnosis uses when the record gives them.
 
 from __future__ import annotations
 
-from ..errors import ModelError
-from ..model import Damper
+from ..core.errors import ModelError
+from ..core.model import Damper
 from .base import Option, Quantity, RecordedAttachment, Tolerance, pm
 
 

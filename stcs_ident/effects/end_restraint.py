@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..errors import InputError, ModelError
-from ..model import Boundary
+from ..core.errors import InputError, ModelError
+from ..core.model import Boundary
 from .base import Effect, Option, Quantity, number, pm
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from ..errors import InputError
+from ..core.errors import InputError
 from .base import Effect
 
 _REGISTRY: dict[str, Effect] = {}

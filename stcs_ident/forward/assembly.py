@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError
+from ..core.errors import ComputationError
 from .elements import BeamSegment, StringSegment
 from .statics import end_slopes, stretched_lengths
 

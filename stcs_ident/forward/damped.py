@@ -1,6 +1,6 @@
 """Complex modes of a cable with dampers, exact: the dynamic stiffness at a complex eigenvalue s.
 
-A damper (:class:`~stcs_ident.model.Damper`) is an attachment with a dashpot: at its node it adds
+A damper (:class:`~stcs_ident.core.model.Damper`) is an attachment with a dashpot: at its node it adds
 ``k + c s + m s²``. Every segment between nodes is the exact tensioned-beam (or string) element of
 :mod:`.elements` evaluated at ω = −i s, and the sag-extensibility term (one additional tension ĥ, as in the
 undamped solver) is kept, so K(s) is the undamped solver's matrix continued into the complex plane plus
@@ -45,8 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError, ModelError
-from ..model import Attachment, Cable
+from ..core.errors import ComputationError, ModelError
+from ..core.model import Attachment, Cable
 from .dsm import _items, build_batch
 from .roots import FORCE_NUMPY, solve_modes
 
@@ -92,7 +92,7 @@ def complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: floa
     ----------
     cable : Cable
     attachments : sequence of Attachment
-        Dampers among them (:class:`~stcs_ident.model.Damper`).
+        Dampers among them (:class:`~stcs_ident.core.model.Damper`).
     tension : float
         H, N.
     n_modes : int

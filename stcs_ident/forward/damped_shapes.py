@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError
-from ..model import Attachment, Cable
+from ..core.errors import ComputationError
+from ..core.model import Attachment, Cable
 from .damped import batch_complex_modes
 from .dsm import build_batch
 from .shapes import segment_solutions

@@ -18,8 +18,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import ModelError
-from ..model import Attachment, Cable
+from ..core.errors import ModelError
+from ..core.model import Attachment, Cable
 from .assembly import TENSION_MODELS, CableBatch, Topology
 from .roots import solve_modes
 
@@ -216,7 +216,7 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
         ``masses``, ``stiffnesses``, ``coefficients`` (a damper's dashpot,
         N s/m).
 
-    With a dashpot (a :class:`~stcs_ident.model.Damper`) the modes are
+    With a dashpot (a :class:`~stcs_ident.core.model.Damper`) the modes are
     complex and the frequencies are |s|/2π (:mod:`.damped`).
 
     Returns

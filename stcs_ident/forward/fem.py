@@ -28,8 +28,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..errors import ComputationError, ModelError
-from ..model import Attachment, Cable
+from ..core.errors import ComputationError, ModelError
+from ..core.model import Attachment, Cable
 from .fem_assembly import FEModel, fe_matrices, upper_banded
 
 __all__ = [

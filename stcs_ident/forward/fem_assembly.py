@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..model import Attachment, Cable
+from ..core.model import Attachment, Cable
 from .fem_mesh import Dofs, check_inputs, element_density, merge_attachments, mesh_nodes, number_dofs
 
 __all__ = ["FEModel", "fe_matrices", "upper_banded"]

@@ -45,8 +45,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import ComputationError, ModelError
-from ..model import Attachment, Cable, Damper
+from ..core.errors import ComputationError, ModelError
+from ..core.model import Attachment, Cable, Damper
 from .damped import ComplexModes
 from .fem_assembly import FEModel, fe_matrices
 
@@ -66,7 +66,7 @@ def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: f
     ----------
     cable : Cable
     attachments : sequence of Attachment
-        The dampers (:class:`~stcs_ident.model.Damper`) among them; each strictly inside the span.
+        The dampers (:class:`~stcs_ident.core.model.Damper`) among them; each strictly inside the span.
     tension : float
         H, N.
     n_modes : int

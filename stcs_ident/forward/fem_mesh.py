@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError
-from ..model import (
+from ..core.errors import ModelError
+from ..core.model import (
     Attachment,
     Cable,
     finite_number,  # the model's check of a finite number, naming the field

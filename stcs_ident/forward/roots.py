@@ -16,7 +16,7 @@ import os
 
 import numpy as np
 
-from ..errors import ComputationError
+from ..core.errors import ComputationError
 
 try:  # the optional compiled kernel (setup.py); same numerics, no per-call overhead
     from . import _dsm_kernel

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError
-from ..model import Attachment, Cable
+from ..core.errors import ComputationError
+from ..core.model import Attachment, Cable
 from .dsm import build_batch, natural_frequencies
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)

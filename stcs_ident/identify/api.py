@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 
-from ..errors import InputError
-from ..model import Campaign
-from ..notes import Note
-from ..settings import Settings
-from .parameters import parse_parameters
+from ..core.errors import InputError
+from ..core.model import Campaign
+from ..core.notes import Note
+from ..core.settings import Settings
+from ..core.parameters import parse_parameters
 from .problem import Problem, gather_measurements
 from .result import IdentificationResult
 
@@ -32,7 +32,7 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     params : str or iterable of str
         Free parameters, e.g. ``"tension,EI"``, ``"position[W1]"``,
         ``"tension,EI,position"`` (see
-        :func:`~stcs_ident.identify.parameters.parse_parameters`).
+        :func:`~stcs_ident.core.parameters.parse_parameters`).
     method : {"lsq", "contour"}
         Weighted least squares (any number of parameters), or the source
         paper's contour intersection (exactly two parameters).

@@ -31,9 +31,9 @@ import numpy as np
 from scipy import ndimage
 from scipy.optimize import minimize
 
-from ..errors import InputError
-from ..notes import Note, point
-from ..settings import Settings
+from ..core.errors import InputError
+from ..core.notes import Note, point
+from ..core.settings import Settings
 from .lsq import finish, local_fit, mirror_images, nearest_nominal
 from .problem import Problem
 from .result import IdentificationResult

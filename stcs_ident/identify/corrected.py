@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..model import Boundary, Campaign
+from ..core.model import Boundary, Campaign
 from .result import IdentificationResult
 
 

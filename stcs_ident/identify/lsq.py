@@ -19,8 +19,8 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..notes import Note, point
-from ..settings import Settings
+from ..core.notes import Note, point
+from ..core.settings import Settings
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability

@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ComputationError, InputError, ModelError
+from ..core.errors import ComputationError, InputError, ModelError
 from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
-from ..model import Campaign, Test, has_dampers
-from .parameters import KINDS, Parameter, overrides_for
+from ..core.model import Campaign, Test, has_dampers
+from ..core.parameters import KINDS, Parameter, overrides_for
 
 #: Relative step of the numerical Jacobian (the solver is accurate to 1e-12).
 JACOBIAN_STEP = 1e-6

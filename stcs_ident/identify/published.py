@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..model import Campaign
+from ..core.model import Campaign
 
 #: Nominal value of each ratio parameter, from the campaign's cable.
 _NOMINAL = {"EI_ratio": lambda c: c.cable.EI, "length_ratio": lambda c: c.cable.length}

@@ -7,7 +7,7 @@ uncertainties, and per test the measured frequencies before and after the
 correction (:class:`TestFit`). ``.summary()`` is the ``identify`` JSON
 plus optional keys; ``.to_dataframe()`` is the paper's Table 9/10 form.
 The tables in words (text and Markdown) and the CSV file are made by
-:mod:`stcs_ident.identify.tables`, which reads these objects; nothing here
+:mod:`stcs_ident.report.identify_tables`, which reads these objects; nothing here
 imports it.
 """
 
@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..formatting import percent_error
-from ..notes import Note
-from ..settings import Settings
-from .parameters import Parameter
+from ..core.formatting import percent_error
+from ..core.notes import Note
+from ..core.settings import Settings
+from ..core.parameters import Parameter
 
 #: Reference columns shown beside the correction: labels containing this word.
 SHOWN_REFERENCE = "corrected"
@@ -102,7 +102,7 @@ class IdentificationResult:
     parameters : tuple of Parameter
     estimate : ndarray
         The identified variables (ratio to nominal for most kinds; see
-        :mod:`stcs_ident.identify.parameters`).
+        :mod:`stcs_ident.core.parameters`).
     uncertainty : ndarray
         lsq: one standard deviation from the covariance. contour: half the
         extent of the intersection region along each axis.

@@ -21,9 +21,9 @@ from dataclasses import replace
 import numpy as np
 from scipy import stats
 
-from ..errors import StcsWarning
-from ..notes import Note
-from ..settings import SCALE_RULES
+from ..core.errors import StcsWarning
+from ..core.notes import Note
+from ..core.settings import SCALE_RULES
 
 #: |correlation| above which two parameters are reported as not separately identifiable.
 CORRELATION_LIMIT = 0.995

@@ -31,11 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..campaign_toml import campaign_to_toml
-from ..errors import ModelError
-from ..files import whole_directory, write_atomic
-from ..model import Campaign, real_number
-from ..spectra.io_hdf5 import write_record
+from ..io.campaign_toml import campaign_to_toml
+from ..core.errors import ModelError
+from ..core.files import whole_directory, write_atomic
+from ..core.model import Campaign, real_number
+from ..io.records.hdf5 import write_record
 from .simulate import Ambient, simulate_record
 
 __all__ = ["ArchiveOptions", "TensionChange", "simulate_archive"]

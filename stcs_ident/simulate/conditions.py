@@ -3,7 +3,7 @@
 :class:`FieldConditions` groups the optional parts (:class:`LowPassLoading`,
 :class:`TensionDrift`, :class:`PinkNoise`, :class:`MainsHum`,
 :class:`DcOffsets`, float32 samples), each validated when built (a
-:class:`~stcs_ident.errors.ModelError` names the field);
+:class:`~stcs_ident.core.errors.ModelError` names the field);
 :class:`RecordTruth` is what a simulated record truly holds (under drift,
 the time-averaged frequencies to score against);
 :func:`random_field_conditions` draws field-like conditions from a seeded
@@ -17,8 +17,8 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
-from ..errors import ModelError
-from ..model import real_number
+from ..core.errors import ModelError
+from ..core.model import real_number
 
 __all__ = [
     "DRIFT_LIMIT", "DcOffsets", "FieldConditions", "LowPassLoading", "MainsHum", "PinkNoise", "RecordTruth",

@@ -1,6 +1,6 @@
 """Complex modes of a cable with dampers, for simulating its records (non-proportional damping).
 
-A :class:`~stcs_ident.model.Damper` puts a dashpot between one point of the
+A :class:`~stcs_ident.core.model.Damper` puts a dashpot between one point of the
 cable and the ground: the damping is concentrated, not proportional to the
 mass or the stiffness, and the modes are complex (each point moves with its
 own phase, a travelling-wave component carries energy into the dashpot).
@@ -57,11 +57,11 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..errors import ComputationError, ModelError
+from ..core.errors import ComputationError, ModelError
 from ..forward.dsm import count_below
 from ..forward.fem import fe_eigen
 from ..forward.fem_assembly import FEModel, fe_matrices
-from ..model import Attachment, Cable, Damper
+from ..core.model import Attachment, Cable, Damper
 
 __all__ = ["EXTRA_MODES", "DampedModes", "FEShapes", "damped_modes", "pole_sensitivities"]
 

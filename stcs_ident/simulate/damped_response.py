@@ -1,7 +1,7 @@
 """Records of cables with dampers: complex modal superposition, exact in time.
 
 The kernel behind :func:`~stcs_ident.simulate.simulate.simulate_record`
-when the true attachments hold a :class:`~stcs_ident.model.Damper` (the
+when the true attachments hold a :class:`~stcs_ident.core.model.Damper` (the
 records of a cable without one are made by
 :mod:`~stcs_ident.simulate.modal_response` and
 :mod:`~stcs_ident.simulate.field_response`, unchanged). The complex modes
@@ -43,7 +43,7 @@ import numpy as np
 from scipy.linalg import solve_discrete_lyapunov
 from scipy.signal import lfilter
 
-from ..model import Attachment, Cable
+from ..core.model import Attachment, Cable
 from .conditions import FieldConditions, RecordTruth
 from .damped_modes import DampedModes, damped_modes, pole_sensitivities
 from .disturbances import filter_state_space, lowpass_force_filter, relative_tension

@@ -3,7 +3,7 @@
 Records simulated with white loading, a constant tension and white sensor
 noise are kinder than field records. :class:`~.conditions.FieldConditions` groups what
 field records carry besides the cable's response, each part optional and
-validated when built (a :class:`~stcs_ident.errors.ModelError` names the
+validated when built (a :class:`~stcs_ident.core.errors.ModelError` names the
 field, e.g. ``drift.period``):
 
 - :class:`LowPassLoading`: the ambient pressure coloured by a Butterworth
@@ -45,10 +45,10 @@ import numpy as np
 from scipy.linalg import solve_discrete_lyapunov
 from scipy.signal import butter
 
-from ..errors import ModelError
-from ..files import atomic_path
+from ..core.errors import ModelError
+from ..core.files import atomic_path
 from ..forward.dsm import natural_frequencies
-from ..model import Attachment, Cable
+from ..core.model import Attachment, Cable
 from .conditions import DRIFT_LIMIT, FieldConditions, LowPassLoading, MainsHum, TensionDrift
 
 __all__ = [
@@ -214,14 +214,14 @@ def apply_sensor_disturbances(signal: np.ndarray, clean: np.ndarray, sampling_ra
 
 
 def write_record_as(record, path: str | os.PathLike, *, float32: bool = False) -> None:
-    """Write ``record`` with :func:`~stcs_ident.spectra.io_hdf5.write_record`, its samples as float32 if asked.
+    """Write ``record`` with :func:`~stcs_ident.io.records.hdf5.write_record`, its samples as float32 if asked.
 
     The layout is io_hdf5's; for float32 the file is copied with the
     acceleration dataset cast (whole or not at all, as write_record).
     """
     import h5py
 
-    from ..spectra.io_hdf5 import write_record
+    from ..io.records.hdf5 import write_record
 
     write_record(record, path)
     if not float32:

@@ -17,8 +17,8 @@ from typing import Any
 
 from .. import effects as registry
 from ..effects.base import Truth
-from ..errors import ModelError
-from ..model import Attachment, Cable, Damper
+from ..core.errors import ModelError
+from ..core.model import Attachment, Cable, Damper
 
 __all__ = ["Effects", "true_model"]
 
@@ -131,7 +131,7 @@ def true_model(cable: Cable, attachments: Sequence[Attachment], tension: float,
         named ``"(extra mass)"`` / ``"(extra spring)"``; attachments that
         end up at one position are merged into one (masses and stiffnesses
         added, names joined with ``+``), as the solver needs distinct nodes;
-        a :class:`~stcs_ident.model.Damper` stays a Damper (merged with
+        a :class:`~stcs_ident.core.model.Damper` stays a Damper (merged with
         another, their dashpots add).
     tension : float
 

@@ -19,7 +19,7 @@ effects (:class:`~stcs_ident.simulate.effects.Effects`) act on the true
 model only. :func:`~stcs_ident.simulate.simulate_campaign.simulate_campaign`
 writes a whole campaign directory from them, for tests and benchmarks.
 
-A cable with a :class:`~stcs_ident.model.Damper` among its true attachments
+A cable with a :class:`~stcs_ident.core.model.Damper` among its true attachments
 has non-proportional damping and complex modes: its records are made by
 complex modal superposition of a finite-element model that carries the
 dashpots exactly (:mod:`~stcs_ident.simulate.damped_response`), with the
@@ -41,12 +41,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError
+from ..core.errors import ModelError
 from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
-from ..model import Attachment, Cable, has_dampers, real_number
-from ..spectra.record import Record
-from ..spectra.record import sampling_rate as record_sampling_rate
+from ..core.model import Attachment, Cable, has_dampers, real_number
+from ..core.record import Record
+from ..core.record import sampling_rate as record_sampling_rate
 from .conditions import FieldConditions, RecordTruth
 from .damped_response import damped_record
 from .disturbances import (

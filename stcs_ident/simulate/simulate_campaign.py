@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..campaign_io import CAMPAIGN_FILE, campaign_to_toml
-from ..errors import ModelError
-from ..files import whole_directory
+from ..io.campaign import CAMPAIGN_FILE, campaign_to_toml
+from ..core.errors import ModelError
+from ..core.files import whole_directory
 from ..forward.dsm import natural_frequencies
-from ..model import Attachment, Cable, Campaign, Damper, Test, has_dampers
+from ..core.model import Attachment, Cable, Campaign, Damper, Test, has_dampers
 from .conditions import FieldConditions
 from .disturbances import write_record_as
 from .effects import Effects, true_model

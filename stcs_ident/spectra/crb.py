@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InputError
+from ..core.errors import InputError
 
 __all__ = ["crb_decay_rate", "crb_frequency", "decay_information"]
 

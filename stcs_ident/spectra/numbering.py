@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import InputError, NumberingWarning
+from ..core.errors import InputError, NumberingWarning
 from ..forward import batch_frequencies
-from ..model import Attachment, Cable
+from ..core.model import Attachment, Cable
 
 #: Cost of leaving a peak unassigned (in squared standardised residuals):
 #: a peak 4σ from every prediction is cheaper to call spurious.

@@ -1,6 +1,6 @@
 """Modal frequencies of a multi-channel acceleration record: detection, sub-bin refinement, uncertainty.
 
-:func:`find_peaks` turns a :class:`~stcs_ident.spectra.record.Record` into a
+:func:`find_peaks` turns a :class:`~stcs_ident.core.record.Record` into a
 :class:`PeakResult`: the peaks, each with a frequency, an honest 1σ, the
 damping ratio, the channels that saw it and its amplitude per channel.
 
@@ -103,7 +103,7 @@ from dataclasses import replace
 import numpy as np
 from scipy import fft
 
-from ..errors import InputError
+from ..core.errors import InputError
 from .ambient_fit import AmbientFit, fit_ambient
 from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution
@@ -111,7 +111,7 @@ from .events import Event, detect_events, whole_record_event
 from .overview import Overview, ambient_overview, decay_overviews
 from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
 from .peak_result import Peak, PeakResult
-from .record import Record, check_finite
+from ..core.record import Record, check_finite
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
 from .wander import common_wander, with_common_wander

@@ -15,12 +15,12 @@ import numpy as np
 import pandas as pd
 
 from ..forward import natural_frequencies
-from ..model import Campaign, Test
-from .io_hdf5 import read_record
+from ..core.model import Campaign, Test
+from ..io.records.hdf5 import read_record
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
-from .record import Record
-from .validation import check_bandwidth, check_duration, check_positions
+from ..core.record import Record
+from ..io.records.validation import check_bandwidth, check_duration, check_positions
 
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
+from ..core.errors import InputError
 from .archive import CableSpec, content_id, discover, record_paths
 from .events import analyse_history
 from .process import process_record
@@ -86,7 +86,7 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     specs = discover(archive, cables)
     out = Path(out) if out is not None else default_out(archive)
     out.mkdir(parents=True, exist_ok=True)
-    from ..files import remove_stale
+    from ..core.files import remove_stale
 
     remove_stale(out / "parts")  # what a killed run left, even if this one has nothing new to write there
     known = read_table(out)
@@ -98,7 +98,7 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     write_table(out, table)
     summary = _summary(archive, specs, table, histories)
     if report:
-        from .report import write_report
+        from ..report.track import write_report
 
         write_report(out, specs, table, histories, summary)
     return summary

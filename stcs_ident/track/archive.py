@@ -16,9 +16,9 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..campaign_io import load_campaign
-from ..errors import InputError
-from ..model import Campaign
+from ..io.campaign import load_campaign
+from ..core.errors import InputError
+from ..core.model import Campaign
 
 __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 

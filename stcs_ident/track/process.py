@@ -19,9 +19,9 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from ..errors import ComputationError, InputError, one_line
-from ..model import Test
-from ..spectra.io_hdf5 import read_record
+from ..core.errors import ComputationError, InputError, one_line
+from ..core.model import Test
+from ..io.records.hdf5 import read_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..files import atomic_path
+from ..core.files import atomic_path
 from .process import COLUMNS
 
 __all__ = ["append_part", "read_table", "write_table"]

@@ -2,7 +2,7 @@
 
 A sensor that died or saturated would spoil the spectra of a record that is
 otherwise good, so its channel is dropped: a
-:class:`~stcs_ident.errors.RecordWarning` names the channel and the file,
+:class:`~stcs_ident.core.errors.RecordWarning` names the channel and the file,
 and ``Record.dropped`` keeps ``(name, reason)``.
 
 - **Dead**: a constant channel, or one whose standard deviation is at most
@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import InputError, RecordWarning
+from ...core.errors import InputError, RecordWarning
 
 __all__ = ["CLIP_FRACTION", "CLIP_LONG_RUN", "CLIP_MIN_RUN", "DEAD_RELATIVE_STD", "screen_channels"]
 

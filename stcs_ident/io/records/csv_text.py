@@ -1,9 +1,9 @@
 """Acceleration records from CSV: a header line, a time column, one column per channel.
 
 The sampling rate comes from the time column, which must be uniform within
-:data:`~stcs_ident.spectra.validation.TIME_TOLERANCE`; the channel
+:data:`~stcs_ident.io.records.validation.TIME_TOLERANCE`; the channel
 positions are given by the caller. Then the checks of every record source
-apply (:mod:`~stcs_ident.spectra.validation`). A problem with the time
+apply (:mod:`~stcs_ident.io.records.validation`). A problem with the time
 column has field ``time``; a file that is missing or not CSV has no field.
 """
 
@@ -15,8 +15,8 @@ import os
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
-from .record import Record
+from ...core.errors import InputError
+from ...core.record import Record
 from .validation import Positions, one_line, position_list, positions_by_name, rate_from_time, validated_record
 
 __all__ = ["record_from_csv"]
@@ -41,7 +41,7 @@ def record_from_csv(
     Raises
     ------
     InputError
-        As :func:`~stcs_ident.spectra.io_hdf5.read_record`; a missing or non-uniform time has field ``time``.
+        As :func:`~stcs_ident.io.records.hdf5.read_record`; a missing or non-uniform time has field ``time``.
     """
     file = str(path)
     header, table = _read_csv(file)

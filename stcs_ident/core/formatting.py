@@ -130,7 +130,7 @@ def render_points(points) -> str:
 
 
 def render_note(note: Note) -> str:
-    """The sentence of ``note``: its template filled with its fields (see :class:`~stcs_ident.notes.Note`)."""
+    """The sentence of ``note``: its template filled with its fields (see :class:`~stcs_ident.core.notes.Note`)."""
     names = tuple(note.parameters)
     fields = {"value": note.value, "unit": note.unit, "parameters": ", ".join(names),
               "parameter": names[0] if names else "", "names": names, "points": render_points(note.points)}

@@ -5,10 +5,10 @@ The layout is the one of the interface contract: root attributes
 ``unit`` (``"m/s^2"`` or ``"g"``) and optional ``start_time`` (ISO 8601);
 datasets ``/acceleration`` (n_samples, n_channels), ``/channel_name`` and
 ``/channel_position`` (m from end A). The checks every record source shares
-(and their errors) are in :mod:`~stcs_ident.spectra.validation`; dead and
-clipped channels are dropped as :mod:`~stcs_ident.spectra.screening` says.
+(and their errors) are in :mod:`~stcs_ident.io.records.validation`; dead and
+clipped channels are dropped as :mod:`~stcs_ident.io.records.screening` says.
 A file that is missing, unreadable or not HDF5 raises an
-:class:`~stcs_ident.errors.InputError` with no field.
+:class:`~stcs_ident.core.errors.InputError` with no field.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ from typing import Any
 import h5py
 import numpy as np
 
-from ..errors import InputError
-from ..files import atomic_path
-from .record import Record
+from ...core.errors import InputError
+from ...core.files import atomic_path
+from ...core.record import Record
 from .validation import one_line, validated_record
 
 __all__ = ["FORMAT", "VERSION", "read_record", "write_record"]

@@ -13,9 +13,9 @@ import sys
 import traceback
 import warnings
 
-from . import __version__, effects
-from .cli_track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
-from .errors import ComputationError, InputError, StcsWarning, one_line
+from .. import __version__, effects
+from .track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
+from ..core.errors import ComputationError, InputError, StcsWarning, one_line
 
 DESCRIPTION = """\
 stcs-ident: cable force, bending stiffness and model diagnosis from the
@@ -59,7 +59,7 @@ _OPTIONS: dict[str, set[str]] = {}
 
 def _mode_count(text: str) -> int:
     """``--modes``: a mode number 1 … MAX_MODE (argparse reports a refusal as a bad option)."""
-    from .model import mode_number
+    from ..core.model import mode_number
 
     try:
         return mode_number(int(text), "--modes")
@@ -170,11 +170,11 @@ def _simulate_parser(sub) -> None:
 
 
 def _simulate(args) -> int:
-    from .campaign_io import campaign_file, load_campaign
-    from .files import check_outputs
-    from .simulate.effects import Effects
-    from .simulate.simulate import Ambient, Impulse
-    from .simulate.simulate_campaign import simulate_campaign
+    from ..io.campaign import campaign_file, load_campaign
+    from ..core.files import check_outputs
+    from ..simulate.effects import Effects
+    from ..simulate.simulate import Ambient, Impulse
+    from ..simulate.simulate_campaign import simulate_campaign
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
@@ -182,7 +182,7 @@ def _simulate(args) -> int:
     if args.archive is not None:
         if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
             raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
-        from .cli_track import simulate_archive_from_args
+        from .track import simulate_archive_from_args
 
         return simulate_archive_from_args(args, campaign)
     try:
@@ -217,7 +217,7 @@ def _field_conditions(args, campaign, n_channels: int):
     """``simulate``'s field-condition options as FieldConditions (per test with --field-random), or None."""
     import numpy as np
 
-    from .simulate import (
+    from ..simulate import (
         DcOffsets,
         FieldConditions,
         LowPassLoading,
@@ -277,7 +277,7 @@ def _check_output(path) -> None:
 
 
 def _write(path, text) -> None:
-    from .files import write_atomic
+    from ..core.files import write_atomic
 
     try:
         write_atomic(path, text)
@@ -293,22 +293,22 @@ def _picked(campaign, tests, file):
     """Spectra of the selected tests that have records (for forward and spectra)."""
     if not any(t.record is not None for t in campaign.tests if not tests or t.name in tests):
         return []
-    from .spectra.pipeline import analyse_campaign
+    from ..spectra.pipeline import analyse_campaign
 
     return analyse_campaign(campaign, tests, progress=_progress)
 
 
 def _inputs(campaign, file: str) -> list[str]:
     """The files a command on ``campaign`` reads: its campaign file and every test's record."""
-    from .spectra.pipeline import record_path
+    from ..spectra.pipeline import record_path
 
     return [file] + [record_path(campaign, t) for t in campaign.tests if t.record is not None]
 
 
 def _prepare(args):
     """Load the campaign and check the selection and the outputs before any work."""
-    from .campaign_io import campaign_file, load_campaign
-    from .files import check_outputs
+    from ..io.campaign import campaign_file, load_campaign
+    from ..core.files import check_outputs
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))
@@ -320,7 +320,7 @@ def _prepare(args):
 
 
 def _spectra(args) -> int:
-    from .report import spectra_text, to_json
+    from ..report.forward import spectra_text, to_json
 
     campaign, file, tests = _prepare(args)
     results = _picked(campaign, tests, file)
@@ -329,7 +329,7 @@ def _spectra(args) -> int:
         _write(args.json, to_json({"campaign": campaign.name, "tests": [r.summary() for r in results],
                                    "skipped": skipped}))
     if args.plot is not None:
-        from .plots import plot_test_spectra, save_figure
+        from ..report.plots import plot_test_spectra, save_figure
 
         os.makedirs(args.plot, exist_ok=True)
         for r in results:
@@ -342,8 +342,8 @@ def _spectra(args) -> int:
 def _identify(args) -> int:
     import warnings
 
-    from .identify import identify
-    from .report import to_json
+    from ..identify import identify
+    from ..report.forward import to_json
 
     campaign, file, tests = _prepare(args)
     picked = {r.name: r for r in _picked(campaign, tests, file)}
@@ -356,18 +356,18 @@ def _identify(args) -> int:
             raise InputError(err.message, field=err.field, file=err.file or file) from None
     for w in caught:
         _show_warning(w.message, w.category, w.filename, w.lineno)
-    from .identify.published import published_comparison
+    from ..identify.published import published_comparison
 
     summary = result.summary()
     summary["published"] = published_comparison(campaign, summary)
     if args.json:
         _write(args.json, to_json(summary))
     if args.plot is not None:
-        from .plots_identify import save_identify_figures
+        from ..report.identify_figures import save_identify_figures
 
         save_identify_figures(result, args.plot)
     if args.json != "-":
-        from .identify.tables import format_result
+        from ..report.identify_tables import format_result
 
         sys.stdout.write(format_result(result, "text"))
         for item in summary["published"]:
@@ -376,8 +376,8 @@ def _identify(args) -> int:
 
 
 def _diagnose(args) -> int:
-    from .diagnose import diagnose
-    from .report import to_json
+    from ..diagnose import diagnose
+    from ..report.forward import to_json
 
     campaign, file, tests = _prepare(args)
     spectra = _picked(campaign, tests, file)
@@ -391,11 +391,11 @@ def _diagnose(args) -> int:
     if args.json:
         _write(args.json, to_json(result.summary()))
     if args.out is not None:
-        from .diagnose.report import write_report
+        from ..report.diagnose import write_report
 
         write_report(result, args.out, spectra=spectra)
     if args.json != "-":
-        from .diagnose.report import diagnosis_text
+        from ..report.diagnose import diagnosis_text
 
         sys.stdout.write(diagnosis_text(result))
         if args.out is not None:
@@ -404,8 +404,8 @@ def _diagnose(args) -> int:
 
 
 def _forward(args) -> int:
-    from .compare import compare_forward
-    from .report import forward_text, to_json
+    from ..forward.compare import compare_forward
+    from ..report.forward import forward_text, to_json
 
     campaign, file, tests = _prepare(args)
     picked = {r.name: (r.modes, r.frequencies) for r in _picked(campaign, tests, file)}

@@ -1,4 +1,4 @@
-"""Write a campaign back in the ``campaign.toml`` format that :mod:`stcs_ident.campaign_io` reads.
+"""Write a campaign back in the ``campaign.toml`` format that :mod:`stcs_ident.io.campaign` reads.
 
 Units other than SI live only at the file's edge: the file gives the
 inclination in degrees, the model holds radians.
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .model import Boundary, Cable, Campaign, Published, Setup, Test
+from ..core.model import Boundary, Cable, Campaign, Published, Setup, Test
 
 __all__ = ["campaign_to_toml"]
 

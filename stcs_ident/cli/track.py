@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .errors import InputError
+from ..core.errors import InputError
 
 TRACK_EXAMPLE = "stcs-ident track archive/ --out histories/ --workers 2"
 ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archive 3 --cables 3 "
@@ -44,10 +44,10 @@ def run_track(args, write) -> int:
     """``stcs-ident track``: ``write(path, text)`` writes the JSON whole."""
     import os
 
-    from .files import check_outputs
-    from .report import to_json
-    from .track.api import default_out, track
-    from .track.archive import discover, record_paths
+    from ..core.files import check_outputs
+    from ..report.forward import to_json
+    from ..track.api import default_out, track
+    from ..track.archive import discover, record_paths
 
     out = args.out if args.out is not None else str(default_out(args.archive))
     specs = discover(args.archive, args.cable)  # refuses a bad archive before any work
@@ -80,7 +80,7 @@ def add_archive_options(sim) -> None:
 
 
 def simulate_archive_from_args(args, campaign) -> int:
-    from .simulate.archive import ArchiveOptions, TensionChange, simulate_archive
+    from ..simulate.archive import ArchiveOptions, TensionChange, simulate_archive
 
     if not 1 <= args.cables <= 1000:
         raise InputError(f"must be 1 … 1000, got {args.cables}", field="--cables")

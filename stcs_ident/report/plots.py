@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .files import write_figure
+from ..core.files import write_figure
 
 
 def new_figure(**kwargs):
@@ -63,5 +63,5 @@ def plot_test_spectra(spectra, fig=None) -> dict:
 
 def save_figure(fig, path) -> None:
     """Save a PNG whole or not at all, with the permissions of any other output
-    (:func:`stcs_ident.files.write_figure`)."""
+    (:func:`stcs_ident.core.files.write_figure`)."""
     write_figure(fig, path)

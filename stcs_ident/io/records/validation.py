@@ -1,17 +1,17 @@
 """Checks every acceleration record passes, whatever its source.
 
-HDF5 (:mod:`~stcs_ident.spectra.io_hdf5`), CSV
-(:mod:`~stcs_ident.spectra.io_csv`) and SEP005
-(:mod:`~stcs_ident.spectra.sep005`) each read their own input, then hand
+HDF5 (:mod:`~stcs_ident.io.records.hdf5`), CSV
+(:mod:`~stcs_ident.io.records.csv_text`) and SEP005
+(:mod:`~stcs_ident.io.records.sep005`) each read their own input, then hand
 its parts to :func:`validated_record`, which checks them, converts to m/s²
-and drops dead and clipped channels (:mod:`~stcs_ident.spectra.screening`).
-The result is a :class:`~stcs_ident.spectra.record.Record`.
+and drops dead and clipped channels (:mod:`~stcs_ident.io.records.screening`).
+The result is a :class:`~stcs_ident.core.record.Record`.
 :func:`check_positions` and :func:`check_duration` check a record against
 the cable it was measured on.
 
 Errors
 ------
-Every problem raises :class:`~stcs_ident.errors.InputError` whose text is
+Every problem raises :class:`~stcs_ident.core.errors.InputError` whose text is
 one line, ``"<file>: field '<field>': <what is wrong>"``. The fields are
 those of the file: ``format``, ``version``, ``sampling_rate``, ``unit``,
 ``start_time``, ``acceleration``, ``channel_name``, ``channel_position``
@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from .record import (
+from ...core.errors import InputError
+from ...core.record import (
     STANDARD_GRAVITY,
     Record,
     check_finite,
@@ -129,7 +129,7 @@ def validated_record(
 
 
 def check_sampling_rate(value: Any, file: str | None) -> float:
-    """``value`` as a sampling rate, Hz (:func:`~stcs_ident.spectra.record.sampling_rate`), naming ``file``."""
+    """``value`` as a sampling rate, Hz (:func:`~stcs_ident.core.record.sampling_rate`), naming ``file``."""
     return sampling_rate(value, file=file)
 
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..formatting import percent_error
+from ..core.formatting import percent_error
 
 #: Units of the effect parameters (the keys of ``Diagnosis.parameters``).
 UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",

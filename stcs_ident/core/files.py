@@ -198,7 +198,7 @@ def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
     ``outputs`` are (option, path, is_directory) (a path None or "-" is skipped); ``inputs`` the files
     the command reads. A file output may not be an input (also through a link); a directory output may not
     be an input, hold one (it is replaced as a whole, or written into), or lie below a file. Raises
-    :class:`~stcs_ident.errors.InputError` naming the option.
+    :class:`~stcs_ident.core.errors.InputError` naming the option.
     """
     from .errors import InputError
 

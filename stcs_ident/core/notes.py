@@ -3,7 +3,7 @@
 A :class:`Note` holds the numbers and names of a remark (a scaled
 covariance, a parameter at a bound, other minima that fit as well) beside a
 template that says it in words. Results carry notes; only the formatting
-module (:func:`stcs_ident.formatting.render_note`, which ``str(note)``
+module (:func:`stcs_ident.core.formatting.render_note`, which ``str(note)``
 calls) turns them into sentences, and a step that needs a note's values in
 other units works on its data (:meth:`Note.with_points`), never on its text.
 """

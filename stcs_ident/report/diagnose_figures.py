@@ -2,7 +2,7 @@
 
 Each function builds on a :class:`matplotlib.figure.Figure` or a given Axes,
 never on pyplot's global state, and returns what it drew so that tests can
-inspect it (as :mod:`stcs_ident.plots`). matplotlib is imported only when a
+inspect it (as :mod:`stcs_ident.report.plots`). matplotlib is imported only when a
 figure is made.
 """
 
@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .. import effects as registry
-from ..plots import new_figure
+from .plots import new_figure
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import write_atomic, write_csv, write_figure
+from ..core.files import write_atomic, write_csv, write_figure
 
 __all__ = ["write_report"]
 

@@ -32,8 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..model import Campaign, Damper, Test
+from .errors import InputError
+from .model import Campaign, Damper, Test
 
 #: Kinds of parameter, what they belong to and the override they change.
 KINDS = {

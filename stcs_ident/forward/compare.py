@@ -17,12 +17,12 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import minimize_scalar
 
-from .formatting import percent_error
-from .forward import batch_frequencies
-from .forward import reference as closed_form
-from .forward.damped import complex_modes
-from .model import Campaign, Test, has_dampers
-from .settings import Settings
+from ..core.formatting import percent_error
+from . import batch_frequencies
+from . import reference as closed_form
+from .damped import complex_modes
+from ..core.model import Campaign, Test, has_dampers
+from ..core.settings import Settings
 
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ class ReferenceCheck:
 class ForwardResult:
     """Result of :func:`compare_forward`: one :class:`TestComparison` per test
     and one :class:`ReferenceCheck` per (reference column, setup), with the
-    :class:`~stcs_ident.settings.Settings` they were computed with."""
+    :class:`~stcs_ident.core.settings.Settings` they were computed with."""
 
     campaign: str
     settings: Settings

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from .errors import InputError
-from .forward.assembly import TENSION_MODELS
+from ..forward.assembly import TENSION_MODELS
 
 #: When the covariance is scaled by the reduced χ² (see :func:`stcs_ident.identify.uncertainty.covariance_scale`).
 SCALE_RULES = ("auto", "birge", "never")

@@ -3,7 +3,7 @@
 One dict per channel, with ``data``, ``fs`` (or a uniform ``time``),
 ``name``, ``quantity`` and ``unit_str``; ``position`` (m from end A) is our
 extension. A record read from them passes the checks of every record source
-(:mod:`~stcs_ident.spectra.validation`); its errors name no file.
+(:mod:`~stcs_ident.io.records.validation`); its errors name no file.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from .record import Record
+from ...core.errors import InputError
+from ...core.record import Record
 from .validation import (
     UNITS,
     Positions,
@@ -70,7 +70,7 @@ def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | No
     Raises
     ------
     InputError
-        As :func:`~stcs_ident.spectra.io_hdf5.read_record`, without a file; the message names the channel.
+        As :func:`~stcs_ident.io.records.hdf5.read_record`, without a file; the message names the channel.
     """
     channels = list(channels)
     if not channels:

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..errors import InputError
-from ..files import whole_directory, write_atomic, write_csv, write_figure
-from ..formatting import markdown_table, number, percent, rms
-from .tables import (
+from ..core.errors import InputError
+from ..core.files import whole_directory, write_atomic, write_csv, write_figure
+from ..core.formatting import markdown_table, number, percent, rms
+from .diagnose_tables import (
     CSV_FILES,
     cause_table,
     effects_label,
@@ -123,7 +123,7 @@ def _forward_section(forward, table: pd.DataFrame) -> list[str]:
 def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
     from scipy.stats import chi2 as chi2_distribution
 
-    from .selection import ALPHA, AMBIGUITY
+    from ..diagnose.selection import ALPHA, AMBIGUITY
 
     n = d.measured.size
     gate = float(chi2_distribution.isf(ALPHA, n))
@@ -162,7 +162,7 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
 def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
     from scipy.stats import chi2 as chi2_distribution
 
-    from .selection import ALPHA, BASELINE, allowed
+    from ..diagnose.selection import ALPHA, BASELINE, allowed
 
     sel = d.selection
     n = d.measured.size
@@ -304,7 +304,7 @@ def write_report(diagnosis, out_dir, spectra=()) -> Path:
         If ``out_dir`` exists and is not a directory, or is a non-empty
         directory that is not a report (holds no ``report.md``).
     """
-    from . import figures as diagnosis_figures
+    from . import diagnose_figures as diagnosis_figures
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
@@ -321,7 +321,7 @@ def write_report(diagnosis, out_dir, spectra=()) -> Path:
             write_csv(frame, tmp / f"{name}.csv", index=False)
         figures: dict = {"spectra": []}
         if spectra:
-            from ..plots import plot_test_spectra
+            from .plots import plot_test_spectra
 
             used = {m.name for m in d.measurements}
             for ts in spectra:

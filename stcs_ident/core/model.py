@@ -2,7 +2,7 @@
 
 Frozen dataclasses in SI units (lengths in m, masses in kg, forces in N,
 angles in radians), validated when built; an invalid value raises
-:class:`~stcs_ident.errors.ModelError` naming the field. Units other than
+:class:`~stcs_ident.core.errors.ModelError` naming the field. Units other than
 SI appear only at the edges (campaign files give the inclination in
 degrees; tables print kN).
 """

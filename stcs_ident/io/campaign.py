@@ -1,12 +1,12 @@
 """Read campaign files (``campaign.toml``).
 
 :func:`load_campaign` parses a campaign file as docs/formats.md describes
-it and builds the frozen model objects of :mod:`stcs_ident.model`;
-:func:`campaign_to_toml` (:mod:`stcs_ident.campaign_toml`) writes a
+it and builds the frozen model objects of :mod:`stcs_ident.core.model`;
+:func:`campaign_to_toml` (:mod:`stcs_ident.io.campaign_toml`) writes a
 campaign back in the same format. Units other than SI live only here: the file gives the
 inclination in degrees, the model holds radians.
 
-Every problem with the file raises :class:`~stcs_ident.errors.CampaignError`
+Every problem with the file raises :class:`~stcs_ident.core.errors.CampaignError`
 whose text is one line, ``"<file>: field '<field>': <what is wrong>"``.
 Fields are named in dotted form: ``cable.length``, ``campaign.name``,
 ``setup[case2].attachment[W1].position``, ``test[case1-L4].tension``. An
@@ -23,10 +23,10 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from . import effects
+from .. import effects
 from .campaign_toml import campaign_to_toml
-from .errors import CampaignError, ModelError
-from .model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
+from ..core.errors import CampaignError, ModelError
+from ..core.model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
 
 __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 

@@ -16,9 +16,9 @@ import os
 
 import pandas as pd
 
-from .. import files
-from ..formatting import PARAMETER_UNITS, STYLES, number, rms, table_lines
-from .problem import printed_step
+from ..core import files
+from ..core.formatting import PARAMETER_UNITS, STYLES, number, rms, table_lines
+from ..identify.problem import printed_step
 
 
 def parameters_table(result) -> pd.DataFrame:

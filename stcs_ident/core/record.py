@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ModelError
+from .errors import ModelError
 
 STANDARD_GRAVITY = 9.80665  # m/s² per g
 

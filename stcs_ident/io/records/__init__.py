@@ -1,0 +1,1 @@
+"""Acceleration records in the formats data loggers write, one module per format."""
