@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.effects import Effects
 from stcs_ident.simulate.simulate import Impulse
 from stcs_ident.simulate.simulate_campaign import simulate_campaign

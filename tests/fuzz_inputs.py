@@ -118,8 +118,8 @@ class Outcome:
 @functools.lru_cache(maxsize=1)
 def _frequencies() -> str:
     """The base campaign's first test: 5 frequencies of the nominal model."""
-    from stcs_ident.forward import batch_frequencies
     from stcs_ident.core.model import Attachment, Cable
+    from stcs_ident.forward import batch_frequencies
 
     cable = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5, EA=3.0e8, inclination=np.radians(10.0))
     f = batch_frequencies(cable, (Attachment("W1", 2.7, 15.0),), 4.0e5, 5)

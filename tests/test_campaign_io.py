@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from stcs_ident.io.campaign import campaign_to_toml, load_campaign
 from stcs_ident.core.errors import CampaignError, InputError
 from stcs_ident.core.model import Attachment, Boundary, Cable, Campaign, Setup, Test
+from stcs_ident.io.campaign import campaign_to_toml, load_campaign
 
 HAN2020 = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
 

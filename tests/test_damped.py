@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from stcs_ident.core.model import Attachment, Cable, Damper
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.dsm import natural_frequencies
-from stcs_ident.core.model import Attachment, Cable, Damper
 
 
 def test_without_a_damper_the_modes_are_the_undamped_solver_s():

@@ -13,13 +13,13 @@ import pytest
 
 from stcs_ident import effects
 from stcs_ident.cli.main import main
+from stcs_ident.core.errors import InputError
+from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.fitting import aicc
 from stcs_ident.diagnose.hypotheses import parse_effects
-from stcs_ident.core.errors import InputError
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify.problem import Measurement
-from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.simulate.effects import Effects, true_model
 
 CABLE = Cable(length=8.0, mass_per_length=30.0, EI=2.0e5)
@@ -208,9 +208,9 @@ def test_cli_writes_json(tmp_path, capsys):
 
 
 def test_notes_name_values_in_si_units():
-    from stcs_ident.diagnose.fitting import in_si_units
-    from stcs_ident.core.parameters import Parameter
     from stcs_ident.core.notes import Note, point
+    from stcs_ident.core.parameters import Parameter
+    from stcs_ident.diagnose.fitting import in_si_units
 
     params = [Parameter("position", "(unmodeled mass)", 0.3, 0.3, 0.1, 60.0, slots=(("S", 0),)),
               Parameter("EI", None, 2e5, 2e5, 0.01, 100.0), Parameter("tension", "T1", 4e5, 4e5, 0.5, 2.0)]

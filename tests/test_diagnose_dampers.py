@@ -26,10 +26,10 @@ import pytest
 from diagnose_cases import BENCHES, MAX_MODES
 
 from stcs_ident import effects as registry
-from stcs_ident.io.campaign import load_campaign
+from stcs_ident.core.model import Campaign, Damper, Setup, Test
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.hypotheses import applicable
-from stcs_ident.core.model import Campaign, Damper, Setup, Test
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.effects import Effects
 from stcs_ident.simulate.simulate import Impulse
 from stcs_ident.simulate.simulate_campaign import simulate_campaign

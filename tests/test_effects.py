@@ -16,11 +16,11 @@ import pytest
 import stcs_ident
 from stcs_ident import effects
 from stcs_ident.cli.main import build_parser
+from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.diagnose import diagnose
 from stcs_ident.effects.base import Effect, Option, Quantity, Truth, positive_ratio
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify.problem import Measurement
-from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.simulate.effects import Effects, true_model
 
 PACKAGE = Path(stcs_ident.__file__).parent

@@ -17,8 +17,8 @@ import pytest
 from scipy.optimize import brentq
 
 from stcs_ident.core.errors import ModelError
-from stcs_ident.forward.fem import fe_frequencies, fe_matrices, fe_modes
 from stcs_ident.core.model import Attachment, Boundary, Cable
+from stcs_ident.forward.fem import fe_frequencies, fe_matrices, fe_modes
 
 PINNED = Boundary.pinned()
 CLAMPED = Boundary.clamped()

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from stcs_ident.core.errors import ComputationError, ModelError
+from stcs_ident.core.model import Attachment, Boundary, Cable, Damper
 from stcs_ident.forward import fem_damped
 from stcs_ident.forward.fem import fe_modes
 from stcs_ident.forward.fem_damped import fe_complex_modes
-from stcs_ident.core.model import Attachment, Boundary, Cable, Damper
 
 L, M, H = 100.0, 50.0, 2.0e6
 XD = 0.02 * L

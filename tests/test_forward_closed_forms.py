@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
+from stcs_ident.core.model import Attachment, Boundary, Cable
 from stcs_ident.forward import batch_frequencies, count_below, natural_frequencies
 from stcs_ident.forward import reference as ref
 from stcs_ident.forward.elements import BeamSegment
 from stcs_ident.forward.statics import end_slopes, stretched_lengths
-from stcs_ident.core.model import Attachment, Boundary, Cable
 
 RTOL = 1e-9
 MODES = np.arange(1, 13)

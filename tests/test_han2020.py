@@ -8,13 +8,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stcs_ident.io.campaign import load_campaign
-from stcs_ident.forward.compare import compare_forward
+from stcs_ident.core.model import Attachment
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward import reference as ref
 from stcs_ident.forward.assembly import CableBatch, Topology
+from stcs_ident.forward.compare import compare_forward
 from stcs_ident.forward.roots import solve_modes
-from stcs_ident.core.model import Attachment
+from stcs_ident.io.campaign import load_campaign
 
 ROOT = Path(__file__).resolve().parents[1]
 CAMPAIGN = ROOT / "campaigns" / "han2020"

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from stcs_ident.core.errors import InputError
+from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify import IdentifiabilityWarning, Measurement, identify, parse_parameters
 from stcs_ident.identify.corrected import corrected_campaign
-from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 
 CABLE = Cable(length=19.715, mass_per_length=16.6, EI=117338.3, EA=4.1382e8)
 SETUPS = (

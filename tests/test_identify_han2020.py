@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.identify import identify
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.report.identify_figures import plot_contours, plot_errors, plot_surfaces, save_identify_figures
 
 ROOT = Path(__file__).resolve().parents[1]

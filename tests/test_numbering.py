@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from stcs_ident.core.errors import NumberingWarning
-from stcs_ident.forward import natural_frequencies
 from stcs_ident.core.model import Attachment, Cable
+from stcs_ident.forward import natural_frequencies
 from stcs_ident.spectra.numbering import assign, number_modes
 
 STAY = Cable(length=120.0, mass_per_length=60.0, EI=2.0e6, EA=3.0e9, inclination=np.radians(30))

@@ -17,9 +17,9 @@ from case_pool import map_cases
 from scipy import signal, stats
 
 from stcs_ident.core.errors import InputError
+from stcs_ident.core.record import Record
 from stcs_ident.spectra.crb import crb_decay_rate, crb_frequency
 from stcs_ident.spectra.peaks import PeakResult, find_peaks
-from stcs_ident.core.record import Record
 
 # ----------------------------------------------------------------------------------------------
 # Synthetic records

@@ -15,9 +15,9 @@ import pandas as pd
 import pytest
 
 from stcs_ident.core.errors import InputError, RecordWarning
+from stcs_ident.core.record import STANDARD_GRAVITY, Record
 from stcs_ident.io.records.csv_text import record_from_csv
 from stcs_ident.io.records.hdf5 import read_record, write_record
-from stcs_ident.core.record import STANDARD_GRAVITY, Record
 from stcs_ident.io.records.sep005 import from_sep005, to_sep005
 from stcs_ident.io.records.validation import check_duration, check_positions
 

@@ -4,11 +4,11 @@ from pathlib import Path
 
 import pytest
 
-from stcs_ident.io.campaign import load_campaign
-from stcs_ident.forward.compare import compare_forward
 from stcs_ident.core.errors import InputError
-from stcs_ident.identify import identify
 from stcs_ident.core.settings import Settings
+from stcs_ident.forward.compare import compare_forward
+from stcs_ident.identify import identify
+from stcs_ident.io.campaign import load_campaign
 
 HAN = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
 

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.core.errors import ModelError
-from stcs_ident.forward import natural_frequencies
 from stcs_ident.core.model import Attachment, Boundary, Cable, Campaign, Setup, Test
+from stcs_ident.forward import natural_frequencies
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.effects import Effects, true_model
 from stcs_ident.simulate.modal_response import (
     exponential_gram,

@@ -16,9 +16,9 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from stcs_ident.core.model import Attachment, Cable, Damper
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.fem_assembly import fe_matrices
-from stcs_ident.core.model import Attachment, Cable, Damper
 from stcs_ident.simulate import (
     Ambient,
     Effects,

@@ -17,8 +17,9 @@ import pytest
 from scipy.signal import butter, freqz, hilbert, lfilter, welch
 
 from stcs_ident.core.errors import ModelError
-from stcs_ident.forward import natural_frequencies
 from stcs_ident.core.model import Cable, Campaign, Setup, Test
+from stcs_ident.forward import natural_frequencies
+from stcs_ident.io.records.hdf5 import read_record
 from stcs_ident.simulate import (
     Ambient,
     DcOffsets,
@@ -35,7 +36,6 @@ from stcs_ident.simulate import (
 from stcs_ident.simulate.disturbances import lowpass_force_filter, relative_tension
 from stcs_ident.simulate.field_response import augmented_stationary_covariance
 from stcs_ident.simulate.modal_response import stationary_covariance, zoh_transition
-from stcs_ident.io.records.hdf5 import read_record
 
 # The taut bare strand of test_simulate.py: f1 ≈ 3.04 Hz, near-harmonic modes, s_k = d ln f / d ln H ≈ 0.49.
 LENGTH, MASS, EI = 20.0, 10.0, 2000.0

@@ -30,9 +30,9 @@ from case_pool import map_cases
 from scipy.signal import welch
 
 from stcs_ident.core.errors import NumberingWarning
+from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.shapes import mode_shapes
-from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.simulate.simulate import Ambient, Impulse, simulate_record
 from stcs_ident.spectra.crb import crb_frequency
 from stcs_ident.spectra.numbering import number_modes

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from stcs_ident.core.record import Record
 from stcs_ident.spectra import overview
 from stcs_ident.spectra.peaks import find_peaks
-from stcs_ident.core.record import Record
 
 
 def ambient(n: int, channels: int, fs: float = 200.0, seed: int = 0) -> np.ndarray:

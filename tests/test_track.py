@@ -22,8 +22,8 @@ import pandas as pd
 import pytest
 from fuzz_inputs import BASE_TOML, _frequencies
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.cli.main import main
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.archive import ArchiveOptions, TensionChange, simulate_archive
 from stcs_ident.track.api import track
 from stcs_ident.track.events import analyse_history

@@ -14,8 +14,8 @@ import traceback
 import warnings
 
 from .. import __version__, effects
-from .track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
 from ..core.errors import ComputationError, InputError, StcsWarning, one_line
+from .track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
 
 DESCRIPTION = """\
 stcs-ident: cable force, bending stiffness and model diagnosis from the
@@ -170,8 +170,8 @@ def _simulate_parser(sub) -> None:
 
 
 def _simulate(args) -> int:
-    from ..io.campaign import campaign_file, load_campaign
     from ..core.files import check_outputs
+    from ..io.campaign import campaign_file, load_campaign
     from ..simulate.effects import Effects
     from ..simulate.simulate import Ambient, Impulse
     from ..simulate.simulate_campaign import simulate_campaign
@@ -307,8 +307,8 @@ def _inputs(campaign, file: str) -> list[str]:
 
 def _prepare(args):
     """Load the campaign and check the selection and the outputs before any work."""
-    from ..io.campaign import campaign_file, load_campaign
     from ..core.files import check_outputs
+    from ..io.campaign import campaign_file, load_campaign
 
     campaign = load_campaign(args.campaign)
     file = str(campaign_file(args.campaign))

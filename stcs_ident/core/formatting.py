@@ -13,8 +13,6 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from .notes import Assignment, Note
-
 #: What a table shows for a missing value (None, NaN).
 MISSING = "-"
 #: Table styles of :func:`table_lines`.
@@ -119,8 +117,9 @@ def markdown_table(frame, formats: Mapping[str, str] | None = None, columns: Map
     return "\n".join(table_lines(list(columns.values()), rows, "markdown", align)) + "\n"
 
 
-def render_assignment(a: Assignment) -> str:
-    """``name = value`` (six significant digits), with the unit when there is one."""
+def render_assignment(a) -> str:
+    """``name = value`` (six significant digits), with the unit when there is one (``a``: a
+    :class:`~stcs_ident.core.notes.Assignment`)."""
     return f"{a.parameter} = {a.value:.6g}" + (f" {a.unit}" if a.unit else "")
 
 
@@ -129,7 +128,7 @@ def render_points(points) -> str:
     return "; ".join(", ".join(render_assignment(a) for a in p) for p in points)
 
 
-def render_note(note: Note) -> str:
+def render_note(note) -> str:
     """The sentence of ``note``: its template filled with its fields (see :class:`~stcs_ident.core.notes.Note`)."""
     names = tuple(note.parameters)
     fields = {"value": note.value, "unit": note.unit, "parameters": ", ".join(names),

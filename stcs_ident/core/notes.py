@@ -13,6 +13,8 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
+from .formatting import render_note
+
 
 @dataclass(frozen=True)
 class Assignment:
@@ -93,8 +95,6 @@ class Note:
         return replace(self, points=tuple(tuple(p) for p in points))
 
     def __str__(self) -> str:
-        from .formatting import render_note
-
         return render_note(self)
 
 

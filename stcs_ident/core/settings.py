@@ -10,7 +10,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from .errors import InputError
-from ..forward.assembly import TENSION_MODELS
+
+#: How the additional tension from sag-extensibility is modelled: one for the whole cable (as horizontal
+#: equilibrium requires), one per segment (the source paper's Eq. 6), or none.
+TENSION_MODELS = ("uniform", "per-segment", "none")
 
 #: When the covariance is scaled by the reduced χ² (see :func:`stcs_ident.identify.uncertainty.covariance_scale`).
 SCALE_RULES = ("auto", "birge", "never")

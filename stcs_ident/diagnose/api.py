@@ -19,13 +19,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..forward.compare import ForwardResult, compare_forward
-from ..effects import registry
 from ..core.errors import InputError
-from ..identify.problem import Measurement, gather_measurements
 from ..core.model import Campaign, has_dampers
 from ..core.notes import Note
 from ..core.settings import Settings
+from ..effects import registry
+from ..forward.compare import ForwardResult, compare_forward
+from ..identify.problem import Measurement, gather_measurements
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
     HypothesisFit,

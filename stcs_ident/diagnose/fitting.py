@@ -29,13 +29,13 @@ import numpy as np
 
 from .. import effects as registry
 from ..core.formatting import PARAMETER_UNITS
-from ..forward import batch_frequencies
-from ..identify.lsq import fit_lsq, local_fit
-from ..core.parameters import fixity, parse_parameters
-from ..identify.problem import Measurement, Problem
-from ..identify.result import IdentificationResult
 from ..core.model import Attachment, Campaign, Test
 from ..core.notes import Assignment, Note
+from ..core.parameters import fixity, parse_parameters
+from ..forward import batch_frequencies
+from ..identify.lsq import fit_lsq, local_fit
+from ..identify.problem import Measurement, Problem
+from ..identify.result import IdentificationResult
 from .hypotheses import Hypothesis, applicable, build, clear_position, free_positions, unmodeled_name
 
 #: Unmodeled attachments kept from the profile scan as starts of the full fit.

@@ -21,9 +21,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import effects as registry
-from ..effects.base import POSITION_MARGIN
-from ..core.parameters import Parameter
 from ..core.model import Attachment, Campaign, Test
+from ..core.parameters import Parameter
+from ..effects.base import POSITION_MARGIN
 
 __all__ = ["CLEARANCE", "POSITION_MARGIN", "Hypothesis", "applicable", "build", "clear_position", "free_positions",
            "hypothesis_sets", "parse_effects", "recorded_attachments", "unmodeled_name"]

@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import effects as registry
-from ..forward.compare import ForwardResult
-from ..effects.base import Context
 from ..core.formatting import percent_error
-from ..identify.problem import Measurement
 from ..core.model import Cable, Campaign
 from ..core.settings import Settings
+from ..effects.base import Context
+from ..forward.compare import ForwardResult
+from ..identify.problem import Measurement
 from .fitting import HypothesisFit
 from .selection import Selection, baseline_fit, ranking
 

@@ -40,8 +40,8 @@ import numpy as np
 
 from ..core.errors import InputError, ModelError
 from ..core.formatting import plus_minus as pm  # the effects' words use the reports' ± format
-from ..core.parameters import Parameter, parse_parameters
 from ..core.model import Attachment, Cable, Campaign, Test
+from ..core.parameters import Parameter, parse_parameters
 
 #: Positions stay this fraction of the length away from the anchorages (as in identify).
 POSITION_MARGIN = 1e-3

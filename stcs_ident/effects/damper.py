@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 
-from ..core.parameters import coefficient_upper
 from ..core.model import Damper
+from ..core.parameters import coefficient_upper
 from .base import Option, Quantity, UnmodeledAttachment
 
 

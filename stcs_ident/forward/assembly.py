@@ -24,8 +24,6 @@ from ..core.errors import ComputationError
 from .elements import BeamSegment, StringSegment
 from .statics import end_slopes, stretched_lengths
 
-TENSION_MODELS = ("uniform", "per-segment", "none")
-
 
 @dataclass(frozen=True)
 class Topology:

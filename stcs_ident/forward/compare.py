@@ -18,11 +18,11 @@ import pandas as pd
 from scipy.optimize import minimize_scalar
 
 from ..core.formatting import percent_error
+from ..core.model import Campaign, Test, has_dampers
+from ..core.settings import Settings
 from . import batch_frequencies
 from . import reference as closed_form
 from .damped import complex_modes
-from ..core.model import Campaign, Test, has_dampers
-from ..core.settings import Settings
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,7 @@ import numpy as np
 
 from ..core.errors import ComputationError, ModelError
 from ..core.model import Attachment, Cable
-from .dsm import _items, build_batch
+from .batch import build_batch, mode_items
 from .roots import FORCE_NUMPY, solve_modes
 
 try:  # the optional compiled kernel (setup.py); same numerics, no per-call overhead
@@ -136,7 +136,7 @@ def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension
     out = np.empty((total, n_modes), dtype=complex)
     for batch, sel in groups:
         count = len(sel)
-        config, mode = _items(0, count, n_modes + 1)
+        config, mode = mode_items(0, count, n_modes + 1)
         omega = solve_modes(batch, config, mode).reshape(count, n_modes + 1)
         s = 1j * omega
         damped = np.flatnonzero(batch.dashpots.any(axis=1))
@@ -178,7 +178,7 @@ def _pinned_roots(batch, configs: np.ndarray, n: int) -> np.ndarray:
     rows, cols = np.nonzero(batch.dashpots)
     v = batch.v_dof[cols + 1]
     pinned._constant[rows, v * nd + v] += PIN / batch._scale[rows, v] ** 2
-    config, mode = _items(0, len(batch), n)
+    config, mode = mode_items(0, len(batch), n)
     keep = np.isin(config, configs)
     return solve_modes(pinned, config[keep], mode[keep]).reshape(len(configs), n)
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from ..core.errors import ComputationError
 from ..core.model import Attachment, Cable
+from .batch import build_batch
 from .damped import batch_complex_modes
-from .dsm import build_batch
 from .shapes import segment_solutions
 
 __all__ = ["ComplexShapes", "complex_mode_shapes"]

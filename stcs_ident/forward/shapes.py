@@ -18,7 +18,8 @@ import numpy as np
 
 from ..core.errors import ComputationError
 from ..core.model import Attachment, Cable
-from .dsm import build_batch, natural_frequencies
+from .batch import build_batch
+from .dsm import natural_frequencies
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 

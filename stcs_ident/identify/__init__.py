@@ -15,11 +15,11 @@
 - :class:`IdentifiabilityWarning`.
 """
 
+from ..core.parameters import Parameter, parse_parameters
 from .api import METHODS, identify
 from .contour import ContourSweep, fit_contour
 from .corrected import corrected_campaign
 from .lsq import fit_lsq
-from ..core.parameters import Parameter, parse_parameters
 from .problem import Measurement, Problem, gather_measurements
 from .result import IdentificationResult, TestFit
 from .uncertainty import IdentifiabilityWarning

@@ -7,8 +7,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..core.notes import Note
-from ..core.settings import Settings
 from ..core.parameters import parse_parameters
+from ..core.settings import Settings
 from .problem import Problem, gather_measurements
 from .result import IdentificationResult
 

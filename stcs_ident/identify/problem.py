@@ -20,10 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import ComputationError, InputError, ModelError
-from ..forward import batch_frequencies
-from ..forward.damped import batch_complex_modes
 from ..core.model import Campaign, Test, has_dampers
 from ..core.parameters import KINDS, Parameter, overrides_for
+from ..forward import batch_frequencies
+from ..forward.damped import batch_complex_modes
 
 #: Relative step of the numerical Jacobian (the solver is accurate to 1e-12).
 JACOBIAN_STEP = 1e-6

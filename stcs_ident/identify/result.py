@@ -21,8 +21,8 @@ import pandas as pd
 
 from ..core.formatting import percent_error
 from ..core.notes import Note
-from ..core.settings import Settings
 from ..core.parameters import Parameter
+from ..core.settings import Settings
 
 #: Reference columns shown beside the correction: labels containing this word.
 SHOWN_REFERENCE = "corrected"

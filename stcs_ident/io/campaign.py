@@ -24,9 +24,9 @@ from pathlib import Path
 from typing import Any
 
 from .. import effects
-from .campaign_toml import campaign_to_toml
 from ..core.errors import CampaignError, ModelError
 from ..core.model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
+from .campaign_toml import campaign_to_toml
 
 __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 

@@ -11,9 +11,9 @@ import json
 import math
 import os
 
-from ..forward.compare import ForwardResult
 from ..core.files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
 from ..core.formatting import number, rms
+from ..forward.compare import ForwardResult
 
 
 def _fmt(value, digits=3, width=9) -> str:

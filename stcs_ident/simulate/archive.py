@@ -31,10 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.campaign_toml import campaign_to_toml
 from ..core.errors import ModelError
 from ..core.files import whole_directory, write_atomic
 from ..core.model import Campaign, real_number
+from ..io.campaign_toml import campaign_to_toml
 from ..io.records.hdf5 import write_record
 from .simulate import Ambient, simulate_record
 

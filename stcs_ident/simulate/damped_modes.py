@@ -58,10 +58,10 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from ..core.errors import ComputationError, ModelError
+from ..core.model import Attachment, Cable, Damper
 from ..forward.dsm import count_below
 from ..forward.fem import fe_eigen
 from ..forward.fem_assembly import FEModel, fe_matrices
-from ..core.model import Attachment, Cable, Damper
 
 __all__ = ["EXTRA_MODES", "DampedModes", "FEShapes", "damped_modes", "pole_sensitivities"]
 

@@ -47,8 +47,8 @@ from scipy.signal import butter
 
 from ..core.errors import ModelError
 from ..core.files import atomic_path
-from ..forward.dsm import natural_frequencies
 from ..core.model import Attachment, Cable
+from ..forward.dsm import natural_frequencies
 from .conditions import DRIFT_LIMIT, FieldConditions, LowPassLoading, MainsHum, TensionDrift
 
 __all__ = [

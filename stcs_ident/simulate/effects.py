@@ -16,9 +16,9 @@ from collections.abc import Sequence
 from typing import Any
 
 from .. import effects as registry
-from ..effects.base import Truth
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable, Damper
+from ..effects.base import Truth
 
 __all__ = ["Effects", "true_model"]
 

@@ -42,11 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import ModelError
-from ..forward.dsm import count_below
-from ..forward.shapes import ModeShapes, mode_shapes
 from ..core.model import Attachment, Cable, has_dampers, real_number
 from ..core.record import Record
 from ..core.record import sampling_rate as record_sampling_rate
+from ..forward.dsm import count_below
+from ..forward.shapes import ModeShapes, mode_shapes
 from .conditions import FieldConditions, RecordTruth
 from .damped_response import damped_record
 from .disturbances import (

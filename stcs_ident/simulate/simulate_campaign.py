@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.campaign import CAMPAIGN_FILE, campaign_to_toml
 from ..core.errors import ModelError
 from ..core.files import whole_directory
-from ..forward.dsm import natural_frequencies
 from ..core.model import Attachment, Cable, Campaign, Damper, Test, has_dampers
+from ..forward.dsm import natural_frequencies
+from ..io.campaign import CAMPAIGN_FILE, campaign_to_toml
 from .conditions import FieldConditions
 from .disturbances import write_record_as
 from .effects import Effects, true_model

@@ -12,14 +12,14 @@
   numbering for a campaign's tests (:class:`TestSpectra`).
 """
 
+from ..core.record import Record
 from ..io.records.csv_text import record_from_csv
 from ..io.records.hdf5 import read_record, write_record
+from ..io.records.sep005 import from_sep005, to_sep005
+from ..io.records.validation import check_duration, check_positions
 from .numbering import Numbering, number_modes
 from .peaks import Peak, PeakResult, find_peaks
 from .pipeline import TestSpectra, analyse_campaign, analyse_test
-from ..core.record import Record
-from ..io.records.sep005 import from_sep005, to_sep005
-from ..io.records.validation import check_duration, check_positions
 
 __all__ = [
     "Numbering", "Peak", "PeakResult", "Record", "TestSpectra", "analyse_campaign", "analyse_test", "check_duration",

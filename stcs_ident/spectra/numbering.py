@@ -26,8 +26,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..core.errors import InputError, NumberingWarning
-from ..forward import batch_frequencies
 from ..core.model import Attachment, Cable
+from ..forward import batch_frequencies
 
 #: Cost of leaving a peak unassigned (in squared standardised residuals):
 #: a peak 4σ from every prediction is cheaper to call spurious.

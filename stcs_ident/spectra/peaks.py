@@ -104,6 +104,7 @@ import numpy as np
 from scipy import fft
 
 from ..core.errors import InputError
+from ..core.record import Record, check_finite
 from .ambient_fit import AmbientFit, fit_ambient
 from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution
@@ -111,7 +112,6 @@ from .events import Event, detect_events, whole_record_event
 from .overview import Overview, ambient_overview, decay_overviews
 from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
 from .peak_result import Peak, PeakResult
-from ..core.record import Record, check_finite
 from .refine import MAX_DAMPING, refine
 from .residual import residual_candidates
 from .wander import common_wander, with_common_wander

@@ -14,13 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..forward import natural_frequencies
 from ..core.model import Campaign, Test
+from ..core.record import Record
+from ..forward import natural_frequencies
 from ..io.records.hdf5 import read_record
+from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
-from ..core.record import Record
-from ..io.records.validation import check_bandwidth, check_duration, check_positions
 
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.

@@ -16,9 +16,9 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..io.campaign import load_campaign
 from ..core.errors import InputError
 from ..core.model import Campaign
+from ..io.campaign import load_campaign
 
 __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 
