@@ -19,7 +19,7 @@ import numpy as np
 
 from ..identify.lsq import local_fit
 from ..identify.problem import Measurement
-from .fitting import TOL, HypothesisFit, _quiet, hypothesis_problem, rms_percent
+from .fitting import TOL, HypothesisFit, hypothesis_problem, quietly, rms_percent
 
 __all__ = ["cross_validate", "cross_validate_tests"]
 
@@ -48,7 +48,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
         if not used or n_kept <= len(used):
             return None
         sub = hypothesis_problem(hyp, kept, tension_model, [hyp.parameters[j] for j in used])
-        x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
+        x_sub, _ = quietly(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
         x[used] = x_sub
         left = modes == mode
         predicted[left] = full.predict(x)[:nf][left]
@@ -81,7 +81,7 @@ def cross_validate_tests(fit: HypothesisFit, measurements: Sequence[Measurement]
             if sum(m.modes.size for m in kept) <= len(used):
                 return None
             sub = hypothesis_problem(hyp, kept, tension_model, [hyp.parameters[j] for j in used])
-            x_sub, _ = _quiet(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
+            x_sub, _ = quietly(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
             x[used] = x_sub
         predicted.append(full.predict(x)[k:k + left.modes.size])
         k += left.modes.size

@@ -279,7 +279,7 @@ def fit_nominal(campaign: Campaign, measurements: Sequence[Measurement], tension
                          sigma=sigma)
 
 
-def _quiet(fn, notes: list[Note]):
+def quietly(fn, notes: list[Note]):
     """Run ``fn`` collecting warnings as notes (the diagnosis reports them, pytest must not fail on them)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -382,7 +382,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             hyp = build(campaign, tests, effects, {**positions, scanned: float(x)}, fixed=(scanned,))
             problem = hypothesis_problem(hyp, measurements, tension_model)
             starts = _starts_from(problem, [previous] if previous else seeds, nominal=not previous)
-            xb, c = _quiet(lambda problem=problem, starts=starts: min(
+            xb, c = quietly(lambda problem=problem, starts=starts: min(
                 (local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
             values[("position", unmodeled_name(scanned))] = float(x)
@@ -405,10 +405,10 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
     starts = _starts_from(problem, seeds)
     has_position = any(p.kind == "position" and not p.slots for p in problem.parameters)
     options = {} if has_position else {"n_starts": 0}
-    result = _quiet(lambda: fit_lsq(problem, starts=None if has_position and not seeds else starts,
+    result = quietly(lambda: fit_lsq(problem, starts=None if has_position and not seeds else starts,
                                     max_nfev=max_nfev, tol=TOL, **options), notes)
     if has_position and seeds and not extra:  # the scan of recorded attachments' positions, besides the seeds
-        other = _quiet(lambda: fit_lsq(problem, max_nfev=max_nfev, tol=TOL), [])
+        other = quietly(lambda: fit_lsq(problem, max_nfev=max_nfev, tol=TOL), [])
         if other.chi2 < result.chi2 * (1 - 1e-9):
             result = other
     notes += [n for n in result.notes if n not in notes]
