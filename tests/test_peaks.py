@@ -477,6 +477,10 @@ def _node_case(name):
         39.93718880833344, 0.008585714641648066, [11, 5, 7], FieldConditions(drift=drift))
 
 
+#: The mode each case blows at its node.
+BLOWN_AT_NODE = {"hum60 seed 7 #10": 3, "drift seed 11 #5": 7}
+
+
 @pytest.mark.parametrize("case", ["hum60 seed 7 #10", "drift seed 11 #5"])
 def test_a_blow_at_a_node_under_wind_is_not_fitted_to_one_noise_bin(case):
     """A mode blown at its node under wind: nothing decays at its frequency, only its random response is there.
@@ -489,10 +493,17 @@ def test_a_blow_at_a_node_under_wind_is_not_fitted_to_one_noise_bin(case):
     the 60 Hz hum lies above the Nyquist frequency and is not recorded.)
     """
     record, true_f = _node_case(case)
+    blown = BLOWN_AT_NODE[case]
     result = find_peaks(record, f_min=0.5 * true_f[0], f_max=1.15 * true_f[-1])
     f = np.array([p.frequency for p in result.peaks])
+    spacing = float(np.min(np.diff(true_f)))
     for k, fk in enumerate(true_f):
         j = int(np.argmin(np.abs(f - fk)))
+        if abs(f[j] - fk) > 0.25 * spacing:  # no peak of this mode (the nearest is a neighbour's)
+            # Only the mode blown at its node may be missed: under light wind its random response alone can
+            # stay below the detection threshold (the simulated wind decides, record by record).
+            assert k + 1 == blown, f"mode {k + 1} ({fk:.5f} Hz) not found"
+            continue
         z = (f[j] - fk) / result.peaks[j].uncertainty
         # 4σ: twelve modes, one record; a lock on a noise bin is tens of σ off.
         assert abs(z) < 4, f"mode {k + 1}: {f[j]:.5f} Hz for {fk:.5f}, z = {z:.1f}"

@@ -101,9 +101,15 @@ def exponential_gram(shapes: ModeShapes, length: float, L: float, spacing: float
 
 
 def matrix_sqrt(C: np.ndarray) -> np.ndarray:
-    """A factor R with R Rᵀ = C for a symmetric positive semi-definite C."""
+    """The principal square root R = V √Λ Vᵀ of a symmetric positive semi-definite C (R Rᵀ = C).
+
+    Of all the factors with R Rᵀ = C this one is unique, so a seeded record is the same on every machine.
+    The factor V √Λ alone is not: the sign of each eigenvector (and the basis of a repeated eigenvalue) is
+    LAPACK's choice, which changes with the BLAS kernel the CPU selects, and the same seeded white noise
+    then made another wind (a record differed by 0.013 m/s² in 8 when OpenBLAS ran its Haswell kernel).
+    """
     lam, V = np.linalg.eigh(0.5 * (C + C.T))
-    return V * np.sqrt(np.clip(lam, 0.0, None))
+    return (V * np.sqrt(np.clip(lam, 0.0, None))) @ V.T
 
 
 def zoh_transition(omega: np.ndarray, zeta: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
