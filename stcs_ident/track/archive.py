@@ -2,7 +2,8 @@
 
     ARCHIVE/<cable>/campaign.toml      the cable and its setup; its first test (if any) gives the
                                        reference tension that numbers the modes
-    ARCHIVE/<cable>/records/**/*.h5    the records (attrs start_time required, temperature optional)
+    ARCHIVE/<cable>/records/**/*       the records, in any registered format (by suffix: *.h5, *.csv, ...;
+                                       start_time required, temperature optional)
 
 A record is known by the SHA-256 of its bytes, not by its name: a rerun
 skips what it processed before even when records were moved or renamed,
@@ -11,7 +12,6 @@ and a record rewritten under the same name is processed again.
 
 from __future__ import annotations
 
-import hashlib
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +19,8 @@ from pathlib import Path
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..io.campaign import load_campaign
+from ..io.content import content_id
+from ..io.records import record_suffixes
 
 __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 
@@ -59,14 +61,7 @@ def _cable(directory: Path) -> CableSpec:
 
 
 def record_paths(spec: CableSpec) -> list[Path]:
-    """The cable's records (``records/**/*.h5``), in path order."""
-    return sorted((Path(spec.directory) / "records").rglob("*.h5"))
-
-
-def content_id(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
-    """SHA-256 of the file's bytes (hex, 32 characters), read in chunks."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        while block := stream.read(chunk):
-            digest.update(block)
-    return digest.hexdigest()[:32]
+    """The cable's records (``records/**/*`` with a registered reader's suffix, any case), in path order."""
+    suffixes = record_suffixes()
+    found = (Path(spec.directory) / "records").rglob("*")
+    return sorted(p for p in found if p.name.lower().endswith(suffixes) and p.is_file())

@@ -11,13 +11,12 @@ of modes and frequencies) and is read column by column.
 
 from __future__ import annotations
 
-import io
 import os
 from pathlib import Path
 
 import pandas as pd
 
-from ..core.files import atomic_path
+from ..io.tables import read_parquet, write_parquet
 from .process import COLUMNS
 
 __all__ = ["append_part", "read_table", "write_table"]
@@ -44,8 +43,7 @@ def append_part(out: str | os.PathLike, rows: list[dict]) -> Path:
     directory = Path(out) / PARTS
     directory.mkdir(parents=True, exist_ok=True)
     target = directory / f"{rows[0]['record_id']}-{len(rows)}.parquet"
-    with atomic_path(target, suffix=".parquet") as tmp:
-        _frame(rows).to_parquet(tmp, index=False)
+    write_parquet(_frame(rows), target)
     return target
 
 
@@ -54,7 +52,7 @@ def read_table(out: str | os.PathLike) -> pd.DataFrame:
     parts = sorted(p for p in (Path(out) / PARTS).glob("*.parquet") if not p.name.startswith("."))  # not a temporary
     if not parts:
         return _frame([])
-    frame = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+    frame = pd.concat([read_parquet(p) for p in parts], ignore_index=True)
     frame = frame.drop_duplicates(["cable", "record_id"], keep="last")
     return frame.sort_values(["cable", "start_time", "record"], kind="stable").reset_index(drop=True)
 
@@ -62,8 +60,5 @@ def read_table(out: str | os.PathLike) -> pd.DataFrame:
 def write_table(out: str | os.PathLike, frame: pd.DataFrame) -> Path:
     """``records.parquet``, whole or not at all."""
     target = Path(out) / TABLE
-    buffer = io.BytesIO()
-    frame.to_parquet(buffer, index=False)
-    with atomic_path(target, suffix=".parquet") as tmp:
-        tmp.write_bytes(buffer.getvalue())
+    write_parquet(frame, target)
     return target
