@@ -88,9 +88,11 @@ def record_path(campaign: Campaign, test: Test) -> str:
 
 def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
                  tension_model: str = "uniform") -> TestSpectra:
-    """Pick and number the modal frequencies of one test's record (in any format io reads)."""
+    """Pick and number the modal frequencies of one test's record (in any format io reads; the test's
+    ``channels`` give the positions a file lacks)."""
     path = record_path(campaign, test)
-    return analyse_record(campaign, test, read_record(path), path, max_modes=max_modes, tension_model=tension_model)
+    record = read_record(path, positions=dict(test.channels) or None)
+    return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model)
 
 
 def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *, max_modes: int = DEFAULT_MAX_MODES,

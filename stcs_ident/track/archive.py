@@ -1,7 +1,8 @@
 """The archive of field records: its cables, their records, and a record's identity by content.
 
     ARCHIVE/<cable>/campaign.toml      the cable and its setup; its first test (if any) gives the
-                                       reference tension that numbers the modes
+                                       reference tension that numbers the modes, and the channel
+                                       positions of records whose files give none ([test.channels])
     ARCHIVE/<cable>/records/**/*       the records, in any registered format (by suffix: *.h5, *.csv, ...;
                                        start_time required, temperature optional)
 
@@ -27,13 +28,15 @@ __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 
 @dataclass(frozen=True)
 class CableSpec:
-    """One cable of an archive: its campaign, the setup its records are of, and the reference tension."""
+    """One cable of an archive: its campaign, the setup its records are of, the reference tension, and the
+    channel positions (m from end A) of records whose files give none (its first test's ``channels``)."""
 
     name: str
     directory: str
     campaign: Campaign
     setup: str
     reference_tension: float
+    channels: tuple[tuple[str, float], ...] = ()
 
 
 def discover(archive: str | os.PathLike, cables: list[str] | None = None) -> list[CableSpec]:
@@ -57,7 +60,7 @@ def _cable(directory: Path) -> CableSpec:
         raise InputError("needs a test: its tension is the reference that numbers the modes of the records, and "
                          "its setup what is attached", field="test", file=file)
     test = campaign.tests[0]
-    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension))
+    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension), test.channels)
 
 
 def record_paths(spec: CableSpec) -> list[Path]:

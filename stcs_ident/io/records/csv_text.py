@@ -47,8 +47,14 @@ class CsvReader(RecordReader):
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None,
              time_column: str = "time", unit: str = "m/s^2") -> Record:
-        """:func:`record_from_csv`; a file without ``positions`` names the first channel without one."""
-        return record_from_csv(path, {} if positions is None else positions, time_column=time_column, unit=unit)
+        """:func:`record_from_csv`; a channel without a position is refused, saying where positions are given."""
+        try:
+            return record_from_csv(path, positions or {}, time_column=time_column, unit=unit)
+        except InputError as err:
+            if err.field != "channel_position" or not err.message.startswith("no position"):
+                raise
+            hint = "a CSV record gives no positions: list its channels in the test's [test.channels] (m from end A)"
+            raise InputError(f"{err.message}; {hint}", field=err.field, file=err.file) from None
 
 
 READER = CsvReader()
