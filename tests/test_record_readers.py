@@ -234,3 +234,29 @@ def test_track_globs_and_reads_a_registered_format(tmp_path, npz):
                                         toy.relative_to(archive / "C1").as_posix()]
     assert list(npz_rows["status"]) == ["ok", "ok"] and np.all(npz_rows["tension"] > 0)
     np.testing.assert_array_equal(npz_rows["tension"], h5_rows["tension"])  # the same samples: the same tension
+
+
+def test_the_command_line_identifies_from_a_csv_record_as_from_its_hdf5(simulated, tmp_path, capsys):
+    """`identify` (through spectra) gives the same tension from the record written as CSV."""
+    import json
+
+    from stcs_ident.cli.main import main
+
+    campaign = load_campaign(simulated)
+    test = campaign.test("T2")
+    record = read_record(Path(simulated) / test.record)
+    (tmp_path / "records").mkdir()
+    _write_csv(record, tmp_path / "records" / "T2.csv")
+    csv_test = replace(test, record="records/T2.csv", channels=tuple(zip(record.channel_names,
+                                                                         record.channel_positions)))
+    (tmp_path / "campaign.toml").write_text(campaign_to_toml(replace(campaign, tests=(csv_test,))), encoding="utf-8")
+    results = {}
+    for name, directory in (("h5", simulated), ("csv", tmp_path)):
+        assert main(["identify", str(directory), "--test", "T2", "--params", "tension",
+                     "--json", str(tmp_path / f"{name}.json")]) == 0
+        results[name] = json.loads((tmp_path / f"{name}.json").read_text())
+    capsys.readouterr()
+    ratio = {name: r["parameters"]["tension_ratio"]["T2"] for name, r in results.items()}
+    # Samples equal to TEXT_RTOL give peaks equal to about 1e-10 relative, and the tension with them.
+    np.testing.assert_allclose(ratio["csv"], ratio["h5"], rtol=1e-9)
+    assert results["csv"]["tests"][0]["modes"] == results["h5"]["tests"][0]["modes"]
