@@ -227,9 +227,9 @@ def test_track_globs_and_reads_a_registered_format(tmp_path, npz):
     assert record_paths(spec) == [first, toy]
     after = track(archive, tmp_path / "out-npz", report=False)
     assert after["cables"]["C1"]["processed"] == before["cables"]["C1"]["processed"] == 2
-    from stcs_ident.track.store import read_table
+    from stcs_ident.track.store import processed_table
 
-    h5_rows, npz_rows = read_table(tmp_path / "out-h5"), read_table(tmp_path / "out-npz")
+    h5_rows, npz_rows = processed_table(tmp_path / "out-h5"), processed_table(tmp_path / "out-npz")
     assert list(npz_rows["record"]) == [first.relative_to(archive / "C1").as_posix(),
                                         toy.relative_to(archive / "C1").as_posix()]
     assert list(npz_rows["status"]) == ["ok", "ok"] and np.all(npz_rows["tension"] > 0)

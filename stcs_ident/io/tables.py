@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import io
 import os
+from pathlib import Path
 
 import pandas as pd
 
 from ..core.files import atomic_path
 
-__all__ = ["read_parquet", "write_parquet"]
+__all__ = ["parquet_parts", "write_parquet"]
 
 
 def write_parquet(frame: pd.DataFrame, path: str | os.PathLike) -> None:
@@ -31,6 +32,13 @@ def write_parquet(frame: pd.DataFrame, path: str | os.PathLike) -> None:
         tmp.write_bytes(buffer.getvalue())
 
 
-def read_parquet(path: str | os.PathLike) -> pd.DataFrame:
-    """The table in the Parquet file at ``path``."""
-    return pd.read_parquet(path)
+def parquet_parts(directory: str | os.PathLike) -> pd.DataFrame | None:
+    """The rows of every Parquet file in ``directory``, concatenated in file-name order (None if there is none).
+
+    A writer's temporary (a name starting with ``.``) is not a part: it is
+    either renamed whole or removed.
+    """
+    parts = sorted(p for p in Path(directory).glob("*.parquet") if not p.name.startswith("."))
+    if not parts:
+        return None
+    return pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)

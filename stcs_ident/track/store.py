@@ -6,7 +6,8 @@ then renamed): a run killed at any moment keeps every batch finished before,
 and the next run skips their records (known by content). ``records.parquet``
 is the union, rewritten whole at the end of each run, for the user to open
 (pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps the types (times, lists
-of modes and frequencies) and is read column by column.
+of modes and frequencies) and is read column by column. The files are
+written and read by :mod:`~stcs_ident.io.tables`; this module keeps the rows' types and order.
 """
 
 from __future__ import annotations
@@ -16,10 +17,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..io.tables import read_parquet, write_parquet
+from ..io.tables import parquet_parts, write_parquet
 from .process import COLUMNS
 
-__all__ = ["append_part", "read_table", "write_table"]
+__all__ = ["append_part", "processed_table", "write_table"]
 
 PARTS = "parts"
 TABLE = "records.parquet"
@@ -47,12 +48,11 @@ def append_part(out: str | os.PathLike, rows: list[dict]) -> Path:
     return target
 
 
-def read_table(out: str | os.PathLike) -> pd.DataFrame:
+def processed_table(out: str | os.PathLike) -> pd.DataFrame:
     """Every part's rows, one per record (the latest row of a record processed twice), sorted by cable and time."""
-    parts = sorted(p for p in (Path(out) / PARTS).glob("*.parquet") if not p.name.startswith("."))  # not a temporary
-    if not parts:
+    frame = parquet_parts(Path(out) / PARTS)
+    if frame is None:
         return _frame([])
-    frame = pd.concat([read_parquet(p) for p in parts], ignore_index=True)
     frame = frame.drop_duplicates(["cable", "record_id"], keep="last")
     return frame.sort_values(["cable", "start_time", "record"], kind="stable").reset_index(drop=True)
 
