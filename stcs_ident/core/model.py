@@ -357,6 +357,9 @@ class Test:
         Frequencies (Hz) computed by others for the same modes (a paper's
         own model, say), shown beside ours; each list is ordered by
         ``modes``.
+    channels : tuple of (name, float)
+        The record's channel positions, m from end A, for a record whose
+        file gives none (CSV); a mapping is accepted.
     """
 
     __test__ = False  # not a pytest class
@@ -368,11 +371,18 @@ class Test:
     modes: tuple[int, ...] | None = None
     record: str | None = None
     reference: tuple[tuple[str, tuple[float, ...]], ...] = ()
+    channels: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="test.name")
         where = f"test[{self.name}]"
+        channels = tuple(dict(self.channels).items())
+        for name, _ in channels:
+            if not isinstance(name, str) or not name:
+                raise ModelError(f"channel names must be non-empty strings, got {name!r}", field=f"{where}.channels")
+        object.__setattr__(self, "channels", tuple(
+            (name, finite_number(position, f"{where}.channels.{name}")) for name, position in channels))
         object.__setattr__(self, "tension", in_band(self.tension, f"{where}.tension", "tension"))
         if self.frequencies is not None:
             freqs = tuple(frequency(f, f"{where}.frequencies") for f in self.frequencies)

@@ -40,7 +40,7 @@ _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity"
 _SETUP_KEYS = ("name", "attachment", "damper")
 _ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
 _DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass")
-_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference")
+_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
 
@@ -259,6 +259,7 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
     modes = table.get("modes")
     record = table.get("record")
     reference = _table(table.get("reference", {}), f"{where}.reference")
+    channels = _table(table.get("channels", {}), f"{where}.channels")
     return Test(
         name=name,
         setup=_string(_required(table, "setup", where), f"{where}.setup"),
@@ -267,6 +268,7 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
         modes=None if modes is None else _integers(modes, f"{where}.modes"),
         record=None if record is None else _string(record, f"{where}.record"),
         reference=tuple((k, _numbers(v, f"{where}.reference.{k}")) for k, v in reference.items()),
+        channels=tuple((k, _number(v, f"{where}.channels.{k}")) for k, v in channels.items()),
     )
 
 

@@ -121,6 +121,10 @@ def _test_lines(test: Test) -> list[str]:
         lines.append("  [test.reference]")
         for label, values in test.reference:
             lines.append(f"  {_toml_key(label)} = [{', '.join(_toml_float(f) for f in values)}]")
+    if test.channels:
+        lines.append("  [test.channels]")
+        for name, position in test.channels:
+            lines.append(f"  {_toml_key(name)} = {_toml_float(position)}")
     return lines
 
 

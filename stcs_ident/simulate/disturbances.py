@@ -46,7 +46,6 @@ from scipy.linalg import solve_discrete_lyapunov
 from scipy.signal import butter
 
 from ..core.errors import ModelError
-from ..core.files import atomic_path
 from ..core.model import Attachment, Cable
 from ..forward.dsm import natural_frequencies
 from .conditions import DRIFT_LIMIT, FieldConditions, LowPassLoading, MainsHum, TensionDrift
@@ -214,26 +213,11 @@ def apply_sensor_disturbances(signal: np.ndarray, clean: np.ndarray, sampling_ra
 
 
 def write_record_as(record, path: str | os.PathLike, *, float32: bool = False) -> None:
-    """Write ``record`` with :func:`~stcs_ident.io.records.hdf5.write_record`, its samples as float32 if asked.
-
-    The layout is io_hdf5's; for float32 the file is copied with the
-    acceleration dataset cast (whole or not at all, as write_record).
-    """
-    import h5py
-
+    """Write ``record`` with :func:`~stcs_ident.io.records.hdf5.write_record`, its samples as float32 if asked
+    (whole or not at all, as write_record)."""
     from ..io.records.hdf5 import write_record
 
-    write_record(record, path)
-    if not float32:
-        return
-    target = os.fspath(path)
-    with atomic_path(target) as tmp, h5py.File(target, "r") as src, h5py.File(tmp, "w") as dst:
-        dst.attrs.update(dict(src.attrs))
-        for name in src:
-            if name == "acceleration":
-                dst.create_dataset(name, data=np.asarray(src[name][()], dtype=np.float32))
-            else:
-                src.copy(name, dst)
+    write_record(record, path, float32=float32)
 
 
 

@@ -1,7 +1,8 @@
 """Spectra: acceleration records and modal frequency picking (the simulator is :mod:`stcs_ident.simulate`).
 
-- :class:`Record`: an acceleration record in m/s²; :func:`read_record` and
-  :func:`write_record` (HDF5), :func:`record_from_csv`, :func:`from_sep005`
+- :class:`Record`: an acceleration record in m/s²; :func:`read_record` (any
+  registered format, by suffix or content) and :func:`write_record` (HDF5),
+  :func:`record_from_csv`, :func:`from_sep005`
   and :func:`to_sep005` (SDyPy SEP005), all with the same checks
   (:mod:`.validation`, dead and clipped channels dropped by :mod:`.screening`);
 - :func:`find_peaks`: modal frequencies, damping and uncertainties from a
@@ -13,8 +14,9 @@
 """
 
 from ..core.record import Record
+from ..io.records import read_record
 from ..io.records.csv_text import record_from_csv
-from ..io.records.hdf5 import read_record, write_record
+from ..io.records.hdf5 import write_record
 from ..io.records.sep005 import from_sep005, to_sep005
 from ..io.records.validation import check_duration, check_positions
 from .numbering import Numbering, number_modes

@@ -1,8 +1,9 @@
 """From a test's acceleration record to numbered modal frequencies.
 
-read the record → check it against the cable (positions, duration) → pick
-peaks across channels (:mod:`.peaks`) → number them by the family of the
-nominal model (:mod:`.numbering`). One :class:`TestSpectra` per test.
+read the record (any format io reads: :func:`~stcs_ident.io.records.read_record`)
+→ check it against the cable (positions, duration) → pick peaks across
+channels (:mod:`.peaks`) → number them by the family of the nominal model
+(:mod:`.numbering`). One :class:`TestSpectra` per test.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import pandas as pd
 from ..core.model import Campaign, Test
 from ..core.record import Record
 from ..forward import natural_frequencies
-from ..io.records.hdf5 import read_record
+from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
 from .peaks import PeakResult, find_peaks
@@ -87,9 +88,11 @@ def record_path(campaign: Campaign, test: Test) -> str:
 
 def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
                  tension_model: str = "uniform") -> TestSpectra:
-    """Pick and number the modal frequencies of one test's record."""
+    """Pick and number the modal frequencies of one test's record (in any format io reads; the test's
+    ``channels`` give the positions a file lacks)."""
     path = record_path(campaign, test)
-    return analyse_record(campaign, test, read_record(path), path, max_modes=max_modes, tension_model=tension_model)
+    record = read_record(path, positions=dict(test.channels) or None)
+    return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model)
 
 
 def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *, max_modes: int = DEFAULT_MAX_MODES,

@@ -30,7 +30,7 @@ from ..core.errors import InputError
 from .archive import CableSpec, content_id, discover, record_paths
 from .events import analyse_history
 from .process import process_record
-from .store import append_part, read_table, write_table
+from .store import append_part, processed_table, write_table
 
 __all__ = ["BATCH", "default_out", "track"]
 
@@ -89,11 +89,11 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     from ..core.files import remove_stale
 
     remove_stale(out / "parts")  # what a killed run left, even if this one has nothing new to write there
-    known = read_table(out)
+    known = processed_table(out)
     pending = _pending(specs, known)
     total = sum(len(items) for _, items in pending)
     _run(_batches(pending, batch), total, workers, scheduler, out, progress)
-    table = read_table(out)
+    table = processed_table(out)
     table, histories = _histories(specs, table)
     write_table(out, table)
     summary = _summary(archive, specs, table, histories)

@@ -1,8 +1,10 @@
 """The archive of field records: its cables, their records, and a record's identity by content.
 
     ARCHIVE/<cable>/campaign.toml      the cable and its setup; its first test (if any) gives the
-                                       reference tension that numbers the modes
-    ARCHIVE/<cable>/records/**/*.h5    the records (attrs start_time required, temperature optional)
+                                       reference tension that numbers the modes, and the channel
+                                       positions of records whose files give none ([test.channels])
+    ARCHIVE/<cable>/records/**/*       the records, in any registered format (by suffix: *.h5, *.csv, ...;
+                                       start_time required, temperature optional)
 
 A record is known by the SHA-256 of its bytes, not by its name: a rerun
 skips what it processed before even when records were moved or renamed,
@@ -11,7 +13,6 @@ and a record rewritten under the same name is processed again.
 
 from __future__ import annotations
 
-import hashlib
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,19 +20,23 @@ from pathlib import Path
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..io.campaign import load_campaign
+from ..io.content import content_id
+from ..io.records import record_suffixes
 
 __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 
 
 @dataclass(frozen=True)
 class CableSpec:
-    """One cable of an archive: its campaign, the setup its records are of, and the reference tension."""
+    """One cable of an archive: its campaign, the setup its records are of, the reference tension, and the
+    channel positions (m from end A) of records whose files give none (its first test's ``channels``)."""
 
     name: str
     directory: str
     campaign: Campaign
     setup: str
     reference_tension: float
+    channels: tuple[tuple[str, float], ...] = ()
 
 
 def discover(archive: str | os.PathLike, cables: list[str] | None = None) -> list[CableSpec]:
@@ -55,18 +60,11 @@ def _cable(directory: Path) -> CableSpec:
         raise InputError("needs a test: its tension is the reference that numbers the modes of the records, and "
                          "its setup what is attached", field="test", file=file)
     test = campaign.tests[0]
-    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension))
+    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension), test.channels)
 
 
 def record_paths(spec: CableSpec) -> list[Path]:
-    """The cable's records (``records/**/*.h5``), in path order."""
-    return sorted((Path(spec.directory) / "records").rglob("*.h5"))
-
-
-def content_id(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
-    """SHA-256 of the file's bytes (hex, 32 characters), read in chunks."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        while block := stream.read(chunk):
-            digest.update(block)
-    return digest.hexdigest()[:32]
+    """The cable's records (``records/**/*`` with a registered reader's suffix, any case), in path order."""
+    suffixes = record_suffixes()
+    found = (Path(spec.directory) / "records").rglob("*")
+    return sorted(p for p in found if p.name.lower().endswith(suffixes) and p.is_file())

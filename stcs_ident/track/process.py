@@ -21,7 +21,8 @@ from pathlib import Path
 
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.model import Test
-from ..io.records.hdf5 import read_record
+from ..identify import identify
+from ..io.records import read_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec
 
@@ -44,12 +45,14 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
            "temperature": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
            "frequencies": [], "frequency_sigma": [], "tension": math.nan, "tension_sigma": math.nan}
     try:
-        record = read_record(path)
+        record = read_record(path, positions=dict(spec.channels) or None)
         row["start_time"] = record.start_time
         row["temperature"] = math.nan if record.temperature is None else float(record.temperature)
         if record.start_time is None:
             raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
-        test = Test(name="record", setup=spec.setup, tension=spec.reference_tension, record=path)
+        # The record as a test of the cable's campaign: its setup, the reference tension, its path in the campaign.
+        test = Test(name=relative, setup=spec.setup, tension=spec.reference_tension, record=relative,
+                    channels=spec.channels)
         campaign = replace(spec.campaign, tests=(test,))
         spectra = analyse_record(campaign, test, record, path, max_modes=MAX_MODES)
         if not spectra.modes:
@@ -57,9 +60,7 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
         row.update(n_modes=len(spectra.modes), modes=[int(m) for m in spectra.modes],
                    frequencies=[float(f) for f in spectra.frequencies],
                    frequency_sigma=[float(s) for s in spectra.uncertainty])
-        from ..identify import identify
-
-        result = identify(campaign, ["record"], "tension", picked={"record": spectra})
+        result = identify(campaign, [test.name], "tension", picked={test.name: spectra})
         row.update(tension=float(result.values[0]), tension_sigma=float(result.value_uncertainty[0]),
                    status="ok")
     except (InputError, ComputationError, FloatingPointError) as err:

@@ -6,21 +6,21 @@ then renamed): a run killed at any moment keeps every batch finished before,
 and the next run skips their records (known by content). ``records.parquet``
 is the union, rewritten whole at the end of each run, for the user to open
 (pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps the types (times, lists
-of modes and frequencies) and is read column by column.
+of modes and frequencies) and is read column by column. The files are
+written and read by :mod:`~stcs_ident.io.tables`; this module keeps the rows' types and order.
 """
 
 from __future__ import annotations
 
-import io
 import os
 from pathlib import Path
 
 import pandas as pd
 
-from ..core.files import atomic_path
+from ..io.tables import parquet_parts, write_parquet
 from .process import COLUMNS
 
-__all__ = ["append_part", "read_table", "write_table"]
+__all__ = ["append_part", "processed_table", "write_table"]
 
 PARTS = "parts"
 TABLE = "records.parquet"
@@ -44,17 +44,15 @@ def append_part(out: str | os.PathLike, rows: list[dict]) -> Path:
     directory = Path(out) / PARTS
     directory.mkdir(parents=True, exist_ok=True)
     target = directory / f"{rows[0]['record_id']}-{len(rows)}.parquet"
-    with atomic_path(target, suffix=".parquet") as tmp:
-        _frame(rows).to_parquet(tmp, index=False)
+    write_parquet(_frame(rows), target)
     return target
 
 
-def read_table(out: str | os.PathLike) -> pd.DataFrame:
+def processed_table(out: str | os.PathLike) -> pd.DataFrame:
     """Every part's rows, one per record (the latest row of a record processed twice), sorted by cable and time."""
-    parts = sorted(p for p in (Path(out) / PARTS).glob("*.parquet") if not p.name.startswith("."))  # not a temporary
-    if not parts:
+    frame = parquet_parts(Path(out) / PARTS)
+    if frame is None:
         return _frame([])
-    frame = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
     frame = frame.drop_duplicates(["cable", "record_id"], keep="last")
     return frame.sort_values(["cable", "start_time", "record"], kind="stable").reset_index(drop=True)
 
@@ -62,8 +60,5 @@ def read_table(out: str | os.PathLike) -> pd.DataFrame:
 def write_table(out: str | os.PathLike, frame: pd.DataFrame) -> Path:
     """``records.parquet``, whole or not at all."""
     target = Path(out) / TABLE
-    buffer = io.BytesIO()
-    frame.to_parquet(buffer, index=False)
-    with atomic_path(target, suffix=".parquet") as tmp:
-        tmp.write_bytes(buffer.getvalue())
+    write_parquet(frame, target)
     return target

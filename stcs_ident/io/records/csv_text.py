@@ -11,15 +11,53 @@ from __future__ import annotations
 
 import csv
 import os
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
 from ...core.errors import InputError
 from ...core.record import Record
+from .base import HEAD_BYTES, RecordReader, file_head
 from .validation import Positions, one_line, position_list, positions_by_name, rate_from_time, validated_record
 
-__all__ = ["record_from_csv"]
+__all__ = ["READER", "CsvReader", "record_from_csv"]
+
+
+class CsvReader(RecordReader):
+    """CSV records (:func:`record_from_csv`): the channel positions come from the caller.
+
+    By content: text whose first line is a comma-separated header (not a JSON document).
+    """
+
+    name = "csv"
+    suffixes = (".csv", ".txt")
+
+    def can_open(self, path: str | os.PathLike) -> bool:
+        head = file_head(path)
+        if not head or b"\0" in head:
+            return False
+        first = head.split(b"\n", 1)[0].removeprefix(b"\xef\xbb\xbf").strip()  # a BOM is tolerated
+        try:
+            first.decode("utf-8")
+        except UnicodeDecodeError as err:  # unless the head only cut a long header line inside a character
+            if b"\n" in head or len(head) < HEAD_BYTES or err.start < len(first) - 3:
+                return False
+        return b"," in first and first[:1] not in (b"[", b"{")
+
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None,
+             time_column: str = "time", unit: str = "m/s^2") -> Record:
+        """:func:`record_from_csv`; a channel without a position is refused, saying where positions are given."""
+        try:
+            return record_from_csv(path, positions or {}, time_column=time_column, unit=unit)
+        except InputError as err:
+            if err.field != "channel_position" or not err.message.startswith("no position"):
+                raise
+            hint = "a CSV record gives no positions: list its channels in the test's [test.channels] (m from end A)"
+            raise InputError(f"{err.message}; {hint}", field=err.field, file=err.file) from None
+
+
+READER = CsvReader()
 
 
 def record_from_csv(

@@ -14,6 +14,7 @@ A file that is missing, unreadable or not HDF5 raises an
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from typing import Any
 
 import h5py
@@ -22,14 +23,35 @@ import numpy as np
 from ...core.errors import InputError
 from ...core.files import atomic_path
 from ...core.record import Record
+from .base import RecordReader, file_head
 from .validation import one_line, validated_record
 
-__all__ = ["FORMAT", "VERSION", "read_record", "write_record"]
+__all__ = ["FORMAT", "READER", "VERSION", "Hdf5Reader", "read_record", "write_record"]
 
 FORMAT = "stcs-record"
 VERSION = 1
 #: Most values of one dataset read into memory (4 GiB as float64).
 MAX_VALUES = 2**29
+#: The HDF5 signature, at offset 0 or after a user block of 512, 1024, 2048, ... bytes.
+SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+class Hdf5Reader(RecordReader):
+    """The contract's HDF5 record (:func:`read_record`); every channel's position is in the file."""
+
+    name = "hdf5"
+    suffixes = (".h5", ".hdf5")
+
+    def can_open(self, path: str | os.PathLike) -> bool:
+        head = file_head(path)
+        return any(head[offset:offset + len(SIGNATURE)] == SIGNATURE for offset in (0, 512, 1024))
+
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None) -> Record:
+        """:func:`read_record`; ``positions`` is not used (the file gives every channel's)."""
+        return read_record(path)
+
+
+READER = Hdf5Reader()
 
 
 def read_record(path: str | os.PathLike) -> Record:
@@ -75,12 +97,13 @@ def _read(file: str) -> Record:
                              source=file, temperature=temperature)
 
 
-def write_record(record: Record, path: str | os.PathLike) -> None:
+def write_record(record: Record, path: str | os.PathLike, *, float32: bool = False) -> None:
     """Write ``record`` to an HDF5 file, whole or not at all.
 
-    The layout is the contract's, in float64 and m/s², version 1. The file
-    is written beside the target under a temporary name, then renamed, so a
-    failure never leaves half a record. Dropped channels are not written.
+    The layout is the contract's, in float64 (float32 if ``float32``, as
+    some data loggers write) and m/s², version 1. The file is written
+    beside the target under a temporary name, then renamed, so a failure
+    never leaves half a record. Dropped channels are not written.
     """
     with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
         h5.attrs.update(format=FORMAT, version=VERSION, sampling_rate=record.sampling_rate, unit="m/s^2")
@@ -88,7 +111,7 @@ def write_record(record: Record, path: str | os.PathLike) -> None:
             h5.attrs["start_time"] = record.start_time
         if record.temperature is not None:
             h5.attrs["temperature"] = record.temperature
-        h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float64)
+        h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float32 if float32 else np.float64)
         h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
         h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
 

@@ -3,29 +3,38 @@
 One dict per channel, with ``data``, ``fs`` (or a uniform ``time``),
 ``name``, ``quantity`` and ``unit_str``; ``position`` (m from end A) is our
 extension. A record read from them passes the checks of every record source
-(:mod:`~stcs_ident.io.records.validation`); its errors name no file.
+(:mod:`~stcs_ident.io.records.validation`); its errors name no file unless
+given one (``source``).
+
+As a file (:class:`Sep005Reader`, :func:`write_sep005`), the channel dicts
+are a JSON list (``.json``), ``data`` and ``time`` as lists of numbers.
 """
 
 from __future__ import annotations
 
+import json
+import os
 from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
 
 from ...core.errors import InputError
+from ...core.files import atomic_file
 from ...core.record import Record
+from .base import RecordReader, file_head
 from .validation import (
     UNITS,
     Positions,
     check_sampling_rate,
+    one_line,
     position_list,
     positions_by_name,
     rate_from_time,
     validated_record,
 )
 
-__all__ = ["from_sep005", "to_sep005"]
+__all__ = ["READER", "Sep005Reader", "from_sep005", "read_sep005", "to_sep005", "write_sep005"]
 
 # SEP005 writes the unit as free text; the contract's spelling is "m/s^2".
 _SEP005_UNITS = {"m/s^2": "m/s^2", "m/s²": "m/s^2", "m/s2": "m/s^2", "g": "g"}
@@ -36,7 +45,8 @@ def to_sep005(record: Record) -> list[dict[str, Any]]:
 
     Each has ``data`` (1-D, m/s²), ``fs`` (Hz), ``name``, ``quantity``
     (``"acceleration"``), ``unit_str`` (``"m/s^2"``), ``position`` (m from
-    end A, our extension) and, when known, ``start_timestamp``.
+    end A, our extension) and, when known, ``start_timestamp`` and
+    ``temperature`` (°C, our extension).
     """
     channels = []
     for index, name in enumerate(record.channel_names):
@@ -50,11 +60,14 @@ def to_sep005(record: Record) -> list[dict[str, Any]]:
         }
         if record.start_time is not None:
             channel["start_timestamp"] = record.start_time
+        if record.temperature is not None:
+            channel["temperature"] = record.temperature
         channels.append(channel)
     return channels
 
 
-def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None = None) -> Record:
+def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None = None, *,
+                source: str | None = None) -> Record:
     """Build a record from SDyPy SEP005 channel dicts.
 
     Parameters
@@ -62,16 +75,27 @@ def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | No
     channels : iterable of dict
         Each with ``name``, ``data`` (1-D), ``unit_str`` (``"m/s^2"``,
         ``"m/s²"`` or ``"g"``), ``fs`` (Hz) or a uniform ``time``, and
-        optionally ``quantity`` (acceleration), ``start_timestamp`` and
-        ``position``. All channels share one length and sampling rate.
+        optionally ``quantity`` (acceleration), ``start_timestamp``,
+        ``position`` and ``temperature`` (°C). All channels share one length and sampling rate.
     positions : mapping or sequence of float, optional
         Positions of the channels without a ``position`` key.
+    source : str, optional
+        The file the channels were read from: named in errors and warnings, and the record's ``source``.
 
     Raises
     ------
     InputError
-        As :func:`~stcs_ident.io.records.hdf5.read_record`, without a file; the message names the channel.
+        As :func:`~stcs_ident.io.records.hdf5.read_record`, naming ``source`` (if given) and the channel.
     """
+    try:
+        return _from_sep005(channels, positions, source)
+    except InputError as err:
+        if source is None or err.file is not None:
+            raise
+        raise err.with_file(source) from None
+
+
+def _from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None, source: str | None) -> Record:
     channels = list(channels)
     if not channels:
         raise InputError("no channels", field="acceleration")
@@ -83,13 +107,65 @@ def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | No
     rates = [_sep005_rate(channel, name, x.size) for channel, name, x in zip(channels, names, data)]
     if not np.allclose(rates, rates[0], rtol=1e-9, atol=0):
         raise InputError(f"channels differ in sampling rate: {dict(zip(names, rates))}", field="sampling_rate")
-    lookup = dict(positions_by_name(names, positions, None)) if positions is not None else {}
+    lookup = dict(positions_by_name(names, positions, source)) if positions is not None else {}
     lookup.update({name: channel["position"] for name, channel in zip(names, channels) if "position" in channel})
     start_time = next((c["start_timestamp"] for c in channels if c.get("start_timestamp") is not None), None)
+    temperature = next((c["temperature"] for c in channels if c.get("temperature") is not None), None)
     return validated_record(
-        np.column_stack(data), rates[0], names, position_list(names, lookup, None),
-        unit="m/s^2", start_time=start_time, source=None,
+        np.column_stack(data), rates[0], names, position_list(names, lookup, source),
+        unit="m/s^2", start_time=start_time, source=source, temperature=temperature,
     )
+
+
+class Sep005Reader(RecordReader):
+    """SEP005 channel dicts stored as a JSON list (:func:`read_sep005`).
+
+    By content: a file whose first non-blank character opens a JSON list.
+    """
+
+    name = "sep005"
+    suffixes = (".json",)
+
+    def can_open(self, path: str | os.PathLike) -> bool:
+        return file_head(path).lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"["
+
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None) -> Record:
+        return read_sep005(path, positions)
+
+
+READER = Sep005Reader()
+
+
+def read_sep005(path: str | os.PathLike, positions: Positions | None = None) -> Record:
+    """Read a record from a JSON list of SEP005 channel dicts (:func:`from_sep005`, naming the file).
+
+    Raises
+    ------
+    InputError
+        If the file is missing or not JSON (no field), or as :func:`from_sep005`.
+    """
+    file = os.fspath(path)
+    try:
+        with open(file, encoding="utf-8-sig") as stream:
+            channels = json.load(stream)
+    except FileNotFoundError:
+        raise InputError("file not found", file=file) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as err:
+        raise InputError(f"cannot read the file as JSON: {one_line(err)}", file=file) from None
+    if not isinstance(channels, list):
+        raise InputError(f"must be a JSON list of SEP005 channel dicts, got a {type(channels).__name__}",
+                         field="acceleration", file=file)
+    return from_sep005(channels, positions, source=file)
+
+
+def write_sep005(record: Record, path: str | os.PathLike) -> None:
+    """Write ``record`` as a JSON list of SEP005 channel dicts (:func:`to_sep005`), whole or not at all.
+
+    Floats are written to the digit that gives them back exactly.
+    """
+    channels = [dict(channel, data=channel["data"].tolist()) for channel in to_sep005(record)]
+    with atomic_file(path) as stream:
+        json.dump(channels, stream)
 
 
 def _sep005_name(channel: Mapping[str, Any], index: int) -> str:

@@ -1,0 +1,44 @@
+"""Tables in Parquet: written whole or not at all, read back with their types.
+
+Parquet keeps the column types (times, lists of modes and frequencies) and
+is read column by column; ``track`` keeps its table of processed records in
+it (:mod:`~stcs_ident.track.store`). Reading and writing files is io's job,
+so the numerics floors hand frames here.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from ..core.files import atomic_path
+
+__all__ = ["parquet_parts", "write_parquet"]
+
+
+def write_parquet(frame: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``frame`` (without its index) to ``path``, whole or not at all.
+
+    The frame is serialised in memory first, then written beside ``path``
+    under a temporary name and renamed: a failure at any point leaves
+    ``path`` as it was.
+    """
+    buffer = io.BytesIO()
+    frame.to_parquet(buffer, index=False)
+    with atomic_path(path, suffix=".parquet") as tmp:
+        tmp.write_bytes(buffer.getvalue())
+
+
+def parquet_parts(directory: str | os.PathLike) -> pd.DataFrame | None:
+    """The rows of every Parquet file in ``directory``, concatenated in file-name order (None if there is none).
+
+    A writer's temporary (a name starting with ``.``) is not a part: it is
+    either renamed whole or removed.
+    """
+    parts = sorted(p for p in Path(directory).glob("*.parquet") if not p.name.startswith("."))
+    if not parts:
+        return None
+    return pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
