@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
                         help="weighted least squares (default) or the source paper's contour intersection")
     add_tension_model_option(parser)
     add_json_option(parser)
-    parser.add_argument("--plot", metavar="DIR", help="write the figures into DIR")
+    parser.add_argument("--plot", metavar="DIR", help="write the figures and the tables (parameters.csv, frequencies.csv) into DIR")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -56,8 +56,10 @@ def run(args: argparse.Namespace) -> int:
         write_output(args.json, to_json(summary))
     if args.plot is not None:
         from ..report.identify_figures import save_identify_figures
+        from ..report.identify_tables import write_tables
 
         save_identify_figures(result, args.plot)
+        write_tables(result, args.plot)
     if args.json != "-":
         from ..report.identify_tables import format_result
 

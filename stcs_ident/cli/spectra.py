@@ -14,7 +14,7 @@ def add_parser(sub) -> None:
     parser = command_parser(sub, "spectra")
     add_campaign_argument(parser)
     add_json_option(parser)
-    parser.add_argument("--plot", metavar="DIR", help="write one PNG per test into DIR")
+    parser.add_argument("--plot", metavar="DIR", help="write one PNG per test and the picked modes (modes.csv) into DIR")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -29,10 +29,12 @@ def run(args: argparse.Namespace) -> int:
                                          "skipped": skipped}))
     if args.plot is not None:
         from ..report.plots import plot_test_spectra, save_figure
+        from ..report.spectra_tables import write_modes_csv
 
         os.makedirs(args.plot, exist_ok=True)
         for r in results:
             save_figure(plot_test_spectra(r)["figure"], os.path.join(args.plot, f"{r.name}.png"))
+        write_modes_csv(results, args.plot)
     if args.json != "-":
         sys.stdout.write(spectra_text(campaign.name, results, skipped))
     return 0
