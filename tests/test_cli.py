@@ -383,7 +383,8 @@ def test_diagnose_help_states_the_default_number_of_processes(capsys):
 
 
 def test_progress_off_a_terminal_is_a_line_per_step_with_the_time_left(capsys):
-    from stcs_ident.cli.common import counted, step_progress
+    from stcs_ident.cli.common import step_progress
+    from stcs_ident.core.formatting import counted
 
     progress = step_progress("diagnose", "hypothesis")
     progress(1, 4, "tension")
@@ -394,3 +395,14 @@ def test_progress_off_a_terminal_is_a_line_per_step_with_the_time_left(capsys):
     assert [counted(n, "test") for n in (0, 1, 2)] == ["0 tests", "1 test", "2 tests"]
     assert counted(1, "hypothesis", "hypotheses") == "1 hypothesis" and counted(3, "hypothesis", "hypotheses")[2:] == \
         "hypotheses"
+
+
+def test_counts_in_the_diagnosis_agree_with_their_nouns(tmp_path, capsys):
+    text = GOOD.replace("frequencies = [2.5, 5.0]", "frequencies = [2.5, 5.0, 7.5, 10.0, 12.5, 15.0]")
+    out = tmp_path / "report"
+    code, stdout, err = run(["diagnose", _write(tmp_path, text), "--effects", "tension,bending_stiffness",
+                             "--max-effects", "1", "--workers", "1", "--out", out], capsys)
+    assert code == 0, err
+    assert stdout.startswith("Diagnosis of t: 1 test, 6 measured frequencies\n")
+    assert "1 test, 6 measured frequencies, 4 hypotheses fitted" in (out / "report.md").read_text()
+    assert "diagnose: hypothesis 4 of 4 (tension + bending_stiffness)" in err

@@ -63,11 +63,6 @@ def worker_count(text: str) -> int:
     return n
 
 
-def counted(n: int, noun: str, plural: str | None = None) -> str:
-    """``1 test``, ``2 tests``, ``0 tests``: a count with its noun in the right number."""
-    return f"{n} {noun if n == 1 else plural or noun + 's'}"
-
-
 def progress_line(message: str) -> None:
     """A progress line on standard error."""
     print(message, file=sys.stderr, flush=True)

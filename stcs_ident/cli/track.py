@@ -7,7 +7,7 @@ import sys
 
 from ..core.errors import InputError
 from .commands import ARCHIVE_EXAMPLE, COMMANDS
-from .common import command_parser, counted, worker_count, write_output
+from .common import command_parser, worker_count, write_output
 
 TRACK_EXAMPLE = COMMANDS["track"].examples[0]
 
@@ -38,6 +38,7 @@ def run(args: argparse.Namespace) -> int:
     import os
 
     from ..core.files import check_outputs
+    from ..core.formatting import counted
     from ..report.forward import to_json
     from ..track.api import default_out, track
     from ..track.archive import discover, record_paths
@@ -112,6 +113,8 @@ def simulate_archive_from_args(args, campaign) -> int:
 def _lines():
     """Progress as a line on standard error every 5 % of the records, with the time left (not a terminal)."""
     import time
+
+    from ..core.formatting import counted
 
     started, shown = time.perf_counter(), [-1]
 
