@@ -18,8 +18,8 @@ import warnings
 from collections.abc import Iterable, Mapping
 from types import ModuleType
 
-from .. import __version__
 from ..core.errors import ComputationError, InputError, one_line
+from ..core.version import __version__
 from .commands import COMMANDS, Command, register_command, unregister_command
 from .common import examples_epilog, show_warning
 
