@@ -1,6 +1,7 @@
 """The command line, in process: output, JSON contract, exit codes."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -406,3 +407,18 @@ def test_counts_in_the_diagnosis_agree_with_their_nouns(tmp_path, capsys):
     assert stdout.startswith("Diagnosis of t: 1 test, 6 measured frequencies\n")
     assert "1 test, 6 measured frequencies, 4 hypotheses fitted" in (out / "report.md").read_text()
     assert "diagnose: hypothesis 4 of 4 (tension + bending_stiffness)" in err
+
+
+def test_progress_on_a_terminal_is_a_bar_with_the_time_left(capsys, monkeypatch):
+    import sys
+
+    from stcs_ident.cli.common import step_progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    progress = step_progress("diagnose", "hypothesis")
+    for k in range(1, 5):
+        progress(k, 4, "tension")
+    err = capsys.readouterr().err
+    assert "diagnose: 100%" in err and "4/4" in err and "tension" in err
+    assert re.search(r"\[\d\d:\d\d<\d\d:\d\d", err)  # elapsed<left, as track shows it
+    assert "hypothesis 1 of 4" not in err  # a bar, not lines
