@@ -1,6 +1,7 @@
 """The command line, in process: output, JSON contract, exit codes."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -304,3 +305,120 @@ def test_simulate_refuses_bad_hidden_effect_options_naming_them(tmp_path, capsys
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"option '{field}'" in err[0], err
     assert not out.exists()
+
+
+def test_spectra_writes_the_picked_modes_as_csv(simulated, tmp_path, capsys):
+    pd = pytest.importorskip("pandas")
+    plots = tmp_path / "plots"
+    code, out, err = run(["spectra", simulated, "--json", "-", "--plot", plots], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    table = pd.read_csv(plots / "modes.csv")
+    assert list(table["test"].unique()) == [t["name"] for t in data["tests"]]
+    for t in data["tests"]:
+        rows = table[table["test"] == t["name"]]
+        assert rows["mode"].tolist() == t["modes"] and (rows["record_kind"] == t["kind"]).all()
+        assert rows["frequency_Hz"].tolist() == t["frequencies"]  # the same numbers, at full precision
+        assert rows["uncertainty_Hz"].tolist() == t["uncertainty"]
+        assert rows["channels"].tolist() == [" ".join(c) for c in t["channels"]]
+
+
+def test_identify_writes_its_tables_as_csv(tmp_path, capsys):
+    pd = pytest.importorskip("pandas")
+    plots = tmp_path / "figures"
+    code, out, err = run(["identify", HAN, "--test", "case1-L4", "--json", "-", "--plot", plots], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert {p.name for p in plots.iterdir()} >= {"errors.png", "parameters.csv", "frequencies.csv"}
+    parameters = pd.read_csv(plots / "parameters.csv").set_index("parameter")
+    # written with 6 significant digits ("%.6g", as the before/after table): agreement to 5e-6 relative
+    assert parameters.loc["EI_ratio", "estimate"] == pytest.approx(data["parameters"]["EI_ratio"], rel=5e-6)
+    assert parameters.loc["EI_ratio", "uncertainty"] == pytest.approx(data["uncertainty"]["EI_ratio"], rel=5e-6)
+    assert parameters.loc["tension_ratio[case1-L4]", "estimate"] == pytest.approx(
+        data["parameters"]["tension_ratio"]["case1-L4"], rel=5e-6)
+    frequencies = pd.read_csv(plots / "frequencies.csv")
+    [t] = data["tests"]
+    assert frequencies["mode"].tolist() == t["modes"]
+    assert frequencies["corrected_Hz"].to_numpy() == pytest.approx(t["after"], rel=5e-6)
+
+
+def test_track_writes_its_records_as_csv_beside_the_parquet_table(tmp_path, capsys):
+    pd = pytest.importorskip("pandas")
+    arch, out = tmp_path / "arch", tmp_path / "histories"
+    code, _, err = run(["simulate", _write(tmp_path, GOOD), "--out", arch, "--archive", "0.05", "--interval", "1800",
+                        "--duration", "30"], capsys)
+    assert code == 0, err
+    code, stdout, err = run(["track", arch, "--out", out], capsys)
+    assert code == 0, err
+    parquet, csv = pd.read_parquet(out / "records.parquet"), pd.read_csv(out / "records.csv")
+    assert list(csv.columns) == list(parquet.columns) and len(csv) == len(parquet) == 2  # 72 min every 30 min
+    assert csv["tension"].tolist() == parquet["tension"].tolist()  # floats written at full precision
+    assert csv["frequencies"].tolist() == [";".join(str(float(f)) for f in fs) for fs in parquet["frequencies"]]
+    assert pd.to_datetime(csv["start_time"]).tolist() == parquet["start_time"].tolist()
+    assert "of 2 records with a tension" in stdout
+
+
+def test_diagnose_workers_caps_the_processes(tmp_path, capsys, monkeypatch):
+    import stcs_ident.diagnose
+    from stcs_ident.core.errors import ComputationError
+
+    given = {}
+
+    def stop(*args, **options):
+        given.update(options)
+        raise ComputationError("stopped here")
+
+    monkeypatch.setattr(stcs_ident.diagnose, "diagnose", stop)
+    code, _, err = run(["diagnose", _write(tmp_path, GOOD), "--workers", "1"], capsys)
+    assert code == 1 and "stopped here" in err and given["workers"] == 1
+    code, _, err = run(["diagnose", tmp_path, "--workers", "0"], capsys)
+    assert code == 2 and "--workers" in err and "1 … 1024" in err
+
+
+def test_diagnose_help_states_the_default_number_of_processes(capsys):
+    from stcs_ident.diagnose.api import MAX_WORKERS
+
+    with pytest.raises(SystemExit):
+        main(["diagnose", "--help"])
+    assert f"at most {MAX_WORKERS}" in " ".join(capsys.readouterr().out.split())
+
+
+def test_progress_off_a_terminal_is_a_line_per_step_with_the_time_left(capsys):
+    from stcs_ident.cli.common import step_progress
+    from stcs_ident.core.formatting import counted
+
+    progress = step_progress("diagnose", "hypothesis")
+    progress(1, 4, "tension")
+    progress(4, 4, "tension + length")
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("diagnose: hypothesis 1 of 4 (tension), ") and lines[0].endswith(" s left")
+    assert lines[1].startswith("diagnose: hypothesis 4 of 4 (tension + length), ") and "about 0 s left" in lines[1]
+    assert [counted(n, "test") for n in (0, 1, 2)] == ["0 tests", "1 test", "2 tests"]
+    assert counted(1, "hypothesis", "hypotheses") == "1 hypothesis" and counted(3, "hypothesis", "hypotheses")[2:] == \
+        "hypotheses"
+
+
+def test_counts_in_the_diagnosis_agree_with_their_nouns(tmp_path, capsys):
+    text = GOOD.replace("frequencies = [2.5, 5.0]", "frequencies = [2.5, 5.0, 7.5, 10.0, 12.5, 15.0]")
+    out = tmp_path / "report"
+    code, stdout, err = run(["diagnose", _write(tmp_path, text), "--effects", "tension,bending_stiffness",
+                             "--max-effects", "1", "--workers", "1", "--out", out], capsys)
+    assert code == 0, err
+    assert stdout.startswith("Diagnosis of t: 1 test, 6 measured frequencies\n")
+    assert "1 test, 6 measured frequencies, 4 hypotheses fitted" in (out / "report.md").read_text()
+    assert "diagnose: hypothesis 4 of 4 (tension + bending_stiffness)" in err
+
+
+def test_progress_on_a_terminal_is_a_bar_with_the_time_left(capsys, monkeypatch):
+    import sys
+
+    from stcs_ident.cli.common import step_progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    progress = step_progress("diagnose", "hypothesis")
+    for k in range(1, 5):
+        progress(k, 4, "tension")
+    err = capsys.readouterr().err
+    assert "diagnose: 100%" in err and "4/4" in err and "tension" in err
+    assert re.search(r"\[\d\d:\d\d<\d\d:\d\d", err)  # elapsed<left, as track shows it
+    assert "hypothesis 1 of 4" not in err  # a bar, not lines

@@ -1,4 +1,4 @@
-"""The command line of archives: ``stcs-ident track`` and ``stcs-ident simulate --archive``."""
+"""``stcs-ident track`` (an archive of field records into tension histories) and ``simulate --archive``'s options."""
 
 from __future__ import annotations
 
@@ -6,45 +6,39 @@ import argparse
 import sys
 
 from ..core.errors import InputError
+from .commands import ARCHIVE_EXAMPLE, COMMANDS
+from .common import command_parser, worker_count, write_output
 
-TRACK_EXAMPLE = "stcs-ident track archive/ --out histories/ --workers 2"
-ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archive 3 --cables 3 "
-                   "--tension-change C2,2026-03-02T12:00:00+00:00,-0.015")
+TRACK_EXAMPLE = COMMANDS["track"].examples[0]
+
+__all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parser", "run",
+           "simulate_archive_from_args"]
 
 
-def add_track_parser(sub, epilog: str) -> None:
-    trk = sub.add_parser("track", epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter,
-                         help="an archive of field records into tension histories, with lasting changes",
+def add_parser(sub) -> None:
+    """The ``track`` subcommand and its options."""
+    trk = command_parser(sub, "track",
                          description="Processes the records of ARCHIVE/<cable>/records/ not processed before "
                                      "(known by content): modes, tension with 1σ, temperature normalisation, "
-                                     "lasting changes. Writes OUT/records.parquet, OUT/report.md, "
-                                     "OUT/<cable>.png, OUT/events.csv and OUT/cables.csv.")
+                                     "lasting changes. Writes OUT/records.parquet (and the same table as "
+                                     "OUT/records.csv), OUT/report.md, OUT/<cable>.png, OUT/events.csv and "
+                                     "OUT/cables.csv.")
     trk.add_argument("archive", help="archive directory: one folder per cable with campaign.toml and records/")
     trk.add_argument("--cable", action="append", metavar="NAME", help="only this cable (repeatable)")
     trk.add_argument("--out", metavar="DIR", help="output directory, also the state of reruns "
                                                   "(default ARCHIVE.track beside the archive)")
     trk.add_argument("--json", metavar="FILE", help="write the JSON summary ('-' for standard output)")
-    trk.add_argument("--workers", type=_workers, default=1, metavar="N", help="local processes (default 1)")
+    trk.add_argument("--workers", type=worker_count, default=1, metavar="N", help="local processes (default 1)")
     trk.add_argument("--scheduler", metavar="ADDRESS",
                      help="a Dask distributed scheduler (tcp://host:8786) to run the records on instead")
-    trk.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
 
 
-def _workers(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
-    if not 1 <= n <= 1024:
-        raise argparse.ArgumentTypeError(f"must be 1 … 1024, got {n}")
-    return n
-
-
-def run_track(args, write) -> int:
-    """``stcs-ident track``: ``write(path, text)`` writes the JSON whole."""
+def run(args: argparse.Namespace) -> int:
+    """Run ``track``; returns the exit status."""
     import os
 
     from ..core.files import check_outputs
+    from ..core.formatting import counted
     from ..report.forward import to_json
     from ..track.api import default_out, track
     from ..track.archive import discover, record_paths
@@ -57,12 +51,12 @@ def run_track(args, write) -> int:
     summary = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
                     progress=True if sys.stderr.isatty() else _lines())
     if args.json:
-        write(args.json, to_json(summary))
+        write_output(args.json, to_json(summary))
     if args.json != "-":
         for name, cable in summary["cables"].items():
             events = "; ".join(f"{100 * e['change']:+.2f} ± {100 * e['uncertainty']:.2f} % from {e['start_time']}"
                                for e in cable["events"]) or "no lasting change"
-            print(f"{name}: {cable['processed']} of {cable['records']} records with a tension, "
+            print(f"{name}: {cable['processed']} of {counted(cable['records'], 'record')} with a tension, "
                   f"{cable['failed']} failed; {events}")
         print(f"wrote {out}")
     return 0
@@ -120,6 +114,8 @@ def _lines():
     """Progress as a line on standard error every 5 % of the records, with the time left (not a terminal)."""
     import time
 
+    from ..core.formatting import counted
+
     started, shown = time.perf_counter(), [-1]
 
     def progress(done, total):
@@ -128,7 +124,7 @@ def _lines():
             shown[0] = step
             elapsed = time.perf_counter() - started
             left = elapsed / done * (total - done)
-            print(f"track: {done} of {total} records, {elapsed:.0f} s, about {left:.0f} s left", file=sys.stderr,
+            print(f"track: {done} of {counted(total, 'record')}, {elapsed:.0f} s, about {left:.0f} s left", file=sys.stderr,
                   flush=True)
     return progress
 

@@ -135,3 +135,17 @@ def render_note(note) -> str:
               "parameter": names[0] if names else "", "names": names, "points": render_points(note.points)}
     fields.update(dict(note.data))
     return note.template.format(**fields)
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """A count with its noun in the right number: ``1 test``, ``0 tests``, ``2 hypotheses``.
+
+    Parameters
+    ----------
+    n : int
+    noun : str
+        The singular.
+    plural : str, optional
+        The plural when it is not ``noun + "s"``.
+    """
+    return f"{n} {noun if n == 1 else plural or noun + 's'}"

@@ -17,7 +17,7 @@ import pandas as pd
 
 from ..core.errors import InputError
 from ..core.files import whole_directory, write_atomic, write_csv, write_figure
-from ..core.formatting import markdown_table, number, percent, rms
+from ..core.formatting import counted, markdown_table, number, percent, rms
 from .diagnose_tables import (
     CSV_FILES,
     cause_table,
@@ -33,7 +33,8 @@ def diagnosis_text(diagnosis) -> str:
     """Ranking, cause and gain for the terminal."""
     d = diagnosis
     n = sum(m.modes.size for m in d.measurements)
-    lines = [f"Diagnosis of {d.campaign.name}: {len(d.measurements)} tests, {n} measured frequencies", ""]
+    lines = [(f"Diagnosis of {d.campaign.name}: {counted(len(d.measurements), 'test')}, "
+              f"{counted(n, 'measured frequency', 'measured frequencies')}"), ""]
     with_error = d.selection.model_error
     lines.append(f"{'hypothesis':<48} {'k':>3} {'chi2':>12} {'prior':>8}" + (f" {'eps':>9}" if with_error else "")
                  + f" {'dAICc':>10} {'rms %':>8} {'cv rms %':>9}")
@@ -82,7 +83,8 @@ def _data_section(d, spectra) -> list[str]:
     n = d.measured.size
     out = ["## Data", "",
            (f"Cable: length {cable.length:g} m, mass {cable.mass_per_length:g} kg/m, nominal EI "
-           f"{cable.EI / 1e3:.4g} kN m². {len(d.measurements)} tests, {n} measured frequencies"
+           f"{cable.EI / 1e3:.4g} kN m². {counted(len(d.measurements), 'test')}, "
+           f"{counted(n, 'measured frequency', 'measured frequencies')}"
            f"{' (setups symmetric about midspan: a position x and l − x are not told apart)' if d.symmetric else ''}."),
            "", markdown_table(pd.DataFrame(rows), {"tension_kN": "{:.1f}"},
                               {"test": "test", "setup": "setup", "tension_kN": "tension (kN)", "modes": "modes",
@@ -256,7 +258,9 @@ def report_markdown(diagnosis, tables: dict, figures: dict, spectra=()) -> str:
     """``report.md`` from the tables (``report_tables``) and the figure file names."""
     d = diagnosis
     lines = [f"# Diagnosis of {d.campaign.name}", "",
-             (f"{len(d.measurements)} tests, {d.measured.size} measured frequencies, {len(d.fits)} hypotheses "
+             (f"{counted(len(d.measurements), 'test')}, "
+              f"{counted(d.measured.size, 'measured frequency', 'measured frequencies')}, "
+              f"{counted(len(d.fits), 'hypothesis', 'hypotheses')} "
              f"fitted in {d.elapsed:.1f} s."), "", "**Cause:** " + d.cause_text(), "",
              "**Gain:** rms error nominal " + percent(d.nominal.rms_error) + ", corrected "
              + percent(d.corrected.rms_error) + " (cross-validated " + percent(d.corrected.cv_rms_error) + ").", ""]

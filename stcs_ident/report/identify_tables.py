@@ -113,3 +113,20 @@ def format_result(result, style: str = "text") -> str:
 def write_csv(result, path: str | os.PathLike) -> None:
     """The before/after table (``result.to_dataframe()``) as CSV, whole or not at all."""
     files.write_csv(result.to_dataframe(), path, index=False, float_format="%.6g")
+
+
+#: File names of :func:`write_tables`, in the ``--plot`` directory.
+PARAMETERS_CSV, FREQUENCIES_CSV = "parameters.csv", "frequencies.csv"
+
+
+def write_tables(result, directory: str | os.PathLike) -> list[str]:
+    """The identification's tables as CSV in ``directory`` (created), each whole or not at all.
+
+    ``parameters.csv`` (:func:`parameters_table`: one row per parameter) and ``frequencies.csv``
+    (:func:`write_csv`: the before/after table, one row per test and mode). Returns the paths.
+    """
+    os.makedirs(directory, exist_ok=True)
+    parameters, frequencies = os.path.join(directory, PARAMETERS_CSV), os.path.join(directory, FREQUENCIES_CSV)
+    files.write_csv(parameters_table(result), parameters, index=False, float_format="%.6g")
+    write_csv(result, frequencies)
+    return [parameters, frequencies]

@@ -1,6 +1,7 @@
 """The ``track`` report: per cable the tension history and its modes, a summary of the cables, the events.
 
     OUT/records.parquet          one row per record (written by the run)
+    OUT/records.csv              the same table as CSV (lists of modes and frequencies joined by ';')
     OUT/report.md                the summary table, the events, the failed records
     OUT/events.csv               one row per lasting change
     OUT/cables.csv               one row per cable
@@ -17,7 +18,7 @@ import pandas as pd
 
 from ..core.files import write_atomic, write_csv, write_figure
 
-__all__ = ["write_report"]
+__all__ = ["records_csv_table", "write_report"]
 
 
 def write_report(out: Path, specs, table: pd.DataFrame, histories, summary: dict) -> None:
@@ -28,12 +29,28 @@ def write_report(out: Path, specs, table: pd.DataFrame, histories, summary: dict
         for name, c in summary["cables"].items()])
     events = pd.DataFrame([{"cable": name, **e} for name, c in summary["cables"].items() for e in c["events"]],
                           columns=["cable", "start_time", "change", "uncertainty", "alarm_time"])
+    write_csv(records_csv_table(table), out / "records.csv", index=False)
     write_csv(cables, out / "cables.csv", index=False)
     write_csv(events, out / "events.csv", index=False)
     for spec in specs:
         rows, history = histories[spec.name]
         write_figure(_figure(spec, table, rows, history), out / f"{spec.name}.png")
     write_atomic(out / "report.md", _markdown(summary, cables, events))
+
+
+def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The records table (``records.parquet``) with plain cells for CSV.
+
+    The per-record lists (``modes``, ``frequencies``, ``frequency_sigma``) become their values joined by
+    ``;`` and ``start_time`` an ISO 8601 string; every other column is as in the Parquet table.
+    """
+    plain = table.copy()
+    for name, cast in (("modes", int), ("frequencies", float), ("frequency_sigma", float)):
+        if name in plain:  # str of a float is its shortest round-trip form
+            plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
+    if "start_time" in plain:
+        plain["start_time"] = [None if pd.isna(t) else t.isoformat() for t in plain["start_time"]]
+    return plain
 
 
 def _figure(spec, table: pd.DataFrame, rows, history):

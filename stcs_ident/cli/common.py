@@ -1,0 +1,169 @@
+"""What the commands share: their parser's frame, the common options, the checks before any work, output.
+
+Light on purpose (the standard library and :mod:`stcs_ident.core.errors`
+at import): the rest of the toolkit is imported inside the functions
+that need it, when a command runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections.abc import Callable
+
+from ..core.errors import InputError, StcsWarning, one_line
+from .commands import COMMANDS
+
+TENSION_MODELS = ("uniform", "per-segment", "none")
+TENSION_MODEL_HELP = ("additional tension from sag-extensibility: uniform (one for the whole cable, default), "
+                      "per-segment (the source paper's form, for comparison) or none (a taut beam)")
+
+
+def command_parser(sub, name: str, **options) -> argparse.ArgumentParser:
+    """``sub.add_parser(name, ...)`` with the table's summary and its examples as the epilog."""
+    command = COMMANDS[name]
+    return sub.add_parser(name, help=command.summary, epilog=examples_epilog(command.examples),
+                          formatter_class=argparse.RawDescriptionHelpFormatter, **options)
+
+
+def examples_epilog(examples) -> str | None:
+    """``example:`` (or ``examples:``) and one command line per line; None without examples."""
+    examples = list(examples)
+    if not examples:
+        return None
+    return "example" + ("s" if len(examples) > 1 else "") + ":\n" + "\n".join(f"  {e}" for e in examples)
+
+
+def add_campaign_argument(parser: argparse.ArgumentParser) -> None:
+    """The positional CAMPAIGN and the repeatable ``--test NAME``."""
+    parser.add_argument("campaign", help="campaign directory or its campaign.toml")
+    parser.add_argument("--test", action="append", metavar="NAME", help="only this test (repeatable)")
+
+
+def add_json_option(parser: argparse.ArgumentParser) -> None:
+    """``--json FILE``."""
+    parser.add_argument("--json", metavar="FILE", help="write the JSON result ('-' for standard output)")
+
+
+def add_tension_model_option(parser: argparse.ArgumentParser) -> None:
+    """``--tension-model uniform|per-segment|none``."""
+    parser.add_argument("--tension-model", choices=TENSION_MODELS, default="uniform", help=TENSION_MODEL_HELP)
+
+
+def worker_count(text: str) -> int:
+    """``--workers``: a number of processes 1 … 1024 (argparse reports a refusal as a bad option)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if not 1 <= n <= 1024:
+        raise argparse.ArgumentTypeError(f"must be 1 … 1024, got {n}")
+    return n
+
+
+def progress_line(message: str) -> None:
+    """A progress line on standard error."""
+    print(message, file=sys.stderr, flush=True)
+
+
+def step_progress(command: str, unit: str) -> Callable[[int, int, str], None]:
+    """Progress of ``total`` steps as ``progress(done, total, label)``: a tqdm bar with the time left on a
+    terminal, else one line per step with the elapsed time and the time left (as ``track`` shows it)."""
+    if sys.stderr.isatty():
+        bar = []
+
+        def on_bar(done: int, total: int, label: str) -> None:
+            if not bar:
+                from tqdm import tqdm
+
+                bar.append(tqdm(total=total, unit=unit, file=sys.stderr, desc=command, dynamic_ncols=True))
+            bar[0].set_postfix_str(label, refresh=False)
+            bar[0].update(done - bar[0].n)
+            if done == total:
+                bar[0].close()
+        return on_bar
+    started = time.perf_counter()
+
+    def on_line(done: int, total: int, label: str) -> None:
+        elapsed = time.perf_counter() - started
+        left = elapsed / done * (total - done) if done else float("nan")
+        progress_line(f"{command}: {unit} {done} of {total} ({label}), {elapsed:.0f} s, about {left:.0f} s left")
+    return on_line
+
+
+def selected_tests(campaign, names: list[str] | None, file: str) -> list[str] | None:
+    """``--test`` names, each checked against the campaign's tests."""
+    known = [t.name for t in campaign.tests]
+    for name in names or []:
+        if name not in known:
+            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="--test", file=file)
+    return names
+
+
+def check_output(path) -> None:
+    """Refuse an output file whose directory does not exist, before any work."""
+    if path in (None, "-"):
+        return
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise InputError(f"directory {parent} does not exist", field="--json", file=str(path))
+
+
+def write_output(path, text: str) -> None:
+    """The JSON result, whole or not at all (``-``: standard output); a failure names ``--json``."""
+    from ..core.files import write_atomic
+
+    try:
+        write_atomic(path, text)
+    except OSError as err:
+        raise InputError(f"cannot write: {err.strerror}", field="--json", file=str(path)) from err
+
+
+def campaign_inputs(campaign, file: str) -> list[str]:
+    """The files a command on ``campaign`` reads: its campaign file and every test's record."""
+    from ..spectra.pipeline import record_path
+
+    return [file] + [record_path(campaign, t) for t in campaign.tests if t.record is not None]
+
+
+def prepare(args):
+    """Load the campaign and check the selection and the outputs before any work.
+
+    Returns
+    -------
+    campaign : Campaign
+    file : str
+        The campaign file, for messages.
+    tests : list of str or None
+        The ``--test`` selection.
+    """
+    from ..core.files import check_outputs
+    from ..io.campaign import campaign_file, load_campaign
+
+    campaign = load_campaign(args.campaign)
+    file = str(campaign_file(args.campaign))
+    tests = selected_tests(campaign, args.test, file)
+    check_outputs([("--json", args.json, False), ("--plot", getattr(args, "plot", None), True),
+                   ("--out", getattr(args, "out", None), True)], campaign_inputs(campaign, file))
+    check_output(args.json)
+    return campaign, file, tests
+
+
+def picked_spectra(campaign, tests, file):
+    """Spectra of the selected tests that have records (for forward, spectra, identify and diagnose)."""
+    if not any(t.record is not None for t in campaign.tests if not tests or t.name in tests):
+        return []
+    from ..spectra.pipeline import analyse_campaign
+
+    return analyse_campaign(campaign, tests, progress=progress_line)
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on standard error: the toolkit's own as ``stcs-ident: warning: ...``; numerical
+    ones from the libraries (overflow in a square, a division by zero on a dead channel) are internal and
+    shown only with --debug."""
+    if not issubclass(category, StcsWarning):
+        return
+    print(f"stcs-ident: warning: {one_line(str(message))}", file=sys.stderr)

@@ -1,0 +1,51 @@
+"""``stcs-ident forward``: the nominal model against measured and published frequencies."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .common import (
+    add_campaign_argument,
+    add_json_option,
+    add_tension_model_option,
+    command_parser,
+    picked_spectra,
+    prepare,
+    write_output,
+)
+
+
+def _mode_count(text: str) -> int:
+    """``--modes``: a mode number 1 … MAX_MODE (argparse reports a refusal as a bad option)."""
+    from ..core.model import mode_number
+
+    try:
+        return mode_number(int(text), "--modes")
+    except ValueError as err:  # not an integer, or out of range (ModelError is a ValueError)
+        raise argparse.ArgumentTypeError(getattr(err, "message", f"must be an integer, got {text!r}")) from None
+
+
+def add_parser(sub) -> None:
+    """The ``forward`` subcommand and its options."""
+    parser = command_parser(sub, "forward")
+    add_campaign_argument(parser)
+    parser.add_argument("--modes", type=_mode_count, metavar="N", help="modes to compute (default: measured, at least 6)")
+    add_tension_model_option(parser)
+    add_json_option(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``forward``; returns the exit status."""
+    from ..forward.compare import compare_forward
+    from ..report.forward import forward_text, to_json
+
+    campaign, file, tests = prepare(args)
+    picked = {r.name: (r.modes, r.frequencies) for r in picked_spectra(campaign, tests, file)}
+    result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked)
+    text = forward_text(result)
+    if args.json:
+        write_output(args.json, to_json(result.summary()))
+    if args.json != "-":
+        sys.stdout.write(text)
+    return 0
