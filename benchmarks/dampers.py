@@ -31,12 +31,12 @@ from pathlib import Path
 import numpy as np
 from common import print_header, timed
 
+from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.forward import damped, natural_frequencies
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.damped_shapes import complex_mode_shapes
 from stcs_ident.identify import identify
 from stcs_ident.identify.problem import Measurement
-from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 
 STAY = Cable(200.0, 80.0, 5.0e5, EA=2.0e9, inclination=math.radians(30.0))
 H = 5.0e6

@@ -30,10 +30,10 @@ import time
 
 from common import CHECKOUT, print_header
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.api import default_workers
 from stcs_ident.identify import identify
+from stcs_ident.io.campaign import load_campaign
 
 CAMPAIGN = CHECKOUT / "campaigns" / "han2020"
 TARGET = 60.0

@@ -24,10 +24,10 @@ import time
 import numpy as np
 from common import CHECKOUT, print_header, timed
 
-from stcs_ident.io.campaign import load_campaign
+from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.forward import batch_frequencies, natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies
-from stcs_ident.core.model import Attachment, Cable
+from stcs_ident.io.campaign import load_campaign
 
 ROOT = CHECKOUT  # campaigns/ of this checkout
 TARGET_ACCURACY = 1e-6  # relative, on mode 10

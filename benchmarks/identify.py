@@ -32,10 +32,10 @@ from pathlib import Path
 import numpy as np
 from common import CHECKOUT, print_header, timed
 
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies
 from stcs_ident.identify import Problem, fit_contour, fit_lsq, gather_measurements, parse_parameters
+from stcs_ident.io.campaign import load_campaign
 
 ROOT = CHECKOUT  # campaigns/ of this checkout
 TARGET_ACCURACY = 1e-6  # relative, on mode 6 at the nominal point

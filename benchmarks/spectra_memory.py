@@ -40,8 +40,8 @@ LENGTH, TENSION = 8.0, 5.0e5  # the fuzz campaign's cable and its test T2
 
 def write_record(path: Path, n_samples: int, n_channels: int, rate: float, seed: int = 0) -> None:
     """A field-like ambient record written in blocks of rows (never the whole array in memory)."""
-    from stcs_ident.forward import batch_frequencies
     from stcs_ident.core.model import Attachment, Cable
+    from stcs_ident.forward import batch_frequencies
 
     cable = Cable(length=LENGTH, mass_per_length=30.0, EI=2.0e5, EA=3.0e8, inclination=np.radians(10.0))
     f = np.asarray(batch_frequencies(cable, (Attachment("W1", 2.7, 15.0),), TENSION, 12)).ravel()

@@ -40,8 +40,8 @@ from common import print_header
 def campaigns(root: Path) -> dict:
     from fuzz_inputs import BASE_TOML, _frequencies
 
-    from stcs_ident.io.campaign import load_campaign
     from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
+    from stcs_ident.io.campaign import load_campaign
 
     (root / "hanger").mkdir(parents=True)
     (root / "hanger" / "campaign.toml").write_text(BASE_TOML.replace('record = "records/T2.h5"\n', "")

@@ -42,9 +42,9 @@ from pathlib import Path
 import numpy as np
 
 import stcs_ident
-from stcs_ident.io.campaign import load_campaign
-from stcs_ident.diagnose import diagnose
 from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
+from stcs_ident.diagnose import diagnose
+from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate import Ambient, Effects, Impulse, random_field_conditions, simulate_campaign
 from stcs_ident.spectra import analyse_test
 
