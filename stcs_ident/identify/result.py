@@ -21,8 +21,8 @@ import pandas as pd
 
 from ..core.formatting import PARAMETER_UNITS, percent_error
 from ..core.notes import Note
-from ..core.result import Result
 from ..core.parameters import Parameter
+from ..core.result import Result
 from ..core.settings import Settings
 
 #: Reference columns shown beside the correction: labels containing this word.
