@@ -13,8 +13,9 @@ import sys
 import traceback
 import warnings
 
-from .. import __version__, effects
+from .. import effects
 from ..core.errors import ComputationError, InputError, StcsWarning, one_line
+from ..core.version import __version__
 from .track import ARCHIVE_EXAMPLE, TRACK_EXAMPLE, add_archive_options, add_track_parser, run_track
 
 DESCRIPTION = """\
@@ -380,8 +381,7 @@ def _diagnose(args) -> int:
     from ..report.forward import to_json
 
     campaign, file, tests = _prepare(args)
-    spectra = _picked(campaign, tests, file)
-    picked = {r.name: r for r in spectra}
+    picked = {r.name: r for r in _picked(campaign, tests, file)}
     try:
         result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,
                           tension_model=args.tension_model, all_hypotheses=args.all_hypotheses,
@@ -393,7 +393,7 @@ def _diagnose(args) -> int:
     if args.out is not None:
         from ..report.diagnose import write_report
 
-        write_report(result, args.out, spectra=spectra)
+        write_report(result, args.out)
     if args.json != "-":
         from ..report.diagnose import diagnosis_text
 

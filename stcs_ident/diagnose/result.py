@@ -85,6 +85,10 @@ class Diagnosis(Result):
         Leave-one-test-out prediction error (%) of ``nominal``, ``baseline``
         and ``corrected`` (each test predicted by the model fitted to the
         others; empty with one test).
+    spectra : tuple of TestSpectra
+        The spectra the frequencies were picked from (the inputs given as
+        ``picked``; empty when every test's frequencies came from a table),
+        for the report's figures.
     """
 
     campaign: Campaign
@@ -100,6 +104,7 @@ class Diagnosis(Result):
     settings: Settings = field(default_factory=Settings)
     comparison: ForwardResult | None = None
     test_cv: dict = field(default_factory=dict)
+    spectra: tuple = ()
 
     main_table = "ranking"
 
