@@ -119,7 +119,8 @@ class Diagnosis(Result):
             cause = f"cause {' + '.join(sel.effects)} (principal {sel.principal})"
         else:
             cause = "no cause: the nominal model stands" if sel.explained else "no cause named"
-        return (f"{self.campaign.name}, {len(self.measurements)} tests, {self.measured.size} frequencies, "
+        n = len(self.measurements)
+        return (f"{self.campaign.name}, {n} test{'s' if n != 1 else ''}, {self.measured.size} frequencies, "
                 f"{len(self.fits)} hypotheses; {cause}; rms error {self.nominal.rms_error:.3g} % nominal, "
                 f"{self.corrected.rms_error:.3g} % corrected")
 
