@@ -86,13 +86,13 @@ def bias_table(etas=ETAS) -> list[dict]:
             meas = {"T": Measurement(plain.tests[0], modes, f, 1e-4 * f, "given")}
             for label, params in (("dsm_tension_EI", "tension,EI"), ("dsm_tension", "tension")):
                 r = identify(plain, params=params, picked=meas)
-                row[f"{label}_%"] = 100 * (r.values[0] / tension - 1)
+                row[f"{label}_%"] = 100 * (r.value("tension")[0] / tension - 1)
             row["string_mode1_%"] = 100 * (4 * m * length**2 * f[0] ** 2 / tension - 1)
             if truth is not None:  # the model with the damper returns the truth
                 with_damper = Campaign("bias", cable, (Setup("S", tuple(atts)),), (Test("T", "S", tension),))
                 meas = {"T": Measurement(with_damper.tests[0], modes, f, 1e-4 * f, "given")}
                 r = identify(with_damper, params="tension,EI", picked=meas)
-                row["with_damper_%"] = 100 * (r.values[0] / tension - 1)
+                row["with_damper_%"] = 100 * (r.value("tension")[0] / tension - 1)
             else:
                 row["with_damper_%"] = row["dsm_tension_EI_%"]
             rows.append(row)

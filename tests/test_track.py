@@ -50,7 +50,7 @@ def archive(tmp_path_factory):
 @pytest.fixture(scope="module")
 def tracked(archive):
     out = archive.parent / "out"
-    return track(archive, out, workers=2), out
+    return track(archive, out, workers=2).summary(), out
 
 
 @pytest.mark.slow
@@ -86,7 +86,7 @@ def test_a_dask_local_cluster_gives_the_same_rows(archive, tracked, tmp_path):
     distributed = pytest.importorskip("distributed")
     _, out = tracked
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        summary = track(archive, tmp_path / "dask", cables=["C2"], scheduler=cluster.scheduler_address, report=False)
+        summary = track(archive, tmp_path / "dask", cables=["C2"], scheduler=cluster.scheduler_address).summary()
     local = pd.read_parquet(out / "records.parquet")
     local = local[local["cable"] == "C2"].reset_index(drop=True)
     dask = pd.read_parquet(tmp_path / "dask" / "records.parquet")
@@ -107,10 +107,10 @@ def small(tmp_path):
 @pytest.mark.slow
 def test_a_run_killed_midway_and_restarted_ends_with_the_same_table(small, tmp_path):
     whole = tmp_path / "whole"
-    track(small, whole, report=False, batch=2, workers=2)  # the reference table (local processes give the same rows)
+    track(small, whole, batch=2, workers=2)  # the reference table (local processes give the same rows)
     out = tmp_path / "killed"
     command = [sys.executable, "-c", ("import sys; from stcs_ident.track.api import track; "
-               f"track({str(small)!r}, {str(out)!r}, batch=2, report=False)")]
+               f"track({str(small)!r}, {str(out)!r}, batch=2)")]
     child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     while child.poll() is None and len(list((out / "parts").glob("*.parquet"))) < 3:
         time.sleep(0.01)
@@ -118,7 +118,7 @@ def test_a_run_killed_midway_and_restarted_ends_with_the_same_table(small, tmp_p
     child.wait()
     finished = len(list((out / "parts").glob("*.parquet")))
     assert 0 < finished < 12  # killed midway: some batches done, not all
-    track(small, out, report=False, batch=2)
+    track(small, out, batch=2)
     a, b = pd.read_parquet(whole / "records.parquet"), pd.read_parquet(out / "records.parquet")
     pd.testing.assert_frame_equal(a.drop(columns=["mtime_ns"]), b.drop(columns=["mtime_ns"]))
     assert not [p for p in out.rglob("*") if ".stcs~" in p.name]  # the killed run's temporaries are gone
@@ -127,14 +127,14 @@ def test_a_run_killed_midway_and_restarted_ends_with_the_same_table(small, tmp_p
 def test_a_rerun_processes_only_new_records_known_by_content(small, tmp_path):
     out = tmp_path / "out"
     calls = []
-    track(small, out, report=False, workers=2, progress=lambda done, total: calls.append(total))
+    track(small, out, workers=2, progress=lambda done, total: calls.append(total))
     assert calls[-1] == 24
     records = small / "C1" / "records"
     day = next(records.iterdir())
     first = min(day.glob("*.h5"))
     shutil.copy(first, records / "renamed-copy.h5")  # the same content under another name: not new
     calls.clear()
-    summary = track(small, out, report=False, progress=lambda done, total: calls.append(total))
+    summary = track(small, out, progress=lambda done, total: calls.append(total)).summary()
     assert calls == [] and summary["cables"]["C1"]["records"] == 24
     (records / "renamed-copy.h5").unlink()
 
@@ -154,7 +154,7 @@ def test_unreadable_records_are_rows_with_their_reason_and_the_rest_go_on(small,
         h5.attrs["temperature"] = 3.0  # another content than the good record's
     with h5py.File(records / "no-time.h5", "r+") as h5:
         del h5.attrs["start_time"]
-    summary = track(small, tmp_path / "out", report=False)
+    summary = track(small, tmp_path / "out").summary()
     cable = summary["cables"]["C1"]
     assert cable["records"] == 28 and cable["processed"] == 24 and cable["failed"] == 4
     reasons = {f["record"]: f["reason"] for f in cable["failures"]}

@@ -49,8 +49,7 @@ def run(args: argparse.Namespace) -> int:
     from ..report.forward import to_json
 
     campaign, file, tests = prepare(args)
-    spectra = picked_spectra(campaign, tests, file)
-    picked = {r.name: r for r in spectra}
+    picked = {r.name: r for r in picked_spectra(campaign, tests, file)}
     try:
         result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,
                           tension_model=args.tension_model, all_hypotheses=args.all_hypotheses,
@@ -62,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out is not None:
         from ..report.diagnose import write_report
 
-        write_report(result, args.out, spectra=spectra)
+        write_report(result, args.out)
     if args.json != "-":
         from ..report.diagnose import diagnosis_text
 

@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from ..core.files import check_outputs
     from ..core.formatting import counted
     from ..report.forward import to_json
+    from ..report.track import write_report
     from ..track.api import default_out, track
     from ..track.archive import discover, record_paths
 
@@ -48,8 +49,10 @@ def run(args: argparse.Namespace) -> int:
     inputs = [os.path.join(s.directory, "campaign.toml") for s in specs]
     inputs += [str(p) for s in specs for p in record_paths(s)]
     check_outputs([("--out", out, True), ("--json", args.json, False)], inputs)
-    summary = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
-                    progress=True if sys.stderr.isatty() else _lines())
+    result = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
+                   progress=True if sys.stderr.isatty() else _lines())
+    write_report(result)
+    summary = result.summary()
     if args.json:
         write_output(args.json, to_json(summary))
     if args.json != "-":

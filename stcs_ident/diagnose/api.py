@@ -26,6 +26,7 @@ from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
 from ..identify.problem import Measurement, gather_measurements
+from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
     HypothesisFit,
@@ -172,7 +173,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     return Diagnosis(campaign=campaign, measurements=tuple(measurements), fits=fits, selection=selection,
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
                      elapsed=time.perf_counter() - started, considered=tuple(usable), settings=settings,
-                     comparison=comparison, test_cv=test_cv)
+                     comparison=comparison, test_cv=test_cv,
+                     spectra=tuple(p for p in given.values() if isinstance(p, TestSpectra)))
 
 
 def with_model_error(fit: HypothesisFit, measured: np.ndarray, sigma: np.ndarray) -> None:

@@ -1,4 +1,4 @@
-"""The diagnosis result: the data of the ``diagnose`` step and its JSON (``.summary()``).
+"""The diagnosis result: the data of the ``diagnose`` step, its JSON (``.summary()``) and tables (``.tables()``).
 
 The terminal summary and the report are made from it by
 :mod:`stcs_ident.report.diagnose`, which this module does not import.
@@ -10,16 +10,19 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 
 from .. import effects as registry
 from ..core.formatting import percent_error
 from ..core.model import Cable, Campaign
+from ..core.result import Result
 from ..core.settings import Settings
 from ..effects.base import Context
 from ..forward.compare import ForwardResult
 from ..identify.problem import Measurement
 from .fitting import HypothesisFit
 from .selection import Selection, baseline_fit, ranking
+from .tables import diagnosis_tables
 
 
 def _finite_or_none(v: float | None) -> float | None:
@@ -46,9 +49,13 @@ def effect_parameters(fit: HypothesisFit, cable: Cable, symmetric: bool) -> tupl
     return values, sigmas
 
 
-@dataclass(frozen=True)
-class Diagnosis:
+@dataclass(frozen=True, repr=False)
+class Diagnosis(Result):
     """What :func:`~stcs_ident.diagnose.diagnose` found.
+
+    ``tables()`` holds ``ranking`` (every hypothesis, best first: the main
+    table), ``frequencies``, ``gain``, ``nominal_comparison`` and ``cause``
+    (:mod:`stcs_ident.diagnose.tables`).
 
     Attributes
     ----------
@@ -78,6 +85,10 @@ class Diagnosis:
         Leave-one-test-out prediction error (%) of ``nominal``, ``baseline``
         and ``corrected`` (each test predicted by the model fitted to the
         others; empty with one test).
+    spectra : tuple of TestSpectra
+        The spectra the frequencies were picked from (the inputs given as
+        ``picked``; empty when every test's frequencies came from a table),
+        for the report's figures.
     """
 
     campaign: Campaign
@@ -93,6 +104,25 @@ class Diagnosis:
     settings: Settings = field(default_factory=Settings)
     comparison: ForwardResult | None = None
     test_cv: dict = field(default_factory=dict)
+    spectra: tuple = ()
+
+    main_table = "ranking"
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """The diagnosis's tables by name (:func:`~stcs_ident.diagnose.tables.diagnosis_tables`)."""
+        return diagnosis_tables(self)
+
+    def headline(self) -> str:
+        """Campaign, data, the named cause and the rms error of the nominal and the corrected model."""
+        sel = self.selection
+        if sel.effects:
+            cause = f"cause {' + '.join(sel.effects)} (principal {sel.principal})"
+        else:
+            cause = "no cause: the nominal model stands" if sel.explained else "no cause named"
+        n = len(self.measurements)
+        return (f"{self.campaign.name}, {n} test{'s' if n != 1 else ''}, {self.measured.size} frequencies, "
+                f"{len(self.fits)} hypotheses; {cause}; rms error {self.nominal.rms_error:.3g} % nominal, "
+                f"{self.corrected.rms_error:.3g} % corrected")
 
     @property
     def measured(self) -> np.ndarray:

@@ -19,6 +19,7 @@ from scipy.optimize import minimize_scalar
 
 from ..core.formatting import percent_error
 from ..core.model import Campaign, Test, has_dampers
+from ..core.result import Result
 from ..core.settings import Settings
 from . import batch_frequencies
 from . import reference as closed_form
@@ -106,20 +107,61 @@ class ReferenceCheck:
                        f"{self.rms_best:.3f} Hz), so it differs from this model in more than EI.")
 
 
-@dataclass(frozen=True)
-class ForwardResult:
+@dataclass(frozen=True, repr=False)
+class ForwardResult(Result):
     """Result of :func:`compare_forward`: one :class:`TestComparison` per test
     and one :class:`ReferenceCheck` per (reference column, setup), with the
-    :class:`~stcs_ident.core.settings.Settings` they were computed with."""
+    :class:`~stcs_ident.core.settings.Settings` they were computed with.
+
+    ``tables()`` holds ``frequencies`` (one row per test and mode, the main
+    table) and ``reference_checks``; ``notes`` is empty (the comparison has
+    nothing to remark beyond its checks).
+    """
 
     campaign: str
     settings: Settings
     tests: list[TestComparison]
     reference_checks: list[ReferenceCheck]
+    notes: tuple = ()
+
+    main_table = "frequencies"
 
     @property
     def tension_model(self) -> str:
         return self.settings.tension_model
+
+    def test(self, name: str) -> TestComparison:
+        """The comparison of the test called ``name``."""
+        for t in self.tests:
+            if t.name == name:
+                return t
+        raise KeyError(f"no test named {name!r} (known: {', '.join(t.name for t in self.tests)})")
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """``frequencies``: per test and mode, every model (Hz) and its error (%) where measured;
+        ``reference_checks``: one row per reference column and setup."""
+        frames = []
+        for t in self.tests:
+            frame = t.to_dataframe()
+            frame.insert(0, "test", t.name)
+            frames.append(frame)
+        frequencies = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame({"test": [], "mode": []})
+        checks = pd.DataFrame(
+            [{"label": c.label, "setup": c.setup, "tests": " ".join(c.tests), "reproduced": c.reproduced,
+              "step_Hz": c.step, "rms_nominal_Hz": c.rms_nominal, "max_nominal_Hz": c.max_nominal,
+              "worst_mode": c.worst_mode, "EI_nominal_Nm2": c.EI_nominal, "EI_best_Nm2": c.EI_best,
+              "rms_best_Hz": c.rms_best} for c in self.reference_checks],
+            columns=["label", "setup", "tests", "reproduced", "step_Hz", "rms_nominal_Hz", "max_nominal_Hz",
+                     "worst_mode", "EI_nominal_Nm2", "EI_best_Nm2", "rms_best_Hz"])
+        return {"frequencies": frequencies, "reference_checks": checks}
+
+    def headline(self) -> str:
+        """Campaign, tests, and the DSM's rms error against the measured frequencies."""
+        errors = [e for t in self.tests if t.measured is not None for e in t.error("dsm") if np.isfinite(e)]
+        rms = f"; DSM rms error {math.sqrt(np.mean(np.square(errors))):.3g} %" if errors else ""
+        modes = sum(len(t.modes) for t in self.tests)
+        return (f"{self.campaign}, {len(self.tests)} test{'s' if len(self.tests) != 1 else ''}, {modes} modes "
+                f"({self.tension_model} tension model){rms}")
 
     def summary(self) -> dict:
         """Plain data for JSON (the ``forward`` object, with ``reference`` and ``settings`` keys)."""

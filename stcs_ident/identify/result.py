@@ -19,9 +19,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..core.formatting import percent_error
+from ..core.formatting import PARAMETER_UNITS, percent_error
 from ..core.notes import Note
 from ..core.parameters import Parameter
+from ..core.result import Result
 from ..core.settings import Settings
 
 #: Reference columns shown beside the correction: labels containing this word.
@@ -92,9 +93,14 @@ class TestFit:
         return float(np.sqrt(np.mean(self.after_error**2)))
 
 
-@dataclass(frozen=True)
-class IdentificationResult:
+@dataclass(frozen=True, repr=False)
+class IdentificationResult(Result):
     """Identified parameters with uncertainties, and the fit to every test.
+
+    Parameters are looked up by name (:meth:`value`, :meth:`get`), never by
+    position. ``tables()`` holds ``parameters`` (:meth:`parameter_table`,
+    the main table a notebook shows) and ``frequencies`` (the paper's Table
+    9/10 form, :meth:`to_dataframe`).
 
     Attributes
     ----------
@@ -145,9 +151,64 @@ class IdentificationResult:
     sweep: object | None = field(default=None, repr=False)
     settings: Settings = field(default_factory=Settings)
 
+    main_table = "parameters"
+
     @property
     def names(self) -> list[str]:
         return [p.name for p in self.parameters]
+
+    def _index(self, name: str) -> int:
+        """Place of the parameter called ``name``: its display name (``tension_ratio[T1]``), its kind and
+        member (``tension[T1]``), or its kind alone when one parameter has it (``EI``, ``tension``)."""
+        for i, p in enumerate(self.parameters):
+            if name in (p.name, p.kind if p.member is None else f"{p.kind}[{p.member}]"):
+                return i
+        same = [i for i, p in enumerate(self.parameters) if p.kind == name]
+        if len(same) == 1:
+            return same[0]
+        known = ", ".join(self.names)
+        if same:
+            raise KeyError(f"{name!r} names {len(same)} parameters; give the member: {known}")
+        raise KeyError(f"no parameter {name!r} (identified: {known})")
+
+    def value(self, name: str) -> tuple[float, float]:
+        """(value, uncertainty) in SI units of the parameter called ``name`` (display name such as
+        ``tension_ratio[T1]``, ``tension[T1]``, or a kind that one parameter has: ``EI``, ``tension``).
+
+        Raises
+        ------
+        KeyError
+            When no parameter, or more than one, answers to ``name`` (the message lists the names).
+        """
+        i = self._index(name)
+        return float(self.values[i]), float(self.value_uncertainty[i])
+
+    def parameter_table(self) -> pd.DataFrame:
+        """One row per parameter: ``parameter`` (display name), ``kind``, ``member``, ``value`` and
+        ``uncertainty`` in SI units, ``unit``, ``nominal`` (SI), and the dimensionless ``variable`` the fit
+        works in (a ratio to nominal, mostly) with its ``variable_uncertainty``."""
+        rows = [{"parameter": p.name, "kind": p.kind, "member": p.member, "value": float(v),
+                 "uncertainty": float(vs), "unit": PARAMETER_UNITS[p.kind], "nominal": float(p.nominal),
+                 "variable": float(x), "variable_uncertainty": float(s)}
+                for p, x, s, v, vs in zip(self.parameters, self.estimate, self.uncertainty, self.values,
+                                          self.value_uncertainty)]
+        return pd.DataFrame(rows, columns=["parameter", "kind", "member", "value", "uncertainty", "unit", "nominal",
+                                           "variable", "variable_uncertainty"])
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """``parameters`` (:meth:`parameter_table`) and ``frequencies`` (:meth:`to_dataframe`)."""
+        return {"parameters": self.parameter_table(), "frequencies": self.to_dataframe()}
+
+    def headline(self) -> str:
+        """Method, the first parameters in SI units with their 1σ, and the rms error before and after."""
+        shown = [f"{p.kind if p.member is None else f'{p.kind}[{p.member}]'} = {v:.4g} ± {vs:.2g} "
+                 f"{PARAMETER_UNITS[p.kind]}"
+                 for p, v, vs in zip(self.parameters, self.values, self.value_uncertainty)]
+        more = f", … ({len(shown)} parameters)" if len(shown) > 3 else ""
+        n = sum(len(t.modes) for t in self.tests)
+        return (f"{self.method}, {', '.join(shown[:3])}{more}; rms error {self.rms_before:.3g} % → "
+                f"{self.rms_after:.3g} % over {n} frequencies of {len(self.tests)} "
+                f"test{'s' if len(self.tests) != 1 else ''}")
 
     @property
     def reduced_chi2(self) -> float:

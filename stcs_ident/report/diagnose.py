@@ -254,9 +254,11 @@ def _notes_section(d) -> list[str]:
     return out + ([""] if notes else [])
 
 
-def report_markdown(diagnosis, tables: dict, figures: dict, spectra=()) -> str:
-    """``report.md`` from the tables (``report_tables``) and the figure file names."""
+def report_markdown(diagnosis, tables: dict, figures: dict, spectra=None) -> str:
+    """``report.md`` from the tables (``report_tables``) and the figure file names (``spectra``: default
+    the spectra the diagnosis carries)."""
     d = diagnosis
+    spectra = d.spectra if spectra is None else spectra
     lines = [f"# Diagnosis of {d.campaign.name}", "",
              (f"{counted(len(d.measurements), 'test')}, "
               f"{counted(d.measured.size, 'measured frequency', 'measured frequencies')}, "
@@ -279,7 +281,7 @@ def report_markdown(diagnosis, tables: dict, figures: dict, spectra=()) -> str:
     return "\n".join(lines)
 
 
-def write_report(diagnosis, out_dir, spectra=()) -> Path:
+def write_report(diagnosis, out_dir, spectra=None) -> Path:
     """Write the diagnosis report into ``out_dir``, whole or not at all.
 
     ``out_dir`` gets ``report.md`` (tables, figures and the named cause in
@@ -295,7 +297,8 @@ def write_report(diagnosis, out_dir, spectra=()) -> Path:
     diagnosis : Diagnosis
     out_dir : path-like
     spectra : sequence of TestSpectra, optional
-        The spectra the frequencies were picked from (one figure each).
+        The spectra the frequencies were picked from (one figure each);
+        default those the diagnosis carries (``diagnosis.spectra``).
 
     Returns
     -------
@@ -318,6 +321,7 @@ def write_report(diagnosis, out_dir, spectra=()) -> Path:
         raise InputError("is a non-empty directory without report.md: not a report, not replaced", field="out_dir",
                          file=str(out))
     d = diagnosis
+    spectra = d.spectra if spectra is None else spectra
     tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
               "nominal_comparison": nominal_comparison(d), "cause": cause_table(d)}
     with whole_directory(out) as tmp:

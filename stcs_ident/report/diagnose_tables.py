@@ -1,146 +1,20 @@
-"""The tables of a diagnosis report, as pandas DataFrames (→ CSV and Markdown).
-
-Every number of the report comes from these tables: the ranking of the
-hypotheses, the frequencies per test and mode, the gain, the named cause's
-parameters and the nominal comparison (taut string, pinned beam, DSM).
-"""
+"""The tables of a diagnosis report: made by :mod:`stcs_ident.diagnose.tables` (data), named here as files."""
 
 from __future__ import annotations
 
-import math
+from ..diagnose.tables import (
+    UNITS,
+    cause_table,
+    effects_label,
+    frequency_table,
+    gain_table,
+    nominal_comparison,
+    parameter_rows,
+    ranking_table,
+)
 
-import numpy as np
-import pandas as pd
+__all__ = ["CSV_FILES", "UNITS", "cause_table", "effects_label", "frequency_table", "gain_table",
+           "nominal_comparison", "parameter_rows", "ranking_table"]
 
-from ..core.formatting import percent_error
-
-#: Units of the effect parameters (the keys of ``Diagnosis.parameters``).
-UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",
-         "mass": "kg", "position": "m", "stiffness": "N/m", "coefficient": "N s/m"}
 #: Files of the report, besides the figures.
 CSV_FILES = ("ranking.csv", "frequencies.csv", "gain.csv", "nominal_comparison.csv", "cause.csv")
-
-
-def effects_label(effects) -> str:
-    """``a + b`` for a hypothesis's effects, ``nominal`` for none."""
-    return " + ".join(effects) if effects else "nominal"
-
-
-def parameter_rows(values: dict, sigmas: dict) -> list[dict]:
-    """One row per parameter of ``Diagnosis.parameters(fit)``: effect, parameter, value, uncertainty, unit.
-
-    A parameter with one value per member (a test's tension ratio, an
-    attachment's position) is named ``kind[member]``; a clamped end's
-    rotational stiffness is ``inf``.
-    """
-    rows = []
-    for effect, entries in values.items():
-        for key, value in entries.items():
-            unit = UNITS.get(key.split("_A")[0].split("_B")[0], "-")
-            sig = sigmas.get(effect, {}).get(key)
-            if isinstance(value, dict):
-                for member, v in value.items():
-                    s = (sig or {}).get(member)
-                    rows.append({"effect": effect, "parameter": f"{key}[{member}]", "value": float(v),
-                                 "uncertainty": math.nan if s is None else float(s), "unit": unit})
-            else:
-                v = math.inf if value == "inf" else (math.nan if value is None else float(value))
-                rows.append({"effect": effect, "parameter": key, "value": v,
-                             "uncertainty": math.nan if sig is None else float(sig), "unit": unit})
-    return rows
-
-
-def _short(rows: list[dict]) -> str:
-    """Key parameter values in one cell: ``EI = 1.05e+05 N m^2; ratio[T1] = 0.981``."""
-    parts = []
-    for r in rows:
-        unit = "" if r["unit"] == "-" else f" {r['unit']}"
-        parts.append(f"{r['parameter']} = {r['value']:.4g}{unit}")
-    return "; ".join(parts)
-
-
-def _reduced_chi2(fit, n: int) -> float:
-    dof = n - fit.n_parameters
-    return fit.chi2 / dof if dof > 0 else math.nan
-
-
-def ranking_table(diagnosis) -> pd.DataFrame:
-    """Every hypothesis, best AICc first: effects, k, χ², reduced χ², AICc, ΔAICc, rms and CV rms (%)."""
-    d = diagnosis
-    n = d.measured.size
-    ranked = d.ranked
-    best = ranked[0].aicc
-    rows = []
-    for rank, f in enumerate(ranked, start=1):
-        rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters, "chi2": f.chi2,
-                     "reduced_chi2": _reduced_chi2(f, n), "prior_penalty": f.penalty, "epsilon": f.epsilon,
-                     "aicc": f.aicc, "delta_aicc": f.aicc - best,
-                     "rms_error_%": f.rms_error,
-                     "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
-                     "cause": f.effects == d.selection.fitted,
-                     "parameters": f"failed: {f.failure}" if f.failure else _short(parameter_rows(*d.parameters(f))),
-                     "seconds": d.timings.get(f.effects, math.nan)})
-    return pd.DataFrame(rows)
-
-
-def frequency_table(diagnosis) -> pd.DataFrame:
-    """Per test and mode: measured (with uncertainty), nominal, baseline, corrected (Hz) and errors (%)."""
-    d = diagnosis
-    models = {"nominal": d.nominal, "baseline": d.baseline, "corrected": d.corrected}
-    split = {key: (d.per_test(fit) if fit is not None else None) for key, fit in models.items()}
-    frames = []
-    for i, m in enumerate(d.measurements):
-        data = {"test": m.name, "setup": m.test.setup, "mode": m.modes, "measured_Hz": m.frequencies,
-                "uncertainty_Hz": m.uncertainty}
-        for key, values in split.items():
-            data[f"{key}_Hz"] = values[i] if values is not None else np.full(m.modes.size, np.nan)
-        for key in models:
-            data[f"{key}_error_%"] = percent_error(data[f"{key}_Hz"], m.frequencies)
-        data["source"] = m.source
-        frames.append(pd.DataFrame(data))
-    return pd.concat(frames, ignore_index=True)
-
-
-def gain_table(diagnosis) -> pd.DataFrame:
-    """rms error (%) in-sample and cross-validated of the nominal, baseline and corrected models."""
-    d = diagnosis
-    n = d.measured.size
-    rows = []
-    for key, fit in (("nominal", d.nominal), ("baseline", d.baseline), ("corrected", d.corrected)):
-        if fit is None:
-            continue
-        rows.append({"model": key, "effects": effects_label(fit.effects), "k": fit.n_parameters, "chi2": fit.chi2,
-                     "reduced_chi2": _reduced_chi2(fit, n), "aicc": fit.aicc, "rms_error_%": fit.rms_error,
-                     "cv_rms_error_%": math.nan if fit.cv_rms_error is None else fit.cv_rms_error,
-                     "test_cv_rms_error_%": d.test_cv.get(key, math.nan)})
-    return pd.DataFrame(rows)
-
-
-def cause_table(diagnosis) -> pd.DataFrame:
-    """The parameters of the chosen hypothesis, each marked ``cause`` or ``correction`` (within the tolerance
-    of its nominal value); no rows when the nominal model stands."""
-    d = diagnosis
-    rows = parameter_rows(*d.parameters(d.corrected)) if d.selection.fitted else []
-    for row in rows:
-        row["role"] = "correction" if row["effect"] in d.selection.corrections else "cause"
-    return pd.DataFrame(rows, columns=["effect", "role", "parameter", "value", "uncertainty", "unit"])
-
-
-def nominal_comparison(diagnosis) -> pd.DataFrame:
-    """The diagnosis's nominal comparison (``diagnosis.comparison``: taut string, pinned beam, DSM against
-    measured), one row per test and mode.
-
-    Raises
-    ------
-    ValueError
-        When the diagnosis carries no comparison (one not made by
-        :func:`~stcs_ident.diagnose.diagnose`).
-    """
-    if diagnosis.comparison is None:
-        raise ValueError("the diagnosis carries no nominal comparison (made by diagnose())")
-    frames = []
-    for t in diagnosis.comparison.tests:
-        frame = t.to_dataframe()
-        frame.insert(0, "test", t.name)
-        frames.append(frame)
-    return pd.concat(frames, ignore_index=True)

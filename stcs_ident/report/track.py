@@ -21,21 +21,26 @@ from ..core.files import write_atomic, write_csv, write_figure
 __all__ = ["records_csv_table", "write_report"]
 
 
-def write_report(out: Path, specs, table: pd.DataFrame, histories, summary: dict) -> None:
-    cables = pd.DataFrame([
-        {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
-         "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
-         "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"], "events": len(c["events"])}
-        for name, c in summary["cables"].items()])
-    events = pd.DataFrame([{"cable": name, **e} for name, c in summary["cables"].items() for e in c["events"]],
-                          columns=["cable", "start_time", "change", "uncertainty", "alarm_time"])
-    write_csv(records_csv_table(table), out / "records.csv", index=False)
+def write_report(result, out: str | Path | None = None) -> Path:
+    """Write the report of a :class:`~stcs_ident.track.result.TrackResult` into ``out`` (default the run's
+    output directory, ``result.out``): the tables as CSV, one figure per cable and ``report.md``.
+
+    Returns
+    -------
+    Path
+        The directory written.
+    """
+    out = Path(result.out if out is None else out)
+    tables = result.tables()
+    cables, events = tables["cables"], tables["events"]
+    write_csv(records_csv_table(result.table), out / "records.csv", index=False)
     write_csv(cables, out / "cables.csv", index=False)
     write_csv(events, out / "events.csv", index=False)
-    for spec in specs:
-        rows, history = histories[spec.name]
-        write_figure(_figure(spec, table, rows, history), out / f"{spec.name}.png")
-    write_atomic(out / "report.md", _markdown(summary, cables, events))
+    for spec in result.specs:
+        rows, history = result.histories[spec.name]
+        write_figure(_figure(spec, result.table, rows, history), out / f"{spec.name}.png")
+    write_atomic(out / "report.md", _markdown(result.summary(), cables, events))
+    return out
 
 
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..core.result import Result
+
 __all__ = ["Peak", "PeakResult"]
 
 
@@ -48,9 +50,11 @@ class Peak:
     channel_snr_db: np.ndarray = field(repr=False)
 
 
-@dataclass(frozen=True)
-class PeakResult:
+@dataclass(frozen=True, repr=False)
+class PeakResult(Result):
     """Result of :func:`find_peaks`.
+
+    ``tables()`` holds ``peaks`` (the main table, :meth:`to_dataframe`).
 
     Parameters
     ----------
@@ -88,6 +92,30 @@ class PeakResult:
     channel_floor: np.ndarray
     channel_names: tuple[str, ...]
     threshold: np.ndarray
+
+    main_table = "peaks"
+
+    @property
+    def settings(self) -> None:
+        """None: the peak picking records no settings yet."""
+        return None
+
+    @property
+    def notes(self) -> tuple:
+        """``()``: the peak picking has no notes yet."""
+        return ()
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """``peaks``: one row per peak (:meth:`to_dataframe`)."""
+        return {"peaks": self.to_dataframe()}
+
+    def headline(self) -> str:
+        """How many peaks, in which band, from which kind of record."""
+        if not self.peaks:
+            return f"no peak ({self.kind} record, {len(self.channel_names)} channels)"
+        low, high = self.peaks[0].frequency, self.peaks[-1].frequency
+        return (f"{len(self.peaks)} peaks from {low:.4g} to {high:.4g} Hz ({self.kind} record, "
+                f"{len(self.channel_names)} channels)")
 
     def to_dataframe(self) -> pd.DataFrame:
         """One row per peak: frequency, uncertainty, damping, its 1σ, SNR, channels, amplitude per channel."""

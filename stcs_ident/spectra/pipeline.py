@@ -17,6 +17,7 @@ import pandas as pd
 
 from ..core.model import Campaign, Test
 from ..core.record import Record
+from ..core.result import Result
 from ..forward import natural_frequencies
 from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
@@ -28,9 +29,13 @@ from .peaks import PeakResult, find_peaks
 DEFAULT_MAX_MODES = 30
 
 
-@dataclass(frozen=True)
-class TestSpectra:
+@dataclass(frozen=True, repr=False)
+class TestSpectra(Result):
     """Numbered modal frequencies picked from one test's record.
+
+    ``tables()`` holds ``modes`` (the numbered modes, the main table:
+    :meth:`to_dataframe`) and ``peaks`` (every peak found, numbered or not:
+    :meth:`PeakResult.to_dataframe`).
 
     Attributes
     ----------
@@ -60,6 +65,29 @@ class TestSpectra:
     numbering: Numbering
     damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
 
+    main_table = "modes"
+
+    @property
+    def settings(self) -> None:
+        """None: the peak picking records no settings yet."""
+        return None
+
+    @property
+    def notes(self) -> tuple:
+        """``()``: the peak picking has no notes yet."""
+        return ()
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """``modes`` (one row per numbered mode) and ``peaks`` (one row per peak found)."""
+        return {"modes": self.to_dataframe(), "peaks": self.peaks.to_dataframe()}
+
+    def headline(self) -> str:
+        """Test, modes numbered, peaks left unnumbered, channels dropped."""
+        modes = f" ({_ranges(self.modes)})" if self.modes else ""
+        extra = f", {len(self.unassigned)} peaks unnumbered" if self.unassigned else ""
+        extra += f", {len(self.dropped)} channels dropped" if self.dropped else ""
+        return f"{self.name}: {len(self.modes)} modes picked{modes} from an {self.peaks.kind} record{extra}"
+
     def to_dataframe(self) -> pd.DataFrame:
         return pd.DataFrame({
             "mode": self.modes, "frequency_Hz": self.frequencies, "uncertainty_Hz": self.uncertainty,
@@ -77,6 +105,18 @@ class TestSpectra:
             "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
         }
+
+
+def _ranges(modes) -> str:
+    """``1-6, 8`` for the modes 1, 2, 3, 4, 5, 6, 8."""
+    parts, start = [], None
+    for k, m in enumerate(modes):
+        if start is None:
+            start = m
+        if k + 1 == len(modes) or modes[k + 1] != m + 1:
+            parts.append(str(m) if m == start else f"{start}-{m}")
+            start = None
+    return ", ".join(parts)
 
 
 def record_path(campaign: Campaign, test: Test) -> str:

@@ -11,13 +11,13 @@
    what it finished.
 3. Per cable, the history of the records that gave a tension: normalised for
    temperature and its lasting changes found (:mod:`.events`).
-4. The table (``records.parquet``), the events, the report (:mod:`.report`)
-   and the summary (the interface's JSON).
+4. The table (``records.parquet``) and a :class:`~.result.TrackResult`
+   (the summary of the interface's JSON, the tables); the report is drawn
+   from it by :func:`stcs_ident.report.track.write_report`.
 """
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 from collections.abc import Callable, Iterable
@@ -27,9 +27,11 @@ import numpy as np
 import pandas as pd
 
 from ..core.errors import InputError
+from ..core.files import remove_stale
 from .archive import CableSpec, content_id, discover, record_paths
 from .events import analyse_history
 from .process import process_record
+from .result import TrackResult
 from .store import append_part, processed_table, write_table
 
 __all__ = ["BATCH", "default_out", "track"]
@@ -54,8 +56,8 @@ def process_batch(spec: CableSpec, items: list[tuple[str, str, int, int]]) -> li
 
 
 def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, cables: list[str] | None = None,
-          workers: int = 1, scheduler: str | None = None, batch: int = BATCH, progress: bool | Callable = False,
-          report: bool = True) -> dict:
+          workers: int = 1, scheduler: str | None = None, batch: int = BATCH,
+          progress: bool | Callable = False) -> TrackResult:
     """Process an archive's new records and analyse every cable's history (see the module docstring).
 
     Parameters
@@ -75,19 +77,16 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
         Records per task.
     progress : bool or callable(done, total)
         True: a progress bar with ETA on standard error (tqdm).
-    report : bool
-        Write the report's figures and tables.
 
     Returns
     -------
-    dict
-        The summary (the ``track`` JSON of the interface).
+    TrackResult
+        The records table, each cable's history and events; ``.summary()`` is the ``track`` JSON of the
+        interface. :func:`stcs_ident.report.track.write_report` writes the report from it.
     """
     specs = discover(archive, cables)
     out = Path(out) if out is not None else default_out(archive)
     out.mkdir(parents=True, exist_ok=True)
-    from ..core.files import remove_stale
-
     remove_stale(out / "parts")  # what a killed run left, even if this one has nothing new to write there
     known = processed_table(out)
     pending = _pending(specs, known)
@@ -96,12 +95,7 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     table = processed_table(out)
     table, histories = _histories(specs, table)
     write_table(out, table)
-    summary = _summary(archive, specs, table, histories)
-    if report:
-        from ..report.track import write_report
-
-        write_report(out, specs, table, histories, summary)
-    return summary
+    return TrackResult(str(archive), out, tuple(specs), table, histories)
 
 
 def _pending(specs: list[CableSpec], known: pd.DataFrame) -> list[tuple[CableSpec, list]]:
@@ -238,23 +232,3 @@ def _histories(specs: list[CableSpec], table: pd.DataFrame):
         histories[spec.name] = (rows, history)
     return table, histories
 
-
-def _summary(archive, specs, table: pd.DataFrame, histories) -> dict:
-    cables = {}
-    for spec in specs:
-        mine = table[table["cable"] == spec.name]
-        rows, history = histories[spec.name]
-        times = table.loc[rows, "start_time"].to_numpy()
-        cables[spec.name] = {
-            "records": len(mine), "processed": int((mine["status"] == "ok").sum()),
-            "failed": int((mine["status"] != "ok").sum()),
-            "reference_tension": spec.reference_tension, "EI": spec.campaign.cable.EI,
-            "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
-            "scatter": None if math.isnan(history.scatter) else history.scatter,
-            "events": [{"start_time": pd.Timestamp(times[e.index]).isoformat(),
-                        "change": e.change, "uncertainty": e.uncertainty,
-                        "alarm_time": pd.Timestamp(times[e.alarm]).isoformat()} for e in history.events],
-            "failures": [{"record": r, "reason": why} for r, why in
-                         zip(mine.loc[mine["status"] != "ok", "record"], mine.loc[mine["status"] != "ok", "reason"])],
-        }
-    return {"archive": str(archive), "cables": cables}

@@ -61,8 +61,8 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
                    frequencies=[float(f) for f in spectra.frequencies],
                    frequency_sigma=[float(s) for s in spectra.uncertainty])
         result = identify(campaign, [test.name], "tension", picked={test.name: spectra})
-        row.update(tension=float(result.values[0]), tension_sigma=float(result.value_uncertainty[0]),
-                   status="ok")
+        tension, sigma = result.value("tension")
+        row.update(tension=tension, tension_sigma=sigma, status="ok")
     except (InputError, ComputationError, FloatingPointError) as err:
         row["reason"] = one_line(str(err))
     except Exception as err:  # noqa: BLE001 (one record never stops an archive: its row says what happened)
