@@ -359,8 +359,12 @@ def test_track_writes_its_records_as_csv_beside_the_parquet_table(tmp_path, caps
 
 
 def test_diagnose_workers_caps_the_processes(tmp_path, capsys, monkeypatch):
-    import stcs_ident.diagnose
+    import importlib
+
     from stcs_ident.core.errors import ComputationError
+
+    # The subpackage, where the command takes the step from (``stcs_ident.diagnose`` is the face's function).
+    package = importlib.import_module("stcs_ident.diagnose")
 
     given = {}
 
@@ -368,7 +372,7 @@ def test_diagnose_workers_caps_the_processes(tmp_path, capsys, monkeypatch):
         given.update(options)
         raise ComputationError("stopped here")
 
-    monkeypatch.setattr(stcs_ident.diagnose, "diagnose", stop)
+    monkeypatch.setattr(package, "diagnose", stop)
     code, _, err = run(["diagnose", _write(tmp_path, GOOD), "--workers", "1"], capsys)
     assert code == 1 and "stopped here" in err and given["workers"] == 1
     code, _, err = run(["diagnose", tmp_path, "--workers", "0"], capsys)

@@ -220,12 +220,12 @@ def test_track_globs_and_reads_a_registered_format(tmp_path, npz):
                                options=ArchiveOptions(days=2 / 24, interval=3600, duration=30.0), seed=5)
     (spec,) = discover(archive)
     first, second = record_paths(spec)
-    before = track(archive, tmp_path / "out-h5", report=False)
+    before = track(archive, tmp_path / "out-h5").summary()
     toy = second.with_suffix(".npz")
     _write_npz(read_record(second), toy)
     shutil.move(second, tmp_path / "put-aside.h5")
     assert record_paths(spec) == [first, toy]
-    after = track(archive, tmp_path / "out-npz", report=False)
+    after = track(archive, tmp_path / "out-npz").summary()
     assert after["cables"]["C1"]["processed"] == before["cables"]["C1"]["processed"] == 2
     from stcs_ident.track.store import processed_table
 
