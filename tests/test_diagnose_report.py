@@ -14,9 +14,9 @@ from stcs_ident.core.errors import InputError
 from stcs_ident.core.files import umask
 from stcs_ident.core.model import Cable, Campaign, Setup, Test
 from stcs_ident.diagnose import diagnose
-from stcs_ident.diagnose import figures as diagnosis_figures
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.io.campaign import load_campaign
+from stcs_ident.report import diagnose_figures as diagnosis_figures
 from stcs_ident.report.diagnose import CSV_FILES, write_report
 
 ROOT = Path(__file__).resolve().parents[1]

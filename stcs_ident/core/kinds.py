@@ -86,8 +86,9 @@ class Kind:
         whose member names the keyword (``end_a``, ``end_b``).
     attribute : str
         Field of the :class:`~stcs_ident.core.model.Test`,
-        :class:`~stcs_ident.core.model.Cable` or
-        :class:`~stcs_ident.core.model.Attachment` that holds the nominal
+        :class:`~stcs_ident.core.model.Cable`,
+        :class:`~stcs_ident.core.model.Attachment` or (for an end)
+        :class:`~stcs_ident.core.model.Boundary` that holds the nominal
         value; default the name. An attachment without that field does not
         have the kind (only a damper has a ``coefficient``).
     bounds : (float, float)
@@ -287,7 +288,8 @@ for _kind in (
     Kind("coefficient", "N s/m", "c", "attachment", "coefficients", bounds=(0.01, 100.0), grid=(0.5, 1.5),
          zero_upper=coefficient_upper, tolerance=Tolerance("coefficient", 0.2), aliases=("damper",),
          amplitude=True, noun="damper"),
-    Kind("end_stiffness", "N m/rad", "k", "end", None, bounds=(0.0, 1.0), grid=(0.0, 1.0), variable="fixity",
+    Kind("end_stiffness", "N m/rad", "k", "end", None, attribute="rotational_stiffness", bounds=(0.0, 1.0),
+         grid=(0.0, 1.0), variable="fixity",
          aliases=("rotational_stiffness",), amplitude=True, noted_in_si=False),
 ):
     register(_kind)
