@@ -78,6 +78,7 @@ from scipy import optimize
 from scipy.stats import chi2 as chi2_distribution
 
 from .. import effects
+from ..core import kinds
 from .fitting import HypothesisFit, prior_widths
 
 #: False-alarm probability of the test "the nominal model explains the data".
@@ -264,7 +265,7 @@ def insignificant(fit: HypothesisFit) -> tuple[str, ...]:
     shown: dict[str, bool] = {}
     for p, owner, x, sigma, width in zip(res.parameters, fit.hypothesis.owners, res.estimate, res.uncertainty,
                                          widths):
-        if width is not None or not p.spec.amplitude:
+        if width is not None or not kinds.get(p.kind).amplitude:
             continue
         at_bound = float(x) >= float(p.upper) * (1 - 1e-6)
         sized = at_bound or (math.isfinite(sigma) and sigma > 0 and abs(float(x) - p.start) > BEYOND * sigma)
