@@ -41,11 +41,11 @@ from .errors import InputError
 from .kinds import coefficient_upper
 from .model import Campaign, Test
 
-__all__ = ["Parameter", "coefficient_upper", "fixity", "overrides_for", "parse_name", "parse_parameters",
-           "stiffness_of_fixity"]
+__all__ = ["POSITION_MARGIN", "Parameter", "coefficient_upper", "fixity", "overrides_for", "parse_name",
+           "parse_parameters", "stiffness_of_fixity"]
 
 #: Positions stay this fraction of the length away from the anchorages.
-_POSITION_MARGIN = 1e-3
+POSITION_MARGIN = 1e-3
 
 _NAME = re.compile(r"^\s*([A-Za-z_]+?)(?:_ratio)?\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
 
@@ -324,7 +324,7 @@ def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], spec: kind
     for s, i, a, label in chosen:
         nominal = getattr(a, spec.attribute)
         if kind == "position":
-            lo, hi = _POSITION_MARGIN * cable.length / nominal, (1 - _POSITION_MARGIN) * cable.length / nominal
+            lo, hi = POSITION_MARGIN * cable.length / nominal, (1 - POSITION_MARGIN) * cable.length / nominal
             out.append(Parameter(kind, label, nominal, nominal, lo, hi, setup=s, index=i))
             continue
         if nominal > 0:
@@ -352,8 +352,8 @@ def _with_bounds(p: Parameter, bounds: Mapping[str, tuple[float, float]], length
     if not lo <= p.start <= hi:
         raise InputError(f"bounds [{lo:g}, {hi:g}] exclude the nominal value {p.start:g}", field=field)
     if p.kind == "position":
-        lo = max(lo, _POSITION_MARGIN * length / p.nominal)
-        hi = min(hi, (1 - _POSITION_MARGIN) * length / p.nominal)
+        lo = max(lo, POSITION_MARGIN * length / p.nominal)
+        hi = min(hi, (1 - POSITION_MARGIN) * length / p.nominal)
     elif p.spec.zero_upper is None and not p.is_fixity:  # always a ratio
         if lo <= 0:
             raise InputError(f"the lower bound must be > 0, got {lo:g}", field=field)

@@ -43,10 +43,7 @@ from ..core.errors import InputError, ModelError
 from ..core.formatting import plus_minus as pm  # the effects' words use the reports' ± format
 from ..core.kinds import Tolerance
 from ..core.model import Attachment, Cable, Campaign, Test
-from ..core.parameters import Parameter, parse_parameters
-
-#: Positions stay this fraction of the length away from the anchorages (as in identify).
-POSITION_MARGIN = 1e-3
+from ..core.parameters import POSITION_MARGIN, Parameter, parse_parameters
 
 
 @dataclass(frozen=True)
