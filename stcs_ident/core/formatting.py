@@ -17,9 +17,6 @@ import numpy as np
 MISSING = "-"
 #: Table styles of :func:`table_lines`.
 STYLES = ("text", "markdown")
-#: SI unit of each parameter kind (``Parameter.kind``), as tables write it.
-PARAMETER_UNITS = {"tension": "N", "EI": "N m^2", "length": "m", "mass_per_length": "kg/m", "position": "m",
-                   "mass": "kg", "stiffness": "N/m", "coefficient": "N s/m", "end_stiffness": "N m/rad"}
 
 
 def percent_error(computed, measured):

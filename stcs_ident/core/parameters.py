@@ -1,7 +1,9 @@
 """Uncertain model parameters: what can be corrected, and how it enters the model.
 
 One :class:`Parameter` is one free number of an identification. It knows
-its kind (tension, EI, attachment position, ...), what it belongs to (a test
+its kind (tension, EI, attachment position, ...: a :class:`~stcs_ident.core.kinds.Kind`
+of the registry :mod:`stcs_ident.core.kinds`, which holds each kind's unit,
+bounds and override), what it belongs to (a test
 for a tension, an attachment for a position, an end for a rotational
 stiffness), its nominal value, the dimensionless *variable* the optimiser
 and the contour grids work in, and how a value of that variable becomes an
@@ -10,8 +12,8 @@ override of :func:`stcs_ident.forward.batch_frequencies`.
 The variable is the ratio to the nominal value (H̃/H, ẼI/EI, l̃_k/l_k), as
 in the source paper, except
 
-- an attachment mass or spring whose nominal value is zero: the variable is
-  then the value itself in kg or N/m;
+- an attachment's mass, spring or dashpot whose nominal value is zero: the
+  variable is then the value itself in the kind's unit (kg, N/m, N s/m);
 - an end's rotational stiffness k: the variable is the *fixity*
   φ = k / (k + √(EI·H)), 0 for a pinned end and 1 for a clamped one. √(EI·H)
   is the stiffness at which the end's boundary layer (length √(EI/H)) is
@@ -20,7 +22,9 @@ in the source paper, except
 :func:`parse_parameters` turns names such as ``"tension,EI"``,
 ``"position[W1]"`` or ``"end_stiffness[A]"`` into parameters for the
 selected tests; the diagnosis step reuses it with the effect vocabulary of
-``docs/effects.md`` (``bending_stiffness``, ``attachment_position``, ...).
+``docs/effects.md`` (``bending_stiffness``, ``attachment_position``, ...),
+whose names the effects register as aliases of their kinds when
+:mod:`stcs_ident.effects` is imported (:mod:`stcs_ident.identify` imports it).
 """
 
 from __future__ import annotations
@@ -32,54 +36,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kinds
 from .errors import InputError
-from .model import Campaign, Damper, Test
+from .kinds import coefficient_upper
+from .model import Campaign, Test
 
-#: Kinds of parameter, what they belong to and the override they change.
-KINDS = {
-    "tension": ("test", "tension"),
-    "EI": (None, "EI"),
-    "length": (None, "length"),
-    "mass_per_length": (None, "mass_per_length"),
-    "position": ("attachment", "positions"),
-    "mass": ("attachment", "masses"),
-    "stiffness": ("attachment", "stiffnesses"),
-    "coefficient": ("attachment", "coefficients"),
-    "end_stiffness": ("end", None),
-}
-
-#: Other names accepted for a kind (besides the names of the effects that free one kind, see
-#: :func:`aliases`).
-ALIASES = {
-    "ei": "EI",
-    "attachment_stiffness": "stiffness",
-    "damper": "coefficient",
-    "rotational_stiffness": "end_stiffness",
-}
-
-
-def aliases() -> dict[str, str]:
-    """Every other name of a kind: :data:`ALIASES` and the name of each registered effect that frees
-    one kind of parameter (``bending_stiffness`` → ``EI``)."""
-    from .. import effects  # the effects build on this module: imported when first needed
-
-    named = {e.name: e.parameter_kind for e in effects.effects() if e.parameter_kind and e.name != e.parameter_kind}
-    return {**named, **ALIASES}
-
-#: Default bounds of the variable (ratio unless stated in the module docstring).
-DEFAULT_BOUNDS = {
-    "tension": (0.5, 2.0),
-    "EI": (0.01, 100.0),
-    "length": (0.8, 1.2),
-    "mass_per_length": (0.5, 2.0),
-    "mass": (0.0, 10.0),
-    "stiffness": (0.0, 100.0),
-    "coefficient": (0.01, 100.0),
-    "end_stiffness": (0.0, 1.0),
-}
+__all__ = ["POSITION_MARGIN", "Parameter", "coefficient_upper", "fixity", "overrides_for", "parse_name",
+           "parse_parameters", "stiffness_of_fixity"]
 
 #: Positions stay this fraction of the length away from the anchorages.
-_POSITION_MARGIN = 1e-3
+POSITION_MARGIN = 1e-3
 
 _NAME = re.compile(r"^\s*([A-Za-z_]+?)(?:_ratio)?\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
 
@@ -91,7 +57,7 @@ class Parameter:
     Attributes
     ----------
     kind : str
-        One of :data:`KINDS`.
+        The name of a registered kind (:mod:`stcs_ident.core.kinds`).
     member : str or None
         The test (tension), the attachment (``"W1"``, or ``"case2:W1"`` when
         two setups of the selected tests have an attachment of that name),
@@ -135,6 +101,21 @@ class Parameter:
         return self.index if setup == self.setup else None
 
     @property
+    def spec(self) -> kinds.Kind:
+        """The parameter's kind (:class:`~stcs_ident.core.kinds.Kind`): its unit, bounds, override, ..."""
+        return kinds.get(self.kind)
+
+    @property
+    def unit(self) -> str:
+        """SI unit of the parameter's value."""
+        return kinds.get(self.kind).unit
+
+    @property
+    def is_fixity(self) -> bool:
+        """True when the variable is an end's fixity rather than a ratio or a value."""
+        return kinds.get(self.kind).variable == "fixity"
+
+    @property
     def name(self) -> str:
         """Display name: ``EI_ratio``, ``tension_ratio[case1-L4]``, ``end_fixity[A]``."""
         return self.key if self.member is None else f"{self.key}[{self.member}]"
@@ -142,31 +123,35 @@ class Parameter:
     @property
     def key(self) -> str:
         """JSON key of the variable (``tension_ratio``, ``mass`` for a zero-nominal mass, ...)."""
-        if self.kind == "end_stiffness":
+        if self.is_fixity:
             return "end_fixity"
         return f"{self.kind}_ratio" if self.is_ratio else self.kind
 
     @property
     def is_ratio(self) -> bool:
         """True when the variable is the ratio to the nominal value."""
-        return self.kind != "end_stiffness" and self.scale == self.nominal
+        return not self.is_fixity and self.scale == self.nominal
 
     @property
     def start(self) -> float:
         """The variable at the nominal value."""
-        if self.kind == "end_stiffness":
-            return fixity(self.nominal, self.reference_stiffness)
-        return self.nominal / self.scale
+        return self.to_variable(self.nominal)
+
+    def to_variable(self, value):
+        """The variable at the SI value ``value``: the inverse of :meth:`to_value`."""
+        if self.is_fixity:
+            return fixity(value, self.reference_stiffness)
+        return value / self.scale
 
     def to_value(self, variable):
         """SI value(s) of the variable (array-friendly)."""
-        if self.kind == "end_stiffness":
+        if self.is_fixity:
             return stiffness_of_fixity(variable, self.reference_stiffness)
         return np.asarray(variable, float) * self.scale
 
     def value_uncertainty(self, variable: float, sigma: float) -> float:
         """Standard deviation in SI units, to first order (inf where the map is singular)."""
-        if self.kind != "end_stiffness":
+        if not self.is_fixity:
             return abs(sigma * self.scale)
         if variable >= 1.0:
             return math.inf
@@ -174,9 +159,10 @@ class Parameter:
 
     def applies_to(self, test: Test) -> bool:
         """Whether the parameter changes the model of ``test``."""
-        if self.kind == "tension":
+        belongs_to = kinds.get(self.kind).belongs_to
+        if belongs_to == "test":
             return self.member == test.name
-        if KINDS[self.kind][0] == "attachment":
+        if belongs_to == "attachment":
             return self.slot(test.setup) is not None
         return True
 
@@ -198,7 +184,7 @@ def stiffness_of_fixity(phi, reference: float):
 
 
 def _known_names() -> str:
-    return ", ".join([*KINDS, *aliases()])
+    return ", ".join([*kinds.names(), *kinds.aliases()])
 
 
 def _split(spec: str | Iterable[str]) -> list[str]:
@@ -217,13 +203,7 @@ def _split(spec: str | Iterable[str]) -> list[str]:
 def parse_name(name: str) -> tuple[str, str | None]:
     """``"position[W1]"`` → ``("position", "W1")``; aliases resolved, unknown names refused."""
     match = _NAME.match(name)
-    kind = None
-    if match:
-        word = match.group(1)
-        known = aliases()
-        kind = word if word in KINDS else known.get(word, known.get(word.lower()))
-        if kind is None and word.lower() in {k.lower() for k in KINDS}:
-            kind = next(k for k in KINDS if k.lower() == word.lower())
+    kind = kinds.resolve(match.group(1)) if match else None
     if kind is None:
         raise InputError(f"unknown parameter {name.strip()!r}; known: {_known_names()}", field="params")
     return kind, (match.group(2) or None)
@@ -243,15 +223,16 @@ def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iter
         Comma-separated names: ``tension``, ``EI``, ``length``,
         ``mass_per_length``, ``position``, ``mass``, ``stiffness``,
         ``end_stiffness`` (one fixity for both ends; ``end_stiffness[A]``,
-        ``end_stiffness[B]`` for one end each), or an alias from the effect
+        ``end_stiffness[B]`` for one end each), any other registered kind
+        (:func:`stcs_ident.core.kinds.register`), or an alias from the effect
         vocabulary (``bending_stiffness``, ``attachment_position``,
         ``attachment_mass``, ``end_restraint``). A member in brackets
         restricts a per-test or per-attachment kind: ``tension[case1-L4]``,
         ``position[W1]``, ``position[case2:W1]``. A ``_ratio`` suffix is
         accepted (``EI_ratio``).
     bounds : mapping, optional
-        ``{name: (lower, upper)}`` in variable units (ratios; kg or N/m for a
-        zero-nominal mass or spring; fixity in [0, 1]), keyed by a kind
+        ``{name: (lower, upper)}`` in variable units (ratios; the kind's unit
+        for a zero-nominal mass, spring or dashpot; fixity in [0, 1]), keyed by a kind
         (``"EI"``, ``"position"``) or a display name
         (``"position_ratio[W1]"``, ``"position[W1]"``).
 
@@ -277,52 +258,55 @@ def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iter
     for n in names:
         if names.count(n) > 1:
             raise InputError(f"parameter {n} is named twice", field="params")
-    ends = {p.member for p in params if p.kind == "end_stiffness"}
-    if "AB" in ends and len(ends) > 1:
-        raise InputError("end_stiffness for both ends and for one end at once", field="params")
+    for kind in dict.fromkeys(p.kind for p in params if p.spec.belongs_to == "end"):
+        ends = {p.member for p in params if p.kind == kind}
+        if "AB" in ends and len(ends) > 1:
+            raise InputError(f"{kind} for both ends and for one end at once", field="params")
     return tuple(_with_bounds(p, bounds or {}, cable.length) for p in params)
 
 
 def _expand(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
             k_ref: float) -> list[Parameter]:
     cable = campaign.cable
-    lo, hi = DEFAULT_BOUNDS.get(kind, (0.0, 1.0))
-    if kind == "tension":
+    spec = kinds.get(kind)
+    lo, hi = spec.bounds
+    if spec.belongs_to == "test":
         chosen = [t for t in tests if member is None or t.name == member]
         if not chosen:
             known = ", ".join(t.name for t in tests)
             raise InputError(f"{name}: no selected test named {member!r} (selected: {known})", field="params")
-        return [Parameter("tension", t.name, t.tension, t.tension, lo, hi) for t in chosen]
-    if kind in ("EI", "length", "mass_per_length"):
+        return [Parameter(kind, t.name, getattr(t, spec.attribute), getattr(t, spec.attribute), lo, hi)
+                for t in chosen]
+    if spec.belongs_to == "cable":
         if member is not None:
             raise InputError(f"{name}: {kind} is a cable property and takes no [member]", field="params")
-        nominal = float(getattr(cable, kind))
+        nominal = float(getattr(cable, spec.attribute))
         if nominal <= 0:
             raise InputError(f"{name}: the nominal {kind} is 0, so it has no ratio", field="params")
         return [Parameter(kind, None, nominal, nominal, lo, hi)]
-    if kind == "end_stiffness":
+    if spec.belongs_to == "end":
         ends = {"A": cable.boundary_a, "B": cable.boundary_b}
         if member is None:
             if cable.boundary_a != cable.boundary_b:
-                return [Parameter(kind, e, b.rotational_stiffness, 1.0, lo, hi, reference_stiffness=k_ref)
+                return [Parameter(kind, e, getattr(b, spec.attribute), 1.0, lo, hi, reference_stiffness=k_ref)
                         for e, b in ends.items()]
-            return [Parameter(kind, "AB", cable.boundary_a.rotational_stiffness, 1.0, lo, hi,
+            return [Parameter(kind, "AB", getattr(cable.boundary_a, spec.attribute), 1.0, lo, hi,
                               reference_stiffness=k_ref)]
         end = member.upper()
         if end not in ends:
             raise InputError(f"{name}: the end must be A or B, got {member!r}", field="params")
-        return [Parameter(kind, end, ends[end].rotational_stiffness, 1.0, lo, hi, reference_stiffness=k_ref)]
-    return _attachment_parameters(campaign, tests, kind, member, name, (lo, hi))
+        return [Parameter(kind, end, getattr(ends[end], spec.attribute), 1.0, lo, hi, reference_stiffness=k_ref)]
+    return _attachment_parameters(campaign, tests, spec, member, name)
 
 
-def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
-                           default: tuple[float, float]) -> list[Parameter]:
+def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], spec: kinds.Kind, member: str | None,
+                           name: str) -> list[Parameter]:
+    kind = spec.name
     setups = list(dict.fromkeys(t.setup for t in tests))
     found = [(s, i, a) for s in setups for i, a in enumerate(campaign.setup(s).attachments)
-             if kind != "coefficient" or isinstance(a, Damper)]
+             if hasattr(a, spec.attribute)]
     if not found:
-        noun = "damper" if kind == "coefficient" else "attachment"
-        raise InputError(f"{name}: the setups of the selected tests have no {noun}", field="params")
+        raise InputError(f"{name}: the setups of the selected tests have no {spec.noun}", field="params")
     counts: dict[str, int] = {}
     for _, _, a in found:
         counts[a.name] = counts.get(a.name, 0) + 1
@@ -338,33 +322,19 @@ def _attachment_parameters(campaign: Campaign, tests: Sequence[Test], kind: str,
     out = []
     cable = campaign.cable
     for s, i, a, label in chosen:
-        nominal = getattr(a, kind)
+        nominal = getattr(a, spec.attribute)
         if kind == "position":
-            lo, hi = _POSITION_MARGIN * cable.length / nominal, (1 - _POSITION_MARGIN) * cable.length / nominal
+            lo, hi = POSITION_MARGIN * cable.length / nominal, (1 - POSITION_MARGIN) * cable.length / nominal
             out.append(Parameter(kind, label, nominal, nominal, lo, hi, setup=s, index=i))
             continue
         if nominal > 0:
-            out.append(Parameter(kind, label, nominal, nominal, *default, setup=s, index=i))
+            out.append(Parameter(kind, label, nominal, nominal, *spec.bounds, setup=s, index=i))
             continue
+        if spec.zero_upper is None:
+            raise InputError(f"{name}: the nominal {kind} of {label} is 0, so it has no ratio", field="params")
         # Zero nominal: the variable is the value itself, bounded by the cable's own scale.
-        if kind == "coefficient":
-            upper = coefficient_upper(campaign)
-        elif kind == "mass":
-            upper = cable.mass_per_length * cable.length
-        else:
-            upper = 100.0 * _mean_tension(campaign) / cable.length
-        out.append(Parameter(kind, label, 0.0, 1.0, 0.0, upper, setup=s, index=i))
+        out.append(Parameter(kind, label, 0.0, 1.0, 0.0, spec.zero_upper(campaign), setup=s, index=i))
     return out
-
-
-def coefficient_upper(campaign: Campaign) -> float:
-    """Largest dashpot worth a search (N s/m): 1000 √(H m), thirty times the optimum of mode 1 for a
-    damper at 1 % of the length (η = c π x_d/(l √(H m)) = 1)."""
-    return 1e3 * math.sqrt(_mean_tension(campaign) * campaign.cable.mass_per_length)
-
-
-def _mean_tension(campaign: Campaign) -> float:
-    return float(np.mean([t.tension for t in campaign.tests])) if campaign.tests else 1.0
 
 
 def _with_bounds(p: Parameter, bounds: Mapping[str, tuple[float, float]], length: float) -> Parameter:
@@ -382,14 +352,14 @@ def _with_bounds(p: Parameter, bounds: Mapping[str, tuple[float, float]], length
     if not lo <= p.start <= hi:
         raise InputError(f"bounds [{lo:g}, {hi:g}] exclude the nominal value {p.start:g}", field=field)
     if p.kind == "position":
-        lo = max(lo, _POSITION_MARGIN * length / p.nominal)
-        hi = min(hi, (1 - _POSITION_MARGIN) * length / p.nominal)
-    elif p.kind in ("EI", "tension", "length", "mass_per_length"):
+        lo = max(lo, POSITION_MARGIN * length / p.nominal)
+        hi = min(hi, (1 - POSITION_MARGIN) * length / p.nominal)
+    elif p.spec.zero_upper is None and not p.is_fixity:  # always a ratio
         if lo <= 0:
             raise InputError(f"the lower bound must be > 0, got {lo:g}", field=field)
     elif lo < 0:
         raise InputError(f"the lower bound must be >= 0, got {lo:g}", field=field)
-    if p.kind == "end_stiffness" and hi > 1:
+    if p.is_fixity and hi > 1:
         raise InputError(f"the fixity lies in [0, 1], got upper bound {hi:g}", field=field)
     return Parameter(p.kind, p.member, p.nominal, p.scale, lo, hi, p.setup, p.index, p.reference_stiffness,
                      p.slots)
@@ -408,12 +378,13 @@ def overrides_for(test: Test, parameters: Sequence[Parameter], X: np.ndarray, n_
         if not p.applies_to(test):
             continue
         column = X[:, j]
-        slot = KINDS[p.kind][1]
-        if p.kind == "end_stiffness":
+        spec = p.spec
+        slot = spec.override
+        if spec.belongs_to == "end":
             value = p.to_value(column)
             for end in ("end_a", "end_b") if p.member == "AB" else ("end_a" if p.member == "A" else "end_b",):
                 out[end] = np.broadcast_to(value, (k,)).astype(float)
-        elif KINDS[p.kind][0] == "attachment":
+        elif spec.belongs_to == "attachment":
             if slot not in out:
                 out[slot] = np.tile(nominal_attachments[slot], (k, 1))
             out[slot][:, p.slot(test.setup)] = p.to_value(column)

@@ -28,10 +28,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .. import effects as registry
-from ..core.formatting import PARAMETER_UNITS
 from ..core.model import Attachment, Campaign, Test
 from ..core.notes import Assignment, Note
-from ..core.parameters import fixity, parse_parameters
+from ..core.parameters import parse_parameters
 from ..forward import batch_frequencies
 from ..identify.lsq import fit_lsq, local_fit
 from ..identify.problem import Measurement, Problem
@@ -291,22 +290,18 @@ def quietly(fn, notes: list[Note]):
     return out
 
 
-#: Units of the SI values of the parameter kinds a note may name (tension and end fixity stay ratios).
-_UNITS = {kind: unit for kind, unit in PARAMETER_UNITS.items() if kind not in ("tension", "end_stiffness")}
-
-
 def in_si_units(note: Note, parameters: Sequence) -> Note:
     """``note`` with every assignment of a variable of ``parameters`` in its points given in SI units
     (``position_ratio[W1] = 1.02`` → ``position[W1] = 10.05 m``); ratios of tension and the end
     fixity stay as they are."""
-    by_name = {p.name: p for p in parameters if p.kind in _UNITS}
+    by_name = {p.name: p for p in parameters if p.spec.noted_in_si}
 
     def convert(a: Assignment) -> Assignment:
         p = by_name.get(a.parameter)
         if p is None or a.unit:
             return a
         label = p.kind if p.member is None else f"{p.kind}[{p.member}]"
-        return Assignment(label, float(p.to_value(a.value)), _UNITS[p.kind])
+        return Assignment(label, float(p.to_value(a.value)), p.unit)
 
     if not note.points:
         return note
@@ -320,7 +315,7 @@ def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None
     """
     start = problem.start.copy()
     for j, p in enumerate(problem.parameters):
-        if p.slots and p.kind in ("mass", "stiffness", "coefficient"):
+        if p.slots and p.spec.amplitude:
             start[j] = 0.01 * problem.upper[j]
     rows = [start] if nominal or not seeds else []
     for seed in seeds:
@@ -329,10 +324,7 @@ def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None
             v = seed.get((p.kind, p.member))
             if v is None:
                 continue
-            if p.kind == "end_stiffness":
-                x[j] = fixity(v, p.reference_stiffness)
-            else:
-                x[j] = v / p.scale
+            x[j] = p.to_variable(v)
         rows.append(np.clip(x, problem.lower, problem.upper))
     return np.unique(np.array(rows), axis=0)
 

@@ -78,6 +78,7 @@ from scipy import optimize
 from scipy.stats import chi2 as chi2_distribution
 
 from .. import effects
+from ..core import kinds
 from .fitting import HypothesisFit, prior_widths
 
 #: False-alarm probability of the test "the nominal model explains the data".
@@ -248,13 +249,10 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
                      implausible, model_error)
 
 
-#: Parameter kinds that give an effect without a tolerance its size.
-AMPLITUDES = ("mass", "stiffness", "coefficient", "end_stiffness")
-
-
 def insignificant(fit: HypothesisFit) -> tuple[str, ...]:
     """Effects of ``fit`` without a tolerance (an unmodeled mass or support, an end restraint) whose size the
-    data do not establish: no amplitude departs from its nominal value by more than :data:`BEYOND` σ (an
+    data do not establish: no amplitude (a parameter of a kind with ``amplitude`` set, :mod:`stcs_ident.core.kinds`)
+    departs from its nominal value by more than :data:`BEYOND` σ (an
     amplitude pushed to its bound counts as established). Such a hypothesis is never chosen (step 2).
 
     A support of 452 N/m found at mid-span of a 4 MN stay, its stiffness and position without a finite σ,
@@ -267,7 +265,7 @@ def insignificant(fit: HypothesisFit) -> tuple[str, ...]:
     shown: dict[str, bool] = {}
     for p, owner, x, sigma, width in zip(res.parameters, fit.hypothesis.owners, res.estimate, res.uncertainty,
                                          widths):
-        if width is not None or p.kind not in AMPLITUDES:
+        if width is not None or not kinds.get(p.kind).amplitude:
             continue
         at_bound = float(x) >= float(p.upper) * (1 - 1e-6)
         sized = at_bound or (math.isfinite(sigma) and sigma > 0 and abs(float(x) - p.start) > BEYOND * sigma)

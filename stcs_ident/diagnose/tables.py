@@ -13,11 +13,10 @@ import math
 import numpy as np
 import pandas as pd
 
+from .. import effects as registry
+from ..core import kinds
 from ..core.formatting import percent_error
 
-#: Units of the effect parameters (the keys of ``Diagnosis.parameters``).
-UNITS = {"ratio": "-", "EI": "N m^2", "length": "m", "rotational_stiffness": "N m/rad", "fixity": "-",
-         "mass": "kg", "position": "m", "stiffness": "N/m", "coefficient": "N s/m"}
 #: The tables of :func:`diagnosis_tables`, in order (each a CSV file of the report).
 TABLES = ("ranking", "frequencies", "gain", "nominal_comparison", "cause")
 
@@ -37,7 +36,7 @@ def parameter_rows(values: dict, sigmas: dict) -> list[dict]:
     rows = []
     for effect, entries in values.items():
         for key, value in entries.items():
-            unit = UNITS.get(key.split("_A")[0].split("_B")[0], "-")
+            unit = _unit(effect, key.split("_A")[0].split("_B")[0])
             sig = sigmas.get(effect, {}).get(key)
             if isinstance(value, dict):
                 for member, v in value.items():
@@ -49,6 +48,14 @@ def parameter_rows(values: dict, sigmas: dict) -> list[dict]:
                 rows.append({"effect": effect, "parameter": key, "value": v,
                              "uncertainty": math.nan if sig is None else float(sig), "unit": unit})
     return rows
+
+
+def _unit(effect: str, key: str) -> str:
+    """Unit of the quantity ``key`` of ``effect`` as the effect declares it (else that of the parameter kind
+    ``key`` names); ``-`` for a ratio or a key of no known unit."""
+    declared = {q.key: q.unit for q in registry.get(effect).quantities} if effect in registry.names() else {}
+    unit = declared.get(key, kinds.unit(key))
+    return unit or "-"
 
 
 def _short(rows: list[dict]) -> str:

@@ -7,14 +7,13 @@ attachment, shared by the tests of its setup.
 
 from __future__ import annotations
 
-from .base import Option, Quantity, RecordedAttachment, Tolerance, pm
+from .base import Option, Quantity, RecordedAttachment, pm
 
 
 class AttachmentMass(RecordedAttachment):
     name = "attachment_mass"
     meaning = "an attachment's mass differs from recorded"
-    quantities = (Quantity("mass", "kg", per="attachment"),)
-    tolerance = Tolerance("mass", 0.02)
+    quantities = (Quantity("mass", per="attachment"),)
     parameter_kind = "mass"
     attribute = "mass"
     truth_key = "attachment_masses"

@@ -8,14 +8,13 @@ its setup.
 
 from __future__ import annotations
 
-from .base import Option, Quantity, RecordedAttachment, Tolerance, pm
+from .base import Option, Quantity, RecordedAttachment, pm
 
 
 class AttachmentPosition(RecordedAttachment):
     name = "attachment_position"
     meaning = "an attachment is elsewhere than recorded"
-    quantities = (Quantity("position", "m", per="attachment"),)
-    tolerance = Tolerance("position", 0.02, relative=False, unit="m")
+    quantities = (Quantity("position", per="attachment"),)
     parameter_kind = "position"
     attribute = "position"
     positive = True

@@ -15,8 +15,8 @@ An effect declares
   test, per attachment or one for the cable);
 - how it frees parameters of the identification (:meth:`Effect.free_parameters`:
   by default the :mod:`stcs_ident.core.parameters` kind ``parameter_kind``);
-- the default ``tolerance`` of the nominal value it changes (how well a
-  user usually knows it), or None;
+- through its kind, the ``tolerance`` of the nominal value it changes (how
+  well a user usually knows it; :class:`stcs_ident.core.kinds.Kind`), or None;
 - how it changes the true model of the simulator (:meth:`Effect.check_truth`,
   :meth:`Effect.apply_truth`, keyword ``truth_key`` of
   :class:`stcs_ident.simulate.effects.Effects`) and the ``simulate`` option
@@ -38,13 +38,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..core import kinds
 from ..core.errors import InputError, ModelError
 from ..core.formatting import plus_minus as pm  # the effects' words use the reports' ± format
+from ..core.kinds import Tolerance
 from ..core.model import Attachment, Cable, Campaign, Test
-from ..core.parameters import Parameter, parse_parameters
-
-#: Positions stay this fraction of the length away from the anchorages (as in identify).
-POSITION_MARGIN = 1e-3
+from ..core.parameters import POSITION_MARGIN, Parameter, parse_parameters
 
 
 @dataclass(frozen=True)
@@ -55,37 +54,23 @@ class Quantity:
     ----------
     key : str
         Its key in the diagnosis JSON (``"ratio"``, ``"EI"``, ``"position"``).
-    unit : str
-        SI unit (``""`` for a ratio).
+    unit : str, optional
+        SI unit (``""`` for a ratio); by default that of the parameter kind
+        the key names (:func:`stcs_ident.core.kinds.unit`).
     per : {"test", "attachment", None}
         One value per test, per recorded attachment, or one value.
     """
 
     key: str
-    unit: str
+    unit: str | None = None
     per: str | None = None
 
-
-@dataclass(frozen=True)
-class Tolerance:
-    """How well the nominal value an effect changes is usually known.
-
-    Attributes
-    ----------
-    key : str
-        Key of the campaign's ``[tolerance]`` table.
-    default : float
-        Used when the campaign gives none.
-    relative : bool
-        Relative (a fraction of the nominal value) or absolute (SI units).
-    unit : str
-        Unit of an absolute tolerance.
-    """
-
-    key: str
-    default: float
-    relative: bool = True
-    unit: str = ""
+    def __post_init__(self):
+        if self.unit is None:
+            unit = kinds.unit(self.key)
+            if unit is None:
+                raise ValueError(f"quantity {self.key!r} names no parameter kind: give its unit")
+            object.__setattr__(self, "unit", unit)
 
 
 @dataclass(frozen=True)
@@ -137,11 +122,9 @@ class Effect:
     quantities: ClassVar[tuple[Quantity, ...]] = ()
     #: How the parameters are shared ("one per test", "all tests", ...).
     shared_by: ClassVar[str] = "all tests"
-    #: Default tolerance of the nominal value the effect changes (None: nothing nominal to change).
-    tolerance: ClassVar[Tolerance | None] = None
     #: Part of the source paper's correction (tension and EI re-estimated), the gain's baseline.
     baseline: ClassVar[bool] = False
-    #: Kind of identification parameter it frees (:data:`stcs_ident.core.parameters.KINDS`).
+    #: Kind of identification parameter it frees (a name of :mod:`stcs_ident.core.kinds`).
     parameter_kind: ClassVar[str | None] = None
     #: True for an attachment the nominal model lacks (position scanned by the diagnosis).
     unmodeled: ClassVar[bool] = False
@@ -155,6 +138,12 @@ class Effect:
 
     def __repr__(self) -> str:
         return f"<effect {self.name}>"
+
+    @property
+    def tolerance(self) -> Tolerance | None:
+        """Default tolerance of the nominal value the effect changes: that of its parameter kind (None:
+        no kind, or nothing nominal the campaign can state a tolerance of)."""
+        return kinds.get(self.parameter_kind).tolerance if self.parameter_kind else None
 
     # ---- identification and diagnosis --------------------------------------------------------
 
@@ -231,11 +220,15 @@ class UnmodeledAttachment(Effect):
     shared_by = "all tests (one attachment added to every measured setup)"
     #: Name of the added attachment.
     attachment_name: ClassVar[str] = ""
-    #: ``"mass"`` or ``"stiffness"``: the amplitude's parameter kind and Attachment field.
+    #: The amplitude's parameter kind and Attachment field (``"mass"``, ``"stiffness"``, ``"coefficient"``).
     amount_kind: ClassVar[str] = "mass"
-    #: Words for the thing (``"mass"``, ``"support"``) and the amplitude's unit.
+    #: Words for the thing (``"mass"``, ``"support"``).
     noun: ClassVar[str] = ""
-    amount_unit: ClassVar[str] = ""
+
+    @property
+    def amount_unit(self) -> str:
+        """The amplitude's SI unit: that of its parameter kind."""
+        return kinds.get(self.amount_kind).unit
 
     def amount_upper(self, campaign: Campaign, tests: Sequence[Test]) -> float:
         """Upper bound of the amplitude (SI)."""

@@ -10,14 +10,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from .base import Effect, Option, Quantity, Tolerance, pm, positive_ratio, scaled
+from .base import Effect, Option, Quantity, pm, positive_ratio, scaled
 
 
 class BendingStiffness(Effect):
     name = "bending_stiffness"
     meaning = "the effective bending stiffness EI differs from nominal"
-    quantities = (Quantity("EI", "N m^2"),)
-    tolerance = Tolerance("EI", 0.3)
+    quantities = (Quantity("EI"),)
     baseline = True
     parameter_kind = "EI"
     truth_key = "EI_ratio"

@@ -13,19 +13,19 @@ from __future__ import annotations
 
 import math
 
+from ..core.errors import ModelError
+from ..core.kinds import coefficient_upper
 from ..core.model import Damper
-from ..core.parameters import coefficient_upper
 from .base import Option, Quantity, UnmodeledAttachment
 
 
 class UnmodeledDamper(UnmodeledAttachment):
     name = "damper"
     meaning = "a damper the model lacks"
-    quantities = (Quantity("coefficient", "N s/m"), Quantity("position", "m"))
+    quantities = (Quantity("coefficient"), Quantity("position"))
     attachment_name = "(unmodeled damper)"
     amount_kind = "coefficient"
     noun = "damper"
-    amount_unit = "N s/m"
     truth_key = "extra_damper"
     option = Option("--extra-damper", "NS/M@X", "an unmodelled viscous damper at X m")
     opt_in = True
@@ -43,8 +43,6 @@ class UnmodeledDamper(UnmodeledAttachment):
     def check_truth(self, value, field):
         checked = super().check_truth(value, field)
         if checked is not None and not (checked[0] > 0 and math.isfinite(checked[0])):
-            from ..core.errors import ModelError
-
             raise ModelError(f"needs a dashpot > 0, got {value!r}", field=field)
         return checked
 

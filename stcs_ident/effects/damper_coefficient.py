@@ -11,14 +11,13 @@ from __future__ import annotations
 
 from ..core.errors import ModelError
 from ..core.model import Damper
-from .base import Option, Quantity, RecordedAttachment, Tolerance, pm
+from .base import Option, Quantity, RecordedAttachment, pm
 
 
 class DamperCoefficient(RecordedAttachment):
     name = "damper_coefficient"
     meaning = "a recorded damper's coefficient differs (a leaking damper)"
-    quantities = (Quantity("coefficient", "N s/m", per="attachment"),)
-    tolerance = Tolerance("coefficient", 0.2)
+    quantities = (Quantity("coefficient", per="attachment"),)
     parameter_kind = "coefficient"
     attribute = "coefficient"
     positive = True

@@ -19,7 +19,7 @@ from .base import Effect, Option, Quantity, number, pm
 class EndRestraint(Effect):
     name = "end_restraint"
     meaning = "anchorages are not fully clamped (or not free to rotate)"
-    quantities = (Quantity("rotational_stiffness", "N m/rad"), Quantity("fixity", ""))
+    quantities = (Quantity("rotational_stiffness"), Quantity("fixity", ""))
     parameter_kind = "end_stiffness"
     truth_key = "end_stiffness"
     option = Option("--end-stiffness", "KA,KB", "rotational end stiffness, N m/rad ('inf' clamped)")

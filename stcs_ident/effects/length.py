@@ -9,14 +9,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from .base import Effect, Option, Quantity, Tolerance, pm, positive_ratio
+from .base import Effect, Option, Quantity, pm, positive_ratio
 
 
 class Length(Effect):
     name = "length"
     meaning = "the effective vibrating length differs"
-    quantities = (Quantity("length", "m"),)
-    tolerance = Tolerance("length", 0.002)
+    quantities = (Quantity("length"),)
     parameter_kind = "length"
     truth_key = "length_ratio"
     option = Option("--length-ratio", "R", "true vibrating length / chord length")

@@ -5,12 +5,19 @@ imported, in the order of the vocabulary; :func:`register` adds another
 (a user's or a test's own effect) at the end. Everything that loops over
 effects (hypotheses, simulator, report, command line) reads
 :func:`effects` or :func:`get`.
+
+Registering an effect that frees a parameter kind under another name
+(``bending_stiffness`` frees ``EI``) adds its name as an alias of the kind
+in :mod:`stcs_ident.core.kinds`, so that identification accepts it; the
+campaign's ``[tolerance]`` keys are the kinds' (an effect's tolerance is its
+kind's). The kinds never import the effects.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
+from ..core import kinds
 from ..core.errors import InputError
 from .base import Effect
 
@@ -23,7 +30,9 @@ def register(effect: Effect) -> Effect:
     Raises
     ------
     ValueError
-        For an effect without a name, or a name or ``truth_key`` already taken.
+        For an effect without a name, a name or ``truth_key`` already taken, an unknown
+        ``parameter_kind`` (register the kind first), a name that another kind answers to, or a
+        tolerance whose key is no kind's.
     """
     if not isinstance(effect, Effect) or not effect.name:
         raise ValueError(f"an effect must be an Effect instance with a name, got {effect!r}")
@@ -31,13 +40,25 @@ def register(effect: Effect) -> Effect:
         raise ValueError(f"an effect named {effect.name!r} is already registered")
     if effect.truth_key and any(e.truth_key == effect.truth_key for e in _REGISTRY.values()):
         raise ValueError(f"the simulator keyword {effect.truth_key!r} is already taken")
+    kind = effect.parameter_kind
+    if kind is not None and kind not in kinds.names():
+        raise ValueError(f"effect {effect.name!r} frees the unknown parameter kind {kind!r}; known: "
+                         f"{', '.join(kinds.names())}")
+    declared = effect.tolerance
+    if declared is not None and declared.key not in kinds.tolerance_keys():
+        raise ValueError(f"effect {effect.name!r} declares the tolerance key {declared.key!r}, which no "
+                         f"parameter kind has (a tolerance belongs to a kind: core.kinds.Kind.tolerance)")
+    if kind is not None and effect.name != kind:
+        kinds.add_alias(effect.name, kind)
     _REGISTRY[effect.name] = effect
     return effect
 
 
 def unregister(name: str) -> None:
-    """Remove an effect (a test's own effect, when the test is done)."""
-    _REGISTRY.pop(name, None)
+    """Remove an effect (a test's own effect, when the test is done) and the alias it added."""
+    effect = _REGISTRY.pop(name, None)
+    if effect is not None and effect.parameter_kind is not None and effect.name != effect.parameter_kind:
+        kinds.remove_alias(effect.name)
 
 
 def effects() -> tuple[Effect, ...]:
@@ -75,8 +96,9 @@ def baseline() -> tuple[str, ...]:
 
 
 def tolerance_keys() -> tuple[str, ...]:
-    """The keys of a campaign's ``[tolerance]`` table: those the registered effects declare."""
-    return tuple(dict.fromkeys(e.tolerance.key for e in _REGISTRY.values() if e.tolerance is not None))
+    """The keys of a campaign's ``[tolerance]`` table: those of the parameter kinds
+    (:func:`stcs_ident.core.kinds.tolerance_keys`), every effect's among them."""
+    return kinds.tolerance_keys()
 
 
 def tolerance(campaign, effect: str) -> float | None:

@@ -7,7 +7,7 @@ frequency measurement, each good to a few per cent; it is one ratio
 
 from __future__ import annotations
 
-from .base import Effect, Option, Quantity, Tolerance, pm, positive_ratio
+from .base import Effect, Option, Quantity, pm, positive_ratio
 
 
 class Tension(Effect):
@@ -15,7 +15,6 @@ class Tension(Effect):
     meaning = "the true tension differs from the measured value"
     quantities = (Quantity("ratio", "", per="test"),)
     shared_by = "one per test"
-    tolerance = Tolerance("tension", 0.02)
     baseline = True
     parameter_kind = "tension"
     truth_key = "tension_ratio"

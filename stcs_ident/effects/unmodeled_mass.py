@@ -12,11 +12,10 @@ from .base import Option, Quantity, UnmodeledAttachment
 class UnmodeledMass(UnmodeledAttachment):
     name = "unmodeled_mass"
     meaning = "a point mass the model lacks"
-    quantities = (Quantity("mass", "kg"), Quantity("position", "m"))
+    quantities = (Quantity("mass"), Quantity("position"))
     attachment_name = "(unmodeled mass)"
     amount_kind = "mass"
     noun = "mass"
-    amount_unit = "kg"
     truth_key = "extra_mass"
     option = Option("--extra-mass", "KG@X", "an unmodelled point mass at X m")
 

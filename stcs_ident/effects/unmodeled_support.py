@@ -13,11 +13,10 @@ from .base import Option, Quantity, UnmodeledAttachment, mean_tension
 class UnmodeledSupport(UnmodeledAttachment):
     name = "unmodeled_support"
     meaning = "a transverse spring the model lacks"
-    quantities = (Quantity("stiffness", "N/m"), Quantity("position", "m"))
+    quantities = (Quantity("stiffness"), Quantity("position"))
     attachment_name = "(unmodeled support)"
     amount_kind = "stiffness"
     noun = "support"
-    amount_unit = "N/m"
     truth_key = "extra_spring"
     option = Option("--extra-spring", "K@X", "an unmodelled transverse spring (N/m) at X m")
 

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 
+# Imported for its registrations: the effects' names (bending_stiffness, ...) become aliases of their
+# parameter kinds, which parse_parameters accepts.
+from .. import effects  # noqa: F401
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..core.notes import Note

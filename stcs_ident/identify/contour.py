@@ -43,12 +43,6 @@ from .uncertainty import covariance_scale
 SCALED_BANDS = ("the misfit is {misfit:.3g} times the stated frequency uncertainties (reduced chi2 {value:.3g}, "
                 "{dof} degrees of freedom): the contour bands are widened by its square root")
 
-#: Grid ranges by kind (variable units), clipped to the bounds.
-DEFAULT_RANGES = {
-    "tension": (0.9, 1.1), "EI": (0.5, 1.5), "length": (0.97, 1.03), "mass_per_length": (0.9, 1.1),
-    "position": (0.9, 1.1), "mass": (0.5, 1.5), "stiffness": (0.5, 1.5), "coefficient": (0.5, 1.5),
-    "end_stiffness": (0.0, 1.0),
-}
 #: Points per side of the finer grid laid over a small region.
 ZOOM_POINTS = 101
 #: A region fewer cells across than this is measured again on a finer grid.
@@ -127,7 +121,7 @@ def fit_contour(problem: Problem, *, grid: tuple[int, int] = (201, 201), ranges=
         Grid points along each parameter.
     ranges : mapping or sequence of two (lower, upper), optional
         Grid ranges in variable units, by parameter name or kind, or in
-        order; default :data:`DEFAULT_RANGES` clipped to the bounds.
+        order; default each kind's grid span (:attr:`stcs_ident.core.kinds.Kind.grid`) clipped to the bounds.
     scale_rule : {"auto", "birge", "never"}
     max_widen : int
         How many times the grid may be widened when the region reaches its
@@ -207,7 +201,7 @@ def _ranges(problem: Problem, ranges) -> tuple[np.ndarray, np.ndarray]:
         elif ranges is not None:
             given = ranges[j]
         if given is None:
-            default = DEFAULT_RANGES[q.kind] if q.is_ratio or q.kind == "end_stiffness" else (q.lower, q.upper)
+            default = q.spec.grid if q.is_ratio or q.is_fixity else (q.lower, q.upper)
             given = (max(default[0], q.lower), min(default[1], q.upper))
         a, b = float(given[0]), float(given[1])
         if not a < b:

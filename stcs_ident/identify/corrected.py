@@ -26,16 +26,17 @@ def corrected_campaign(campaign: Campaign, result: IdentificationResult) -> Camp
     setups = {s.name: list(s.attachments) for s in campaign.setups}
     for p, value in zip(result.parameters, result.values):
         value = float(value)
-        if p.kind == "tension":
-            tests[p.member] = replace(tests[p.member], tension=value)
-        elif p.kind in ("EI", "length", "mass_per_length"):
-            cable = replace(cable, **{p.kind: value})
-        elif p.kind == "end_stiffness":
+        spec = p.spec
+        if spec.belongs_to == "test":
+            tests[p.member] = replace(tests[p.member], **{spec.attribute: value})
+        elif spec.belongs_to == "cable":
+            cable = replace(cable, **{spec.attribute: value})
+        elif spec.belongs_to == "end":
             ends = {"A": ("boundary_a",), "B": ("boundary_b",), "AB": ("boundary_a", "boundary_b")}[p.member]
             cable = replace(cable, **{end: Boundary(value) for end in ends})
         else:
             for setup, index in p.slots or ((p.setup, p.index),):
                 atts = setups[setup]
-                atts[index] = replace(atts[index], **{p.kind: value})
+                atts[index] = replace(atts[index], **{spec.attribute: value})
     new_setups = tuple(replace(s, attachments=tuple(setups[s.name])) for s in campaign.setups)
     return replace(campaign, cable=cable, setups=new_setups, tests=tuple(tests[t.name] for t in campaign.tests))

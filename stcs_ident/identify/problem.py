@@ -19,9 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core import kinds
 from ..core.errors import ComputationError, InputError, ModelError
 from ..core.model import Campaign, Test, has_dampers
-from ..core.parameters import KINDS, Parameter, overrides_for
+from ..core.parameters import Parameter, overrides_for
 from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
 
@@ -242,8 +243,8 @@ class Problem:
                 raise InputError(f"{q.name} belongs to none of the selected tests", field="params")
         self._atts = {m.name: campaign.setup(m.test.setup).attachments for m in self.measurements}
         self._nominal_atts = {
-            name: {KINDS[k][1]: np.array([getattr(a, k, 0.0) for a in atts], float)
-                   for k in ("position", "mass", "stiffness", "coefficient")}
+            name: {k.override: np.array([getattr(a, k.attribute, 0.0) for a in atts], float)
+                   for k in kinds.kinds() if k.belongs_to == "attachment"}
             for name, atts in self._atts.items()
         }
         groups: dict[str, list[int]] = {}
@@ -374,7 +375,7 @@ class Problem:
         compares across variables of different units (a tension ratio, a stiffness in N/m)."""
         x = np.asarray(x, float)
         size = np.maximum(np.abs(x), 1.0)
-        return np.where([q.kind == "end_stiffness" for q in self.parameters], 1.0, size)
+        return np.where([q.is_fixity for q in self.parameters], 1.0, size)
 
     def jacobian(self, x) -> np.ndarray:
         """d residuals / d variables by central differences (one-sided at a bound), one batch."""

@@ -23,7 +23,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from .. import effects
+from ..core import kinds
 from ..core.errors import CampaignError, ModelError
 from ..core.model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
 from .campaign_toml import campaign_to_toml
@@ -133,8 +133,8 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
 
 
 def _parse_tolerance(table: dict[str, Any]) -> tuple[tuple[str, float], ...]:
-    """``[tolerance]``: how well the nominal values are known, by the keys the effects declare."""
-    _check_keys(table, effects.tolerance_keys(), "tolerance")
+    """``[tolerance]``: how well the nominal values are known, by the parameter kinds' keys."""
+    _check_keys(table, kinds.tolerance_keys(), "tolerance")
     out = []
     for key, value in table.items():
         v = _number(value, f"tolerance.{key}")

@@ -22,19 +22,17 @@ import numpy as np
 
 from .plots import new_figure, save_figure
 
-_SYMBOL = {"tension": "H", "EI": "EI", "length": "l", "mass_per_length": "m", "position": "x", "mass": "M",
-           "stiffness": "s", "coefficient": "c"}
-
 
 def parameter_label(p) -> str:
-    """Axis label of a parameter's variable: ``H̃/H (case1-L4)``, ``ẼI/EI``, ``x̃/x (W1)``."""
-    if p.kind == "end_stiffness":
+    """Axis label of a parameter's variable: ``H̃/H (case1-L4)``, ``ẼI/EI``, ``x̃/x (W1)``; a zero-nominal
+    value in its kind's unit, ``coefficient (N s/m)``."""
+    if p.is_fixity:
         text = "end fixity φ = k/(k + √(EI·H))"
     elif p.is_ratio:
-        s = _SYMBOL[p.kind]
+        s = p.spec.symbol
         text = f"{s}\u0303/{s}" if len(s) == 1 else f"{s[0]}\u0303{s[1:]}/{s}"
     else:
-        text = f"{p.kind} ({'kg' if p.kind == 'mass' else 'N/m'})"
+        text = f"{p.kind} ({p.unit})"
     return f"{text} ({p.member})" if p.member else text
 
 

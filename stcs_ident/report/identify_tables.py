@@ -17,7 +17,7 @@ import os
 import pandas as pd
 
 from ..core import files
-from ..core.formatting import PARAMETER_UNITS, STYLES, number, rms, table_lines
+from ..core.formatting import STYLES, number, rms, table_lines
 from ..identify.problem import printed_step
 
 
@@ -27,7 +27,7 @@ def parameters_table(result) -> pd.DataFrame:
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
                               result.value_uncertainty):
         rows.append({"parameter": p.name, "estimate": float(x), "uncertainty": float(s), "nominal_SI": p.nominal,
-                     "value_SI": float(v), "uncertainty_SI": float(vs), "unit": PARAMETER_UNITS[p.kind]})
+                     "value_SI": float(v), "uncertainty_SI": float(vs), "unit": p.unit})
     return pd.DataFrame(rows)
 
 
@@ -63,7 +63,7 @@ def _parameter_lines(result) -> list[list[str]]:
     out = []
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
                               result.value_uncertainty):
-        unit = PARAMETER_UNITS[p.kind]
+        unit = p.unit
         out.append([p.name, f"{x:.5g}", f"{s:.2g}", f"{number(p.nominal, '{:.5g}')} {unit}",
                     f"{number(v, '{:.5g}')} ± {number(vs, '{:.5g}')} {unit}"])
     return out
