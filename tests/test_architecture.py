@@ -20,6 +20,9 @@ FLOORS = ("core", "io", "effects", "forward", "spectra", "simulate", "identify",
 #: Where a file may be read: the readers of io/, and the report writers (they read back what they wrote to
 #: check it, and the fonts and styles matplotlib opens).
 READERS = ("io",)
+#: The one writer below report/: core/files.py puts every output in place whole (its ``open`` takes the
+#: caller's write mode, and it opens the finished temporary read-only only to fsync it).
+WRITERS = ("stcs_ident.core.files",)
 #: Calls that read a file (by the callee's last name, or ``module.name``).
 READ_CALLS = {"open", "read_text", "read_bytes", "File", "load", "loadtxt", "genfromtxt", "fromfile", "read_csv",
               "read_parquet", "read_table", "read_hdf", "read_json", "read_excel", "ParquetFile", "TdmsFile"}
@@ -101,7 +104,7 @@ def test_no_import_circle():
     stack: list[str] = []
     on_stack: set[str] = set()
     circles = []
-    for root in list(graph):  # noqa: PLC0206 (the values are read through the stack)
+    for root in list(graph):
         if root in index:
             continue
         work = [(root, iter(sorted(graph[root])))]
@@ -156,7 +159,7 @@ def test_no_file_is_read_outside_io():
     found = []
     for module, (path, tree) in SOURCES.items():
         floor = module.split(".")[1] if "." in module else ""
-        if floor in READERS or floor == "report":
+        if floor in READERS or floor == "report" or module in WRITERS:
             continue
         for node in ast.walk(tree):
             if not isinstance(node, ast.Call) or _callee(node) not in READ_CALLS:

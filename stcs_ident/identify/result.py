@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..core.formatting import PARAMETER_UNITS, percent_error
+from ..core.formatting import percent_error
 from ..core.notes import Note
 from ..core.parameters import Parameter
 from ..core.result import Result
@@ -188,7 +188,7 @@ class IdentificationResult(Result):
         ``uncertainty`` in SI units, ``unit``, ``nominal`` (SI), and the dimensionless ``variable`` the fit
         works in (a ratio to nominal, mostly) with its ``variable_uncertainty``."""
         rows = [{"parameter": p.name, "kind": p.kind, "member": p.member, "value": float(v),
-                 "uncertainty": float(vs), "unit": PARAMETER_UNITS[p.kind], "nominal": float(p.nominal),
+                 "uncertainty": float(vs), "unit": p.unit, "nominal": float(p.nominal),
                  "variable": float(x), "variable_uncertainty": float(s)}
                 for p, x, s, v, vs in zip(self.parameters, self.estimate, self.uncertainty, self.values,
                                           self.value_uncertainty)]
@@ -202,7 +202,7 @@ class IdentificationResult(Result):
     def headline(self) -> str:
         """Method, the first parameters in SI units with their 1σ, and the rms error before and after."""
         shown = [f"{p.kind if p.member is None else f'{p.kind}[{p.member}]'} = {v:.4g} ± {vs:.2g} "
-                 f"{PARAMETER_UNITS[p.kind]}"
+                 f"{p.unit}"
                  for p, v, vs in zip(self.parameters, self.values, self.value_uncertainty)]
         more = f", … ({len(shown)} parameters)" if len(shown) > 3 else ""
         n = sum(len(t.modes) for t in self.tests)
