@@ -28,7 +28,7 @@
 static void evaluate(const Problem *P, long long cfg, double omega, int *J_out, int *J0_out, double *det_out) {
     int nd = P->n_dof;
     double K[MAX_DOF * MAX_DOF];
-    assemble(P, cfg, omega, K);
+    int J0 = assemble(P, cfg, omega, K);
     for (int k = 0; k < P->n_att; k++) {
         long long v = P->v_dof[k + 1];
         K[v * nd + v] -= P->masses[cfg * P->n_att + k] * omega * omega;
@@ -55,7 +55,6 @@ static void evaluate(const Problem *P, long long cfg, double omega, int *J_out, 
             for (int j = k + 1; j < nd; j++) K[i * nd + j] -= l * K[k * nd + j];
         }
     }
-    int J0 = clamped_count(P, cfg, omega);
     *J_out = J0 + neg - P->n_h;
     *J0_out = J0;
     *det_out = det;

@@ -54,25 +54,37 @@ static int problem_of(Problem *P, int n_att, int n_dof, int n_h, int string, int
     return 0;
 }
 
-/* J0 of configuration cfg at a real ω: the number of clamped–clamped segment frequencies below it. */
-static int clamped_count(const Problem *P, long long cfg, double omega) {
+/* Clamped–clamped frequencies below a real ω of a beam segment, from its p, q, p², q² at ω and
+ * pL = p L, qL = q L. */
+static int beam_clamped_count(double p, double q, double p2, double q2, double pL, double qL) {
+    double ex = exp(-pL);
+    double delta = 2 * p * q * (ex * 2.0 / (1.0 + ex * ex) - cos(qL)) + (p2 - q2) * tanh(pL) * sin(qL);
+    double i = floor(qL / M_PI);
+    if (i < 1) return 0;
+    double parity = fmod(i, 2.0) == 0.0 ? 1.0 : -1.0;
+    return (int)(i - 1) + (((delta > 0) - (delta < 0)) == parity);
+}
+
+/* The same for a string segment, from qL = ω √(m/H) L. */
+static int string_clamped_count(double qL) {
+    double n = ceil(qL / M_PI) - 1;
+    return n > 0 ? (int)n : 0;
+}
+
+/* J0 of configuration cfg at a real ω: the number of clamped–clamped segment frequencies below it (the
+ * complex kernel's count on the contour; the real kernel counts while it assembles). */
+static inline int clamped_count(const Problem *P, long long cfg, double omega) {
     int J0 = 0;
     double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
     for (int j = 0; j < P->n_seg; j++) {
         double L = P->seg_len[cfg * P->n_seg + j];
         if (P->string) {
-            double n = ceil(omega * sqrt(m / H) * L / M_PI) - 1;
-            J0 += n > 0 ? (int)n : 0;
+            J0 += string_clamped_count(omega * sqrt(m / H) * L);
             continue;
         }
         double a_ = H / (2.0 * EI), b_ = m * omega * omega / EI;
         double p2 = a_ + sqrt(a_ * a_ + b_), q2 = b_ / p2, p = sqrt(p2), q = sqrt(q2);
-        double pL = p * L, qL = q * L, ex = exp(-pL);
-        double delta = 2 * p * q * (ex * 2.0 / (1.0 + ex * ex) - cos(qL)) + (p2 - q2) * tanh(pL) * sin(qL);
-        double i = floor(qL / M_PI);
-        if (i < 1) continue;
-        double parity = fmod(i, 2.0) == 0.0 ? 1.0 : -1.0;
-        J0 += (int)(i - 1) + (((delta > 0) - (delta < 0)) == parity);
+        J0 += beam_clamped_count(p, q, p2, q2, p * L, q * L);
     }
     return J0;
 }

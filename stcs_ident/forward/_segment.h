@@ -61,8 +61,9 @@ static SCALAR x_minus_tan(SCALAR x) {
 }
 
 /* Beam segment of length L at ω: element matrix Ke (row-major 4×4 on v, θ, v, θ), the translation
- * force of a unit tension increment and its residual R. */
-static void beam_segment(double L, double EI, double H, double m, SCALAR omega, SCALAR Ke[16], SCALAR force[4],
+ * force of a unit tension increment and its residual R. Returns the segment's J0 at a real ω (counted
+ * here from the same p and q; 0 for a complex ω, whose count is clamped_count on the real axis). */
+static int beam_segment(double L, double EI, double H, double m, SCALAR omega, SCALAR Ke[16], SCALAR force[4],
                          SCALAR *R) {
     double half = 0.5 * L;
     double a_ = H / (2.0 * EI);
@@ -90,10 +91,15 @@ static void beam_segment(double L, double EI, double H, double m, SCALAR omega, 
     Ke[6] = Ke[9] = 0.5 * (f - b);
     force[0] = a; force[1] = -b; force[2] = a; force[3] = b;
     *R = 2.0 * EI * pq * (p2 * T * xcs + q2 * s * xt) / n_sym;
+#ifdef SEGMENT_COMPLEX
+    return 0;
+#else
+    return beam_clamped_count(p, q, p2, q2, 2.0 * pl, 2.0 * ql);
+#endif
 }
 
-/* String segment (EI = 0) of length L at ω: Ke (2×2 on v, v), force and R as beam_segment. */
-static void string_segment(double L, double H, double m, SCALAR omega, SCALAR Ke[4], SCALAR force[2], SCALAR *R) {
+/* String segment (EI = 0) of length L at ω: Ke (2×2 on v, v), force, R and J0 as beam_segment. */
+static int string_segment(double L, double H, double m, SCALAR omega, SCALAR Ke[4], SCALAR force[2], SCALAR *R) {
     double half = 0.5 * L;
     SCALAR q = omega * sqrt(m / H);
     SCALAR ql2 = 2.0 * q * half;
@@ -104,17 +110,23 @@ static void string_segment(double L, double H, double m, SCALAR omega, SCALAR Ke
     Ke[1] = Ke[2] = off;
     force[0] = force[1] = diag + off;
     *R = 2.0 * H * q * x_minus_tan(q * half);
+#ifdef SEGMENT_COMPLEX
+    return 0;
+#else
+    return string_clamped_count(ql2);
+#endif
 }
 
 /* K (n_dof × n_dof, row-major) of configuration cfg at ω without the attachments: the constant part
  * (boundary springs), every segment, and with a tension model the segments' coupling to the tension
- * increments. */
-static void assemble(const Problem *P, long long cfg, SCALAR omega, SCALAR *K) {
+ * increments. Returns J0 at a real ω (0 for a complex one). */
+static int assemble(const Problem *P, long long cfg, SCALAR omega, SCALAR *K) {
     int nd = P->n_dof, ns = P->n_seg;
     const double *kconst = P->kconst + cfg * nd * nd;
     for (int i = 0; i < nd * nd; i++) K[i] = kconst[i];
     double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
     SCALAR gamma = P->w[cfg] / (H * m * omega * omega);
+    int J0 = 0;
     for (int j = 0; j < ns; j++) {
         SCALAR Ke[16], force[4], R;
         long long dofs[4];
@@ -122,11 +134,11 @@ static void assemble(const Problem *P, long long cfg, SCALAR omega, SCALAR *K) {
         double L = P->seg_len[cfg * ns + j];
         if (P->string) {
             ne = 2;
-            string_segment(L, H, m, omega, Ke, force, &R);
+            J0 += string_segment(L, H, m, omega, Ke, force, &R);
             dofs[0] = P->v_dof[j]; dofs[1] = P->v_dof[j + 1];
         } else {
             ne = 4;
-            beam_segment(L, EI, H, m, omega, Ke, force, &R);
+            J0 += beam_segment(L, EI, H, m, omega, Ke, force, &R);
             dofs[0] = P->v_dof[j]; dofs[1] = P->t_dof[j];
             dofs[2] = P->v_dof[j + 1]; dofs[3] = P->t_dof[j + 1];
         }
@@ -146,6 +158,7 @@ static void assemble(const Problem *P, long long cfg, SCALAR omega, SCALAR *K) {
             K[hj * nd + hj] += gamma * gamma * R;
         }
     }
+    return J0;
 }
 
 #undef ABS
