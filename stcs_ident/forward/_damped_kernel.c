@@ -8,7 +8,8 @@
  * root solved again from its pinned end with the roots found divided out), and the count is certified by the argument
  * principle on a quadrilateral (damping ratio below 0.5), the phase followed by recursive bisection of the edges (no step of more than π/4). It exists because
  * numpy's per-call overhead dominates these small problems; damped.py stays the reference and the
- * tests compare the two.
+ * tests compare the two. The segments, their assembly and J0 are written once with the real kernel
+ * (_segment.h over the scalar type, _problem.h).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>

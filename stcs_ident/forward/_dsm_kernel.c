@@ -9,6 +9,9 @@
  * one-root bracket. It exists because numpy's per-call overhead dominates
  * small problems (a single configuration, or the 3×3 systems of a sweep);
  * the numpy path stays the reference and the tests compare the two.
+ * The segment matrices, their assembly and J0 are shared with the complex
+ * kernel (_segment.h over the scalar type, _problem.h); this file holds
+ * what is its own: the attachments, the elimination and the root search.
  *
  * Arrays are C-contiguous float64 (int64 for indices), passed as buffers.
  */
