@@ -73,11 +73,13 @@ def code_path() -> tuple[str, str | None]:
     built = sorted(p for p in directory.glob("_dsm_kernel*") if p.suffix in (".so", ".pyd"))
     forced = roots.FORCE_NUMPY
     if roots.use_kernel():
-        source = directory / "_dsm_kernel.c"  # in a source tree (not an install's copy) it may be newer
-        if (directory.is_relative_to(CHECKOUT) and source.exists() and built
-                and built[0].stat().st_mtime < source.stat().st_mtime):
+        # in a source tree (not an install's copy) the source or a header it includes may be newer
+        sources = [directory / "_dsm_kernel.c", *directory.glob("_*.h")]
+        newest = max(sources, key=lambda p: p.stat().st_mtime if p.exists() else 0.0)
+        if (directory.is_relative_to(CHECKOUT) and newest.exists() and built
+                and built[0].stat().st_mtime < newest.stat().st_mtime):
             return (f"compiled kernel ({built[0].name})",
-                    (f"WARNING: {built[0].name} is older than _dsm_kernel.c beside it: it may be stale "
+                    (f"WARNING: {built[0].name} is older than {newest.name} beside it: it may be stale "
                     f"(rebuild it by reinstalling: pip install [-e] .)"))
         return f"compiled kernel ({built[0].name if built else roots._dsm_kernel.__file__})", None
     if roots._dsm_kernel is not None:  # built and importable, switched off

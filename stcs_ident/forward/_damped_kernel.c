@@ -8,7 +8,8 @@
  * root solved again from its pinned end with the roots found divided out), and the count is certified by the argument
  * principle on a quadrilateral (damping ratio below 0.5), the phase followed by recursive bisection of the edges (no step of more than π/4). It exists because
  * numpy's per-call overhead dominates these small problems; damped.py stays the reference and the
- * tests compare the two.
+ * tests compare the two. The segments, their assembly and J0 are written once with the real kernel
+ * (_segment.h over the scalar type, _problem.h).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -17,7 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_DOF 64
 #define SECANT_RTOL 1e-10
 #define SECANT_ITER 40
 #define START 0.01
@@ -35,144 +35,17 @@
 #define MAX_ARG_STEP (M_PI / 4)
 #define MAX_CONTOUR_POINTS 200000
 
+#define SEGMENT_COMPLEX
+#include "_segment.h"
+
 typedef double complex cplx;
-
-typedef struct {
-    int n_att, n_seg, n_dof, n_h, string, tension_model; /* 0 none, 1 uniform, 2 per-segment */
-    const long long *v_dof, *t_dof, *h_dof;
-    const double *length, *m, *EI, *H, *w, *seg_len, *masses, *kconst, *scale, *dash;
-} Problem;
-
-/* sin z and cos z from one complex exponential (|Im z| stays far below overflow on the contours). */
-static void sin_cos(cplx z, cplx *s, cplx *c) {
-    cplx e = cexp(I * z), r = 1.0 / e;
-    *s = (e - r) / (2.0 * I);
-    *c = 0.5 * (e + r);
-}
-
-/* x cos x − sin x, given sin x and cos x, without cancellation near 0. */
-static cplx c_cos_minus_sin(cplx x, cplx sn, cplx cs) {
-    cplx x2 = x * x;
-    if (cabs(x) < 0.1) return x * x2 * (-1.0 / 3 + x2 * (1.0 / 30 + x2 * (-1.0 / 840 + x2 / 45360)));
-    return x * cs - sn;
-}
-
-/* x − tanh x, given tanh x, without cancellation near 0. */
-static cplx c_minus_tanh(cplx x, cplx th) {
-    cplx x2 = x * x;
-    if (cabs(x) < 0.1) return x * x2 * (1.0 / 3 + x2 * (-2.0 / 15 + x2 * (17.0 / 315 - x2 * 62.0 / 2835)));
-    return x - th;
-}
-
-static cplx c_minus_tan(cplx x) {
-    cplx x2 = x * x;
-    if (cabs(x) < 0.1) return -x * x2 * (1.0 / 3 + x2 * (2.0 / 15 + x2 * (17.0 / 315 + x2 * 62.0 / 2835)));
-    return x - ctan(x);
-}
-
-static void beam_segment(double L, double EI, double H, double m, cplx omega, cplx Ke[16], cplx force[4], cplx *R) {
-    double half = 0.5 * L;
-    double a_ = H / (2.0 * EI);
-    cplx b_ = m * omega * omega / EI;
-    cplx root = csqrt(a_ * a_ + b_);
-    cplx p2 = a_ + root, q2 = b_ / p2;
-    cplx p = csqrt(p2), q = csqrt(q2);
-    cplx pl = p * half, ql = q * half;
-    cplx T = ctanh(pl), s, c;
-    sin_cos(ql, &s, &c);
-    cplx ppqq = p2 + q2, pq = p * q;
-    cplx xcs = c_cos_minus_sin(ql, s, c), xt = c_minus_tanh(pl, T);
-    cplx n_sym = q * s + p * T * c, n_anti = p * xcs - q * c * xt;
-    cplx k1 = EI / n_sym, k2 = EI / n_anti;
-    cplx a = -k1 * pq * T * s * ppqq, b = -k1 * pq * n_anti, d = k1 * c * ppqq;
-    cplx e = -k2 * pq * c * ppqq, f = k2 * pq * n_sym, h = -k2 * T * s * ppqq;
-    Ke[0] = Ke[10] = 0.5 * (a + e);
-    Ke[5] = Ke[15] = 0.5 * (d + h);
-    Ke[2] = Ke[8] = 0.5 * (a - e);
-    Ke[7] = Ke[13] = 0.5 * (h - d);
-    Ke[1] = Ke[4] = -0.5 * (b + f);
-    Ke[11] = Ke[14] = 0.5 * (b + f);
-    Ke[3] = Ke[12] = 0.5 * (b - f);
-    Ke[6] = Ke[9] = 0.5 * (f - b);
-    force[0] = a; force[1] = -b; force[2] = a; force[3] = b;
-    *R = 2.0 * EI * pq * (p2 * T * xcs + q2 * s * xt) / n_sym;
-}
-
-static void string_segment(double L, double H, double m, cplx omega, cplx Ke[4], cplx force[2], cplx *R) {
-    double half = 0.5 * L;
-    cplx q = omega * sqrt(m / H);
-    cplx ql2 = 2.0 * q * half;
-    cplx sn, cs;
-    sin_cos(ql2, &sn, &cs);
-    cplx diag = H * q * cs / sn, off = -H * q / sn;
-    Ke[0] = Ke[3] = diag;
-    Ke[1] = Ke[2] = off;
-    force[0] = force[1] = diag + off;
-    *R = 2.0 * H * q * c_minus_tan(q * half);
-}
-
-/* Number of clamped–clamped segment frequencies below a real ω (the poles of det K): J0. */
-static int clamped_count(const Problem *P, long long cfg, double omega) {
-    int J0 = 0;
-    double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
-    for (int j = 0; j < P->n_seg; j++) {
-        double L = P->seg_len[cfg * P->n_seg + j];
-        if (P->string) {
-            double n = ceil(omega * sqrt(m / H) * L / M_PI) - 1;
-            J0 += n > 0 ? (int)n : 0;
-            continue;
-        }
-        double a_ = H / (2.0 * EI), b_ = m * omega * omega / EI;
-        double p2 = a_ + sqrt(a_ * a_ + b_), q2 = b_ / p2, p = sqrt(p2), q = sqrt(q2);
-        double pL = p * L, qL = q * L, ex = exp(-pL);
-        double delta = 2 * p * q * (ex * 2.0 / (1.0 + ex * ex) - cos(qL)) + (p2 - q2) * tanh(pL) * sin(qL);
-        double i = floor(qL / M_PI);
-        if (i < 1) continue;
-        double parity = fmod(i, 2.0) == 0.0 ? 1.0 : -1.0;
-        J0 += (int)(i - 1) + (((delta > 0) - (delta < 0)) == parity);
-    }
-    return J0;
-}
 
 /* det of the scaled K(s) of configuration cfg with the dashpots times t. */
 static cplx cdet(const Problem *P, long long cfg, cplx s, double t) {
-    int nd = P->n_dof, ns = P->n_seg;
+    int nd = P->n_dof;
     cplx K[MAX_DOF * MAX_DOF];
-    for (int i = 0; i < nd * nd; i++) K[i] = P->kconst[cfg * nd * nd + i];
-    double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
     cplx omega = -I * s;
-    cplx gamma = P->w[cfg] / (H * m * omega * omega);
-    for (int j = 0; j < ns; j++) {
-        cplx Ke[16], force[4], R;
-        long long dofs[4];
-        int ne;
-        double L = P->seg_len[cfg * ns + j];
-        if (P->string) {
-            ne = 2;
-            string_segment(L, H, m, omega, Ke, force, &R);
-            dofs[0] = P->v_dof[j]; dofs[1] = P->v_dof[j + 1];
-        } else {
-            ne = 4;
-            beam_segment(L, EI, H, m, omega, Ke, force, &R);
-            dofs[0] = P->v_dof[j]; dofs[1] = P->t_dof[j];
-            dofs[2] = P->v_dof[j + 1]; dofs[3] = P->t_dof[j + 1];
-        }
-        for (int r = 0; r < ne; r++) {
-            if (dofs[r] < 0) continue;
-            for (int c = 0; c < ne; c++)
-                if (dofs[c] >= 0) K[dofs[r] * nd + dofs[c]] += Ke[r * ne + c];
-        }
-        if (P->tension_model != 0) {
-            long long hj = P->h_dof[P->tension_model == 1 ? 0 : j];
-            for (int r = 0; r < ne; r++) {
-                if (dofs[r] < 0) continue;
-                cplx v = -gamma * force[r];
-                K[dofs[r] * nd + hj] += v;
-                K[hj * nd + dofs[r]] += v;
-            }
-            K[hj * nd + hj] += gamma * gamma * R;
-        }
-    }
+    assemble(P, cfg, omega, K);
     for (int k = 0; k < P->n_att; k++) {
         long long v = P->v_dof[k + 1];
         K[v * nd + v] += -P->masses[cfg * P->n_att + k] * omega * omega + t * P->dash[cfg * P->n_att + k] * s;
@@ -514,40 +387,25 @@ static int solve_config(const Problem *P, long long cfg, const double *omega, co
     return complete(P, cfg, omega, s, n_modes);
 }
 
-static int get_buffer(PyObject *obj, Py_buffer *view, const char *name) {
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0) {
-        PyErr_Format(PyExc_TypeError, "%s: a contiguous buffer is required", name);
-        return -1;
-    }
-    return 0;
-}
-
 /* solve(topology ints, arrays..., configs, omega (n_cfg_all × (n_modes+1)), pinned (configs × (n_modes+1)),
  *       n_modes, certify)
  * -> (bytes of complex128 s, configs × (n_modes+1)), bytes of int32 status per config) */
 static PyObject *py_solve(PyObject *self, PyObject *args) {
     int n_att, n_dof, n_h, string, tension_model, n_modes, certify;
-    PyObject *objs[16];
+    PyObject *objs[PROBLEM_ARRAYS + 4];
     if (!PyArg_ParseTuple(args, "iiiii" "OOOOOOOOOOOOOOOO" "ii", &n_att, &n_dof, &n_h, &string, &tension_model,
                           &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
                           &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13], &objs[14], &objs[15],
                           &n_modes, &certify))
         return NULL;
-    if (n_dof > MAX_DOF) {
-        PyErr_SetString(PyExc_ValueError, "too many degrees of freedom for the compiled kernel");
-        return NULL;
-    }
-    static const char *names[16] = {"v_dof", "t_dof", "h_dof", "length", "m", "EI", "H", "w", "seg_len",
-                                    "masses", "kconst", "scale", "dash", "configs", "omega", "pinned"};
-    Py_buffer views[16];
-    int got = 0;
+    static const char *const names[PROBLEM_ARRAYS + 4] = {PROBLEM_ARRAY_NAMES, "dash", "configs", "omega", "pinned"};
+    Py_buffer views[PROBLEM_ARRAYS + 4];
+    Problem P;
     PyObject *result = NULL;
-    for (; got < 16; got++)
-        if (get_buffer(objs[got], &views[got], names[got]) < 0) goto done;
-    Problem P = {n_att, n_att + 1, n_dof, n_h, string, tension_model,
-                 views[0].buf, views[1].buf, views[2].buf,
-                 views[3].buf, views[4].buf, views[5].buf, views[6].buf, views[7].buf, views[8].buf,
-                 views[9].buf, views[10].buf, views[11].buf, views[12].buf};
+    int got = open_buffers(objs, names, PROBLEM_ARRAYS + 4, views);
+    if (got < PROBLEM_ARRAYS + 4
+        || problem_of(&P, n_att, n_dof, n_h, string, tension_model, views, views[12].buf) != 0)
+        goto done;
     const long long *configs = views[13].buf;
     const double *omega = views[14].buf, *pinned = views[15].buf;
     Py_ssize_t n_cfg = views[13].len / (Py_ssize_t)sizeof(long long);
@@ -563,7 +421,7 @@ static PyObject *py_solve(PyObject *self, PyObject *args) {
     Py_END_ALLOW_THREADS
     result = Py_BuildValue("NN", out, status);
 done:
-    for (int i = 0; i < got; i++) PyBuffer_Release(&views[i]);
+    close_buffers(views, got);
     return result;
 }
 

@@ -9,6 +9,9 @@
  * one-root bracket. It exists because numpy's per-call overhead dominates
  * small problems (a single configuration, or the 3×3 systems of a sweep);
  * the numpy path stays the reference and the tests compare the two.
+ * The segment matrices, their assembly and J0 are shared with the complex
+ * kernel (_segment.h over the scalar type, _problem.h); this file holds
+ * what is its own: the attachments, the elimination and the root search.
  *
  * Arrays are C-contiguous float64 (int64 for indices), passed as buffers.
  */
@@ -21,127 +24,14 @@
 
 #define RTOL 2e-13
 #define MAX_ITER 200
-#define MAX_DOF 64
 
-typedef struct {
-    int n_att, n_seg, n_dof, n_h, string, tension_model; /* 0 none, 1 uniform, 2 per-segment */
-    const long long *v_dof, *t_dof, *h_dof;
-    const double *length, *m, *EI, *H, *w, *seg_len, *masses, *kconst, *scale;
-} Problem;
-
-static double x_cos_minus_sin(double x) {
-    double x2 = x * x;
-    if (fabs(x) < 0.1)
-        return x * x2 * (-1.0 / 3 + x2 * (1.0 / 30 + x2 * (-1.0 / 840 + x2 / 45360)));
-    return x * cos(x) - sin(x);
-}
-
-static double x_minus_tanh(double x) {
-    double x2 = x * x;
-    if (fabs(x) < 0.1)
-        return x * x2 * (1.0 / 3 + x2 * (-2.0 / 15 + x2 * (17.0 / 315 - x2 * 62.0 / 2835)));
-    return x - tanh(x);
-}
-
-static double x_minus_tan(double x) {
-    double x2 = x * x;
-    if (fabs(x) < 0.1)
-        return -x * x2 * (1.0 / 3 + x2 * (2.0 / 15 + x2 * (17.0 / 315 + x2 * 62.0 / 2835)));
-    return x - tan(x);
-}
-
-static double sign_of(double x) { return (x > 0) - (x < 0); }
-
-/* Element matrix Ke (row-major ne×ne), translation force, residual R, J0. */
-static int beam_segment(double L, double EI, double H, double m, double omega,
-                        double Ke[16], double force[4], double *R) {
-    double half = 0.5 * L;
-    double a_ = H / (2.0 * EI), b_ = m * omega * omega / EI;
-    double root = sqrt(a_ * a_ + b_);
-    double p2 = a_ + root, q2 = b_ / p2;
-    double p = sqrt(p2), q = sqrt(q2);
-    double pl = p * half, ql = q * half;
-    double T = tanh(pl), s = sin(ql), c = cos(ql);
-    double ppqq = p2 + q2, pq = p * q;
-    /* n_anti = T q c - s p without the cancellation of its leading terms on a short segment */
-    double n_sym = q * s + p * T * c, n_anti = p * x_cos_minus_sin(ql) - q * c * x_minus_tanh(pl);
-    double k1 = EI / n_sym, k2 = EI / n_anti;
-    double a = -k1 * pq * T * s * ppqq, b = -k1 * pq * n_anti, d = k1 * c * ppqq;
-    double e = -k2 * pq * c * ppqq, f = k2 * pq * n_sym, h = -k2 * T * s * ppqq;
-    Ke[0] = Ke[10] = 0.5 * (a + e);
-    Ke[5] = Ke[15] = 0.5 * (d + h);
-    Ke[2] = Ke[8] = 0.5 * (a - e);
-    Ke[7] = Ke[13] = 0.5 * (h - d);
-    Ke[1] = Ke[4] = -0.5 * (b + f);
-    Ke[11] = Ke[14] = 0.5 * (b + f);
-    Ke[3] = Ke[12] = 0.5 * (b - f);
-    Ke[6] = Ke[9] = 0.5 * (f - b);
-    force[0] = a; force[1] = -b; force[2] = a; force[3] = b;
-    *R = 2.0 * EI * pq * (p2 * T * x_cos_minus_sin(ql) + q2 * s * x_minus_tanh(pl)) / n_sym;
-    /* clamped–clamped count J0 */
-    double pL = 2.0 * pl, qL = 2.0 * ql;
-    double ex = exp(-pL);
-    double tanh_pl = tanh(pL), sech_pl = ex * 2.0 / (1.0 + ex * ex);
-    double delta = 2 * p * q * (sech_pl - cos(qL)) + (p2 - q2) * tanh_pl * sin(qL);
-    double i = floor(qL / M_PI);
-    if (i < 1) return 0;
-    double parity = fmod(i, 2.0) == 0.0 ? 1.0 : -1.0;
-    return (int)(i - 1) + (sign_of(delta) == parity);
-}
-
-static int string_segment(double L, double H, double m, double omega,
-                          double Ke[4], double force[2], double *R) {
-    double half = 0.5 * L;
-    double q = omega * sqrt(m / H);
-    double ql2 = 2.0 * q * half;
-    double diag = H * q * cos(ql2) / sin(ql2), off = -H * q / sin(ql2);
-    Ke[0] = Ke[3] = diag;
-    Ke[1] = Ke[2] = off;
-    force[0] = force[1] = diag + off;
-    *R = 2.0 * H * q * x_minus_tan(q * half);
-    double n = ceil(ql2 / M_PI) - 1;
-    return n > 0 ? (int)n : 0;
-}
+#include "_segment.h"
 
 /* Count J(ω) and det of the scaled K for configuration cfg. */
 static void evaluate(const Problem *P, long long cfg, double omega, int *J_out, int *J0_out, double *det_out) {
-    int nd = P->n_dof, ns = P->n_seg;
+    int nd = P->n_dof;
     double K[MAX_DOF * MAX_DOF];
-    memcpy(K, P->kconst + cfg * nd * nd, sizeof(double) * nd * nd);
-    double m = P->m[cfg], H = P->H[cfg], EI = P->EI[cfg];
-    double gamma = P->w[cfg] / (H * m * omega * omega);
-    int J0 = 0;
-    for (int j = 0; j < ns; j++) {
-        double Ke[16], force[4], R;
-        long long dofs[4];
-        int ne;
-        double L = P->seg_len[cfg * ns + j];
-        if (P->string) {
-            ne = 2;
-            J0 += string_segment(L, H, m, omega, Ke, force, &R);
-            dofs[0] = P->v_dof[j]; dofs[1] = P->v_dof[j + 1];
-        } else {
-            ne = 4;
-            J0 += beam_segment(L, EI, H, m, omega, Ke, force, &R);
-            dofs[0] = P->v_dof[j]; dofs[1] = P->t_dof[j];
-            dofs[2] = P->v_dof[j + 1]; dofs[3] = P->t_dof[j + 1];
-        }
-        for (int r = 0; r < ne; r++) {
-            if (dofs[r] < 0) continue;
-            for (int c = 0; c < ne; c++)
-                if (dofs[c] >= 0) K[dofs[r] * nd + dofs[c]] += Ke[r * ne + c];
-        }
-        if (P->tension_model != 0) {
-            long long hj = P->h_dof[P->tension_model == 1 ? 0 : j];
-            for (int r = 0; r < ne; r++) {
-                if (dofs[r] < 0) continue;
-                double v = -gamma * force[r];
-                K[dofs[r] * nd + hj] += v;
-                K[hj * nd + dofs[r]] += v;
-            }
-            K[hj * nd + hj] += gamma * gamma * R;
-        }
-    }
+    int J0 = assemble(P, cfg, omega, K);
     for (int k = 0; k < P->n_att; k++) {
         long long v = P->v_dof[k + 1];
         K[v * nd + v] -= P->masses[cfg * P->n_att + k] * omega * omega;
@@ -296,37 +186,21 @@ static int find_repeats(const Problem *P, const long long *config, const long lo
     return 0;
 }
 
-static int get_buffer(PyObject *obj, Py_buffer *view, const char *name) {
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0) {
-        PyErr_Format(PyExc_TypeError, "%s: a contiguous buffer is required", name);
-        return -1;
-    }
-    return 0;
-}
-
-/* solve(topology tuple, arrays..., config, mode, out) */
+/* solve(topology ints, arrays..., config, mode) -> (bytes of float64 ω per item, number failed) */
 static PyObject *py_solve(PyObject *self, PyObject *args) {
     int n_att, n_dof, n_h, string, tension_model;
-    PyObject *objs[14];
+    PyObject *objs[PROBLEM_ARRAYS + 2];
     if (!PyArg_ParseTuple(args, "iiiiiOOOOOOOOOOOOOO", &n_att, &n_dof, &n_h, &string, &tension_model,
                           &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
                           &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13]))
         return NULL;
-    if (n_dof > MAX_DOF) {
-        PyErr_SetString(PyExc_ValueError, "too many degrees of freedom for the compiled kernel");
-        return NULL;
-    }
-    static const char *names[14] = {"v_dof", "t_dof", "h_dof", "length", "m", "EI", "H", "w", "seg_len",
-                                    "masses", "kconst", "scale", "config", "mode"};
-    Py_buffer views[15];
-    int got = 0;
+    static const char *const names[PROBLEM_ARRAYS + 2] = {PROBLEM_ARRAY_NAMES, "config", "mode"};
+    Py_buffer views[PROBLEM_ARRAYS + 2];
+    Problem P;
     PyObject *result = NULL;
-    for (; got < 14; got++)
-        if (get_buffer(objs[got], &views[got], names[got]) < 0) goto done;
-    Problem P = {n_att, n_att + 1, n_dof, n_h, string, tension_model,
-                 views[0].buf, views[1].buf, views[2].buf,
-                 views[3].buf, views[4].buf, views[5].buf, views[6].buf, views[7].buf, views[8].buf,
-                 views[9].buf, views[10].buf, views[11].buf};
+    int got = open_buffers(objs, names, PROBLEM_ARRAYS + 2, views);
+    if (got < PROBLEM_ARRAYS + 2 || problem_of(&P, n_att, n_dof, n_h, string, tension_model, views, NULL) != 0)
+        goto done;
     const long long *config = views[12].buf, *mode = views[13].buf;
     Py_ssize_t n_items = views[12].len / (Py_ssize_t)sizeof(long long);
     PyObject *out = PyBytes_FromStringAndSize(NULL, n_items * (Py_ssize_t)sizeof(double));
@@ -350,7 +224,7 @@ static PyObject *py_solve(PyObject *self, PyObject *args) {
     free(source);
     result = Py_BuildValue("Nn", out, failed);
 done:
-    for (int i = 0; i < got; i++) PyBuffer_Release(&views[i]);
+    close_buffers(views, got);
     return result;
 }
 
