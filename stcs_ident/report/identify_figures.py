@@ -17,6 +17,7 @@ and returns a dict of what it drew so tests can inspect it.
 from __future__ import annotations
 
 import os
+import textwrap
 
 import numpy as np
 
@@ -205,7 +206,8 @@ def plot_errors(result, fig=None) -> dict:
     tests = list(result.tests)
     ncols = min(3, len(tests))
     nrows = -(-len(tests) // ncols)
-    fig = fig or new_figure(figsize=(4.2 * ncols + 0.4, 2.6 * nrows + 0.7), layout="constrained")
+    width = max(7.5, 4.2 * ncols + 0.4)  # one test's panel alone is wide enough for the legend's one row
+    fig = fig or new_figure(figsize=(width, 2.6 * nrows + 0.7), layout="constrained")
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     before, after, errorbars = [], [], []
     for i, (t, ax) in enumerate(zip(tests, axes)):
@@ -230,9 +232,9 @@ def plot_errors(result, fig=None) -> dict:
     handles = [_patch("tab:gray", ""), _patch("tab:blue", ""), errorbars[0]]
     labels = [f"before (rms {result.rms_before:.2f} %)", f"corrected (rms {result.rms_after:.2f} %)",
               "± 1σ of the measured frequency"]
-    fig.legend(handles, labels, loc="outside upper center", ncols=3, fontsize=8, frameon=False)
-    fig.suptitle(f"{result.method}: {', '.join(result.names)}; error = (computed − measured) / measured",
-                 fontsize=9)
+    fig.legend(handles, labels, loc="outside lower center", ncols=3, fontsize=8, frameon=False)
+    fig.suptitle(textwrap.fill(f"{result.method}: {', '.join(result.names)} fitted; error = (computed − measured) "
+                               f"/ measured", int(12 * width)), fontsize=9)
     return {"figure": fig, "axes": list(axes[:len(tests)]), "before": before, "after": after,
             "errorbars": errorbars}
 

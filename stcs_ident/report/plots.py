@@ -23,7 +23,8 @@ def plot_test_spectra(spectra, fig=None) -> dict:
     The upper panel is the combined spectrum: each channel's PSD divided by
     its noise floor, averaged over the channels (1 where there is only
     noise), on which peaks are picked. A blue triangle at its top marks each
-    frequency of the nominal model the peaks were numbered against.
+    frequency of the nominal model the peaks were numbered against, so that
+    how far the cable is from its model shows at a glance.
 
     Parameters
     ----------
@@ -61,9 +62,8 @@ def plot_test_spectra(spectra, fig=None) -> dict:
     nominal = _nominal_markers(ax_c, spectra, f)
     ax_c.set_ylabel("combined spectrum\n(PSD / noise floor, channel mean)")
     ax_c.set_title(f"{spectra.name}: {len(spectra.modes)} modes picked ({result.kind}); "
-                   "red = mode number, orange ? = doubtful, dotted = unassigned", fontsize=9)
-    if nominal is not None:
-        ax_c.legend(handles=[nominal], fontsize=7, loc="upper right")
+                   "red = mode number, orange ? = doubtful, dotted = unassigned"
+                   + ("; blue ▼ = nominal model" if nominal is not None else ""), fontsize=9)
     ax_ch.set_ylabel("channel PSD (m/s²)²/Hz")
     ax_ch.set_xlabel("frequency (Hz)")
     ax_ch.legend(fontsize=7, ncols=4, loc="upper right")
@@ -80,7 +80,7 @@ def _nominal_markers(ax, spectra, f):
     shown = shown[(shown >= f[0]) & (shown <= f[-1])]
     if not shown.size:
         return None
-    return ax.plot(shown, np.full(shown.size, 0.985), "v", color="tab:blue", ms=6, clip_on=False,
+    return ax.plot(shown, np.full(shown.size, 0.97), "v", color="tab:blue", ms=6,
                    transform=ax.get_xaxis_transform(), label="nominal model's frequencies")[0]
 
 
