@@ -15,7 +15,7 @@ import tomli_w
 
 from ..core.model import Boundary, Cable, Campaign, Published, Setup, Test
 
-__all__ = ["campaign_to_toml"]
+__all__ = ["campaign_tables", "campaign_to_toml"]
 
 
 def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
