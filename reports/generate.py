@@ -24,6 +24,7 @@ import sys
 from pathlib import Path
 
 from stcs_ident.cli.main import main
+from stcs_ident.core.formatting import plus_minus
 from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.simulate.effects import Effects
 from stcs_ident.simulate.simulate import Impulse
@@ -69,14 +70,16 @@ def assessment(summary: dict) -> str:
     for effect in effects:
         v, s = values.get(effect, {}), sigmas.get(effect, {})
         if effect == "unmodeled_mass":
-            lines.append(f"- **Unmodeled mass, {v['mass']:.2f} ± {s['mass']:.2f} kg at {v['position']:.2f} m: not "
+            lines.append(f"- **Unmodeled mass, {plus_minus(v['mass'], s['mass'], 'kg')} at "
+                         f"{plus_minus(v['position'], s.get('position'), 'm')}: not "
                          f"plausible as drawn.** The only things clamped on the strand besides the recorded weights "
                          f"are the accelerometers, {SENSOR_MASS[0]:g}–{SENSOR_MASS[1]:g} kg each with their clamps; "
                          f"a mass of {v['mass']:.1f} kg at one point would be a forgotten weight, which the paper's "
                          "set-up does not show. It more likely absorbs what the model lacks (below).")
         elif effect == "unmodeled_support":
-            lines.append(f"- **Unmodeled support, {v['stiffness'] / 1e3:.0f} ± {s['stiffness'] / 1e3:.0f} kN/m at "
-                         f"{v['position']:.2f} m: not plausible.** Nothing touches the strand between the "
+            lines.append(f"- **Unmodeled support, {plus_minus(v['stiffness'], s['stiffness'], 'N/m')} at "
+                         f"{plus_minus(v['position'], s.get('position'), 'm')}: not plausible.** Nothing touches "
+                         "the strand between the "
                          "anchorages of the test bed; a transverse spring there has no physical counterpart.")
         elif effect == "bending_stiffness":
             lines.append(f"- **Bending stiffness {v['EI'] / 1e3:.1f} kN m²: plausible.** A strand's effective EI "

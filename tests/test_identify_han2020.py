@@ -137,7 +137,7 @@ def test_contours_figure_like_fig24(per_level, tmp_path):
 def test_errors_figure_and_saved_files(per_level, tmp_path):
     lsq, contour = per_level["case1-L4"]
     bars = plot_errors(lsq)
-    np.testing.assert_allclose([b.get_height() for b in bars["after"]], np.abs(lsq.tests[0].after_error))
+    np.testing.assert_allclose([b.get_height() for b in bars["after"]], lsq.tests[0].after_error)  # signed
     paths = save_identify_figures(contour, tmp_path / "plots", lsq=lsq)
     assert [Path(p).name for p in paths] == ["surfaces.png", "contours.png", "errors.png"]
     assert all(Path(p).stat().st_size > 10_000 for p in paths)

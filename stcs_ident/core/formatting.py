@@ -56,12 +56,91 @@ def percent(value, digits: int = 3) -> str:
     return number(value, f"{{:.{digits}f}} %", finite_only=True)
 
 
-def plus_minus(value: float, sigma: float | None, digits: int = 3, sigma_digits: int = 2) -> str:
-    """``1.02 ± 0.0031`` (``digits`` and ``sigma_digits`` significant); the value alone when the
-    uncertainty is unknown or not finite."""
-    if sigma is None or not math.isfinite(sigma):
-        return f"{value:.{digits}g}"
-    return f"{value:.{digits}g} ± {sigma:.{sigma_digits}g}"
+#: Units shown with an engineering prefix (kN, MN) by :func:`plus_minus`: forces and the quantities built on them.
+PREFIXED_UNITS = ("N", "N/m", "N s/m", "N m/rad", "N m^2", "N m²")
+#: Magnitudes outside [SCIENTIFIC_BELOW, SCIENTIFIC_FROM) are written as ``(m ± s)e+XX`` by :func:`plus_minus`.
+SCIENTIFIC_BELOW = 1e-3
+SCIENTIFIC_FROM = 1e6
+
+
+def _prefixed(value: float, sigma: float | None, unit: str) -> tuple[float, float | None, str]:
+    """``value`` and ``sigma`` in kN or MN (MN from 10⁶) when ``unit`` is force-based; as they are otherwise
+    (also from 10⁹, where the shared exponent of :func:`plus_minus` reads better than a prefix)."""
+    size = max(abs(value), sigma or 0.0)
+    if unit not in PREFIXED_UNITS or size >= 1e9:
+        return value, sigma, unit
+    for factor, prefix in ((1e6, "M"), (1e3, "k")):
+        if size >= factor:
+            return value / factor, None if sigma is None else sigma / factor, prefix + unit
+    return value, sigma, unit
+
+
+def _decimal_place(sigma: float, sigma_digits: int) -> int:
+    """Decimals that keep ``sigma_digits`` significant digits of ``sigma`` > 0, once rounded there
+    (0.0996 → 0.10: 2 decimals, not 3)."""
+    decimals = sigma_digits - 1 - math.floor(math.log10(sigma))
+    rounded = round(sigma, decimals)
+    return sigma_digits - 1 - math.floor(math.log10(rounded))
+
+
+def _fixed(value: float, decimals: int) -> str:
+    """``value`` rounded to ``decimals`` (negative: to tens, hundreds, ...), without a sign on zero."""
+    x = round(value, decimals) + 0.0  # + 0.0 turns -0.0 into 0.0
+    return f"{x:.{max(decimals, 0)}f}"
+
+
+def plus_minus(value: float | None, sigma: float | None, unit: str = "", *, digits: int = 3,
+               sigma_digits: int = 2) -> str:
+    """A value with its standard uncertainty as a reader expects it: ``9.5984 ± 0.0015 kg``.
+
+    The uncertainty keeps ``sigma_digits`` significant digits and the value is
+    rounded to the same decimal place, so it carries the digits the
+    uncertainty supports and no more. Force-based units (:data:`PREFIXED_UNITS`)
+    take an engineering prefix: ``1248.7 ± 4.2 kN``, ``5.0012 ± 0.0042 MN``.
+    Magnitudes far from 1 are written with a shared exponent,
+    ``(3.553 ± 0.010)e+21``.
+
+    Parameters
+    ----------
+    value : float or None
+        The value; missing (None, NaN) gives :data:`MISSING`.
+    sigma : float or None
+        Its standard uncertainty. Unknown (None, NaN, ±inf) gives the value
+        alone with ``digits`` significant digits; 0 gives the value with
+        ``digits`` significant digits and ``± 0``. A negative σ is read as its
+        magnitude.
+    unit : str, optional
+        Appended after a space; force-based units are prefixed.
+    digits : int, optional
+        Significant digits of a value shown without a usable uncertainty.
+    sigma_digits : int, optional
+        Significant digits of the uncertainty.
+
+    Returns
+    -------
+    str
+    """
+    if is_missing(value):
+        return MISSING
+    value = float(value)
+    known = sigma is not None and math.isfinite(sigma)
+    sigma = abs(float(sigma)) if known else None
+    if not math.isfinite(value):
+        return f"{value}" + (f" {unit}" if unit else "")
+    value, sigma, unit = _prefixed(value, sigma, unit)
+    tail = f" {unit}" if unit else ""
+    if sigma is None:
+        return f"{value:.{digits}g}{tail}"
+    if sigma == 0.0:
+        return f"{value:.{digits}g} ± 0{tail}"
+    decimals = _decimal_place(sigma, sigma_digits)
+    size = max(abs(value), sigma)
+    if SCIENTIFIC_BELOW <= size < SCIENTIFIC_FROM:
+        return f"{_fixed(value, decimals)} ± {_fixed(sigma, decimals)}{tail}"
+    exponent = math.floor(math.log10(size))
+    scale = 10.0**exponent
+    decimals += exponent
+    return f"({_fixed(value / scale, decimals)} ± {_fixed(sigma / scale, decimals)})e{exponent:+03d}{tail}"
 
 
 def cell(value, fmt: str = "{}") -> str:

@@ -251,8 +251,8 @@ class UnmodeledAttachment(Effect):
         values[p.kind], sigmas[p.kind] = value, value_sigma
 
     def describe(self, values, sigmas, cable):
-        return (f"an unmodeled {self.noun} of {pm(values[self.amount_kind], sigmas.get(self.amount_kind))} "
-                f"{self.amount_unit} near {pm(values['position'], sigmas.get('position'))} m")
+        amount = pm(values[self.amount_kind], sigmas.get(self.amount_kind), self.amount_unit)
+        return f"an unmodeled {self.noun} of {amount} near {pm(values['position'], sigmas.get('position'), 'm')}"
 
     def check_truth(self, value, field):
         if value is None:

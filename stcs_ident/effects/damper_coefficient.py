@@ -39,7 +39,7 @@ class DamperCoefficient(RecordedAttachment):
         super().apply_truth(truth, value)
 
     def describe(self, values, sigmas, cable):
-        shown = ", ".join(f"{a}: {pm(v, sigmas['coefficient'].get(a))} N s/m" for a, v in values["coefficient"].items())
+        shown = ", ".join(f"{a}: {pm(v, sigmas['coefficient'].get(a), 'N s/m')}" for a, v in values["coefficient"].items())
         return f"damper coefficients differ from the recorded ones ({shown})"
 
 

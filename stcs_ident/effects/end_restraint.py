@@ -32,7 +32,7 @@ class EndRestraint(Effect):
 
     def describe(self, values, sigmas, cable):
         k = values.get("rotational_stiffness")
-        shown = "clamped" if k == "inf" else f"{pm(k, sigmas.get('rotational_stiffness'))} N m/rad"
+        shown = "clamped" if k == "inf" else pm(k, sigmas.get('rotational_stiffness'), "N m/rad")
         return f"anchorages restrained by a rotational stiffness {shown} (fixity {values.get('fixity', math.nan):.3f})"
 
     def check_truth(self, value, field):

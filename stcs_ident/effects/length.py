@@ -21,7 +21,7 @@ class Length(Effect):
     option = Option("--length-ratio", "R", "true vibrating length / chord length")
 
     def describe(self, values, sigmas, cable):
-        return f"a vibrating length of {pm(values['length'], sigmas.get('length'), 5)} m (nominal {cable.length:g} m)"
+        return f"a vibrating length of {pm(values['length'], sigmas.get('length'), digits=5)} m (nominal {cable.length:g} m)"
 
     def check_truth(self, value, field):
         return positive_ratio(value, field)

@@ -25,7 +25,7 @@ class Tension(Effect):
         sigmas.setdefault("ratio", {})[p.member] = sigma
 
     def describe(self, values, sigmas, cable):
-        ratios = ", ".join(f"{t}: {pm(v, sigmas['ratio'].get(t), 4)}" for t, v in values["ratio"].items())
+        ratios = ", ".join(f"{t}: {pm(v, sigmas['ratio'].get(t), digits=4)}" for t, v in values["ratio"].items())
         return f"tensions differ from the measured ones (true/measured {ratios})"
 
     def check_truth(self, value, field):

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from ..core.formatting import plus_minus
 from ..core.model import Campaign
 
 #: Nominal value of each ratio parameter, from the campaign's cable.
 _NOMINAL = {"EI_ratio": lambda c: c.cable.EI, "length_ratio": lambda c: c.cable.length}
+#: Unit of that nominal value.
+_UNIT = {"EI_ratio": "N m^2", "length_ratio": "m"}
 
 
 def published_comparison(campaign: Campaign, summary: dict) -> list[dict]:
@@ -43,11 +46,11 @@ def published_comparison(campaign: Campaign, summary: dict) -> list[dict]:
                 text += (f" (= {item.low * item.basis:.4g}–{item.high * item.basis:.4g}, i.e. "
                          f"{item.low / scale:.3f}–{item.high / scale:.3f} of the nominal {nominal:.4g})")
         text += f" [{item.source}]" if item.source else ""
-        text += f"; this identification: {ours:.3f} ± {sigma:.3f} of the nominal"
+        text += f"; this identification: {plus_minus(ours, sigma)} of the nominal"
         if nominal is not None:
-            text += f" (= {ours * nominal:.4g} ± {sigma * nominal:.2g})"
+            text += f" (= {plus_minus(ours * nominal, sigma * nominal, _UNIT.get(item.parameter, ''))})"
         if item.basis is not None:
-            text += f", i.e. {ours_b:.3f} ± {sigma_b:.3f} of {item.basis:.4g}"
+            text += f", i.e. {plus_minus(ours_b, sigma_b)} of {item.basis:.4g}"
         text += (", consistent with it." if n_sigma <= 1 else
                  f", {n_sigma:.1f} σ outside the published range.")
         out.append({"parameter": item.parameter, "published": [item.low, item.high], "basis": item.basis,

@@ -1,20 +1,21 @@
 """Write a campaign back in the ``campaign.toml`` format that :mod:`stcs_ident.io.campaign` reads.
 
-Units other than SI live only at the file's edge: the file gives the
-inclination in degrees, the model holds radians.
+The campaign is laid out as the tables and keys of the format (a plain
+dict) and written by tomli-w, which owns TOML's quoting, escaping and
+number syntax. Units other than SI live only at the file's edge: the file
+gives the inclination in degrees, the model holds radians.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
+
+import tomli_w
 
 from ..core.model import Boundary, Cable, Campaign, Published, Setup, Test
 
-__all__ = ["campaign_to_toml"]
-
-# Numbers from this size up are written in exponent form (1.2487e6 N).
-_EXPONENT_FROM = 1e6
-
+__all__ = ["campaign_tables", "campaign_to_toml"]
 
 
 def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
@@ -36,114 +37,89 @@ def campaign_to_toml(campaign: Campaign, header: str = "") -> str:
     str
         The TOML text, ending with a newline.
     """
-    lines = [("# " + line).rstrip() for line in header.splitlines()]
-    if lines:
-        lines.append("")
-    lines += _campaign_lines(campaign)
-    lines += ["", *_cable_lines(campaign.cable)]
-    for setup in campaign.setups:
-        lines += ["", *_setup_lines(setup)]
-    for test in campaign.tests:
-        lines += ["", *_test_lines(test)]
-    for item in campaign.published:
-        lines += ["", *_published_lines(item)]
-    if campaign.tolerance:
-        lines += ["", "[tolerance]", *(f"{key} = {_toml_float(value)}" for key, value in campaign.tolerance)]
-    return "\n".join(lines) + "\n"
+    comments = "".join(("# " + line).rstrip() + "\n" for line in header.splitlines())
+    return (comments + "\n" if comments else "") + tomli_w.dumps(campaign_tables(campaign))
 
 
-def _campaign_lines(campaign: Campaign) -> list[str]:
-    lines = ["[campaign]", f"name = {_toml_string(campaign.name)}"]
+def campaign_tables(campaign: Campaign) -> dict[str, Any]:
+    """The campaign as the tables of ``campaign.toml`` (key order as the format lists them), SI units
+    except the inclination in degrees."""
+    data: dict[str, Any] = {"campaign": {"name": campaign.name}, "cable": _cable_table(campaign.cable)}
     if campaign.description:
-        lines.append(f"description = {_toml_string(campaign.description)}")
-    return lines
+        data["campaign"]["description"] = campaign.description
+    if campaign.setups:
+        data["setup"] = [_setup_table(setup) for setup in campaign.setups]
+    if campaign.tests:
+        data["test"] = [_test_table(test) for test in campaign.tests]
+    if campaign.published:
+        data["published"] = [_published_table(item) for item in campaign.published]
+    if campaign.tolerance:
+        data["tolerance"] = {key: float(value) for key, value in campaign.tolerance}
+    return data
 
 
-def _cable_lines(cable: Cable) -> list[str]:
-    lines = [
-        "[cable]",
-        f"length = {_toml_float(cable.length)}",
-        f"mass_per_length = {_toml_float(cable.mass_per_length)}",
-        f"EI = {_toml_float(cable.EI)}",
-    ]
+def _cable_table(cable: Cable) -> dict[str, Any]:
+    table: dict[str, Any] = {"length": cable.length, "mass_per_length": cable.mass_per_length, "EI": cable.EI}
     if cable.EA is not None:
-        lines.append(f"EA = {_toml_float(cable.EA)}")
-    lines += [
-        f"inclination = {_toml_float(_degrees(cable.inclination))}",
-        f"gravity = {_toml_float(cable.gravity)}",
-        f"boundary = {_toml_boundary(cable.boundary_a, cable.boundary_b)}",
-    ]
-    return lines
+        table["EA"] = cable.EA
+    table.update(inclination=_degrees(cable.inclination), gravity=cable.gravity,
+                 boundary=_boundary(cable.boundary_a, cable.boundary_b))
+    return {key: _number(value) for key, value in table.items()}
 
 
-def _setup_lines(setup: Setup) -> list[str]:
-    lines = ["[[setup]]", f"name = {_toml_string(setup.name)}"]
+def _setup_table(setup: Setup) -> dict[str, Any]:
+    table: dict[str, Any] = {"name": setup.name}
+    attachments, dampers = [], []
     for a in setup.attachments:
-        damper = getattr(a, "coefficient", None) is not None
-        lines += [
-            "",
-            "  [[setup.damper]]" if damper else "  [[setup.attachment]]",
-            f"  name = {_toml_string(a.name)}",
-            f"  position = {_toml_float(a.position)}",
-        ]
-        if damper:
-            lines.append(f"  coefficient = {_toml_float(a.coefficient)}")
-        lines += [
-            f"  mass = {_toml_float(a.mass)}",
-            f"  stiffness = {_toml_float(a.stiffness)}",
-        ]
-    return lines
+        point = {"name": a.name, "position": float(a.position)}
+        if getattr(a, "coefficient", None) is not None:
+            point["coefficient"] = float(a.coefficient)
+            dampers.append(point)
+        else:
+            attachments.append(point)
+        point.update(mass=float(a.mass), stiffness=float(a.stiffness))
+    # The reader builds a setup's attachments before its dampers, so this order reads back equal.
+    if attachments:
+        table["attachment"] = attachments
+    if dampers:
+        table["damper"] = dampers
+    return table
 
 
-def _published_lines(item: Published) -> list[str]:
-    lines = ["[[published]]", f"parameter = {_toml_string(item.parameter)}",
-             f"low = {_toml_float(item.low)}", f"high = {_toml_float(item.high)}"]
-    if item.basis is not None:
-        lines.append(f"basis = {_toml_float(item.basis)}")
-    if item.source:
-        lines.append(f"source = {_toml_string(item.source)}")
-    return lines
-
-
-def _test_lines(test: Test) -> list[str]:
-    lines = [
-        "[[test]]",
-        f"name = {_toml_string(test.name)}",
-        f"setup = {_toml_string(test.setup)}",
-        f"tension = {_toml_float(test.tension)}",
-    ]
+def _test_table(test: Test) -> dict[str, Any]:
+    table: dict[str, Any] = {"name": test.name, "setup": test.setup, "tension": float(test.tension)}
     if test.frequencies is not None:
-        lines.append(f"frequencies = [{', '.join(_toml_float(f) for f in test.frequencies)}]")
-        lines.append(f"modes = [{', '.join(str(k) for k in test.modes)}]")
+        table["frequencies"] = [float(f) for f in test.frequencies]
+        table["modes"] = [int(k) for k in test.modes]
     if test.record is not None:
-        lines.append(f"record = {_toml_string(test.record)}")
+        table["record"] = test.record
     if test.reference:
-        lines.append("  [test.reference]")
-        for label, values in test.reference:
-            lines.append(f"  {_toml_key(label)} = [{', '.join(_toml_float(f) for f in values)}]")
+        table["reference"] = {label: [float(f) for f in values] for label, values in test.reference}
     if test.channels:
-        lines.append("  [test.channels]")
-        for name, position in test.channels:
-            lines.append(f"  {_toml_key(name)} = {_toml_float(position)}")
-    return lines
+        table["channels"] = {name: float(position) for name, position in test.channels}
+    return table
 
 
-def _toml_key(key: str) -> str:
-    """A bare TOML key when possible, else a quoted one."""
-    bare = key and all(c.isalnum() or c in "-_" for c in key) and key.isascii()
-    return key if bare else _toml_string(key)
+def _published_table(item: Published) -> dict[str, Any]:
+    table: dict[str, Any] = {"parameter": item.parameter, "low": float(item.low), "high": float(item.high)}
+    if item.basis is not None:
+        table["basis"] = float(item.basis)
+    if item.source:
+        table["source"] = item.source
+    return table
 
 
-def _toml_boundary(a: Boundary, b: Boundary) -> str:
-    if a == b:
-        return _toml_boundary_end(a)
-    return f"[{_toml_boundary_end(a)}, {_toml_boundary_end(b)}]"
+def _boundary(a: Boundary, b: Boundary) -> str | float | list[str | float]:
+    """One end's value when both ends are alike, else ``[A, B]``."""
+    ends = [end.rotational_stiffness if end.kind == "spring" else end.kind for end in (a, b)]
+    return ends[0] if a == b else ends
 
 
-def _toml_boundary_end(end: Boundary) -> str:
-    if end.kind == "spring":
-        return _toml_float(end.rotational_stiffness)
-    return _toml_string(end.kind)
+def _number(value):
+    """Numbers as floats (TOML integers would read back as int); strings and lists as they are."""
+    if isinstance(value, list):
+        return [_number(v) for v in value]
+    return value if isinstance(value, str) else float(value)
 
 
 def _degrees(radians: float) -> float:
@@ -154,36 +130,3 @@ def _degrees(radians: float) -> float:
         if math.radians(candidate) == radians:
             return candidate
     return exact
-
-
-def _toml_float(value: float) -> str:
-    """A TOML float with the fewest digits that read back exactly."""
-    value = float(value)
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    if abs(value) < _EXPONENT_FROM:
-        return repr(value)
-    for digits in range(17):
-        text = f"{value:.{digits}e}"
-        if float(text) == value:
-            mantissa, exponent = text.split("e")
-            return f"{mantissa}e{int(exponent)}"
-    return repr(value)
-
-
-_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
-
-
-def _toml_string(text: str) -> str:
-    """A TOML basic string, escaped."""
-    out = []
-    for ch in text:
-        if ch in _ESCAPES:
-            out.append(_ESCAPES[ch])
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append(f"\\u{ord(ch):04X}")
-        else:
-            out.append(ch)
-    return '"' + "".join(out) + '"'

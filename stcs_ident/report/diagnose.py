@@ -198,7 +198,8 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
     if "profile" in figures:
         out += ["![Profile of the position](profile.png)", "",
                 ("χ² with the unmodeled attachment held at each position of a grid (every other parameter "
-                 "refitted), the scan that started the fit; the red line is the named cause's estimate."), ""]
+                 "refitted), the scan that started the fit; the red line is the named cause's estimate."
+                 + (f" {figures['unscanned']}" if figures.get("unscanned") else "")), ""]
     return out
 
 
@@ -340,8 +341,11 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
         write_figure(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
         figures["residuals"] = "residuals.png"
         if diagnosis_figures.profile_scans(d):
-            write_figure(diagnosis_figures.plot_profiles(d)["figure"], tmp / "profile.png")
+            drawn = diagnosis_figures.plot_profiles(d)
+            write_figure(drawn["figure"], tmp / "profile.png")
             figures["profile"] = "profile.png"
+            if drawn["unscanned"]:
+                figures["unscanned"] = diagnosis_figures.unscanned_sentence(drawn["unscanned"])
         text = report_markdown(d, tables, figures, spectra)
         write_atomic(tmp / "report.md", text)
     return out

@@ -83,8 +83,15 @@ def plot_residuals(diagnosis, fig=None) -> dict:
     for ax in axes[n:]:
         ax.set_visible(False)
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside upper center", ncols=len(labels), fontsize=8, frameon=False)
+    # One test's panel is too narrow for the four entries side by side: two rows then, not a clipped row.
+    fig.legend(handles, labels, loc="outside upper center", ncols=len(labels) if ncols > 1 else 2, fontsize=8,
+               frameon=False)
     return {"figure": fig, "axes": list(axes[:n]), "lines": lines, "bands": bands}
+
+
+#: A profile whose χ² varies by less than this over the whole span says nothing about the position
+#: (Δχ² = 1 is the width of a 1σ interval): it is not drawn.
+FLAT_PROFILE = 1.0
 
 
 def profile_scans(diagnosis) -> dict:
@@ -92,7 +99,9 @@ def profile_scans(diagnosis) -> dict:
 
     The fit that scanned the position: the cause's own when it scanned it,
     else the single-effect hypothesis (pairs start from the single effects'
-    profile minima and are not scanned again).
+    profile minima and are not scanned again). An effect without a scan, or
+    whose scan is flat (χ² varies by less than :data:`FLAT_PROFILE` along
+    the span: the effect alone changes nothing there), is left out.
     """
     d = diagnosis
     out = {}
@@ -101,10 +110,28 @@ def profile_scans(diagnosis) -> dict:
             continue
         own = [x for x in d.corrected.effects if registry.get(x).unmodeled]
         if d.corrected.profile and own and own[0] == e:
-            out[e] = d.corrected
+            scan = d.corrected
         elif (e,) in d.fits and d.fits[(e,)].profile:
-            out[e] = d.fits[(e,)]
+            scan = d.fits[(e,)]
+        else:
+            continue
+        chi2 = [c for _, c in scan.profile]
+        if max(chi2) - min(chi2) >= FLAT_PROFILE:
+            out[e] = scan
     return out
+
+
+def unscanned(diagnosis) -> list[str]:
+    """The unmodeled attachments of the named cause that :func:`profile_scans` has no (informative) scan of."""
+    scans = profile_scans(diagnosis)
+    return [e for e in diagnosis.selection.effects if registry.get(e).unmodeled and e not in scans]
+
+
+def unscanned_sentence(effects) -> str:
+    """Why the profile figure has no panel for ``effects`` (see :func:`unscanned`)."""
+    nouns = " and ".join(registry.get(e).noun for e in effects)
+    return (f"No profile of the {nouns} position: not scanned within the named cause, and alone it leaves χ² "
+            "flat along the span.")
 
 
 def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
@@ -167,9 +194,13 @@ def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
 def plot_profiles(diagnosis, fig=None) -> dict:
     """:func:`plot_profile` of every scanned unmodeled attachment of the cause, one above the other.
 
+    An unmodeled attachment of the cause without an informative scan
+    (:func:`unscanned`) gets no flat panel; the figure's title says so.
+
     Returns
     -------
-    dict with the figure and the :func:`plot_profile` results by effect (``panels``).
+    dict with the figure, the :func:`plot_profile` results by effect (``panels``) and the effects left
+    out (``unscanned``).
     """
     effects = list(profile_scans(diagnosis))
     if not effects:
@@ -177,4 +208,7 @@ def plot_profiles(diagnosis, fig=None) -> dict:
     fig = fig or new_figure(figsize=(9.5, 3.6 * len(effects)), layout="constrained")
     axes = np.atleast_1d(fig.subplots(len(effects), 1))
     panels = {e: plot_profile(diagnosis, e, ax) for e, ax in zip(effects, axes)}
-    return {"figure": fig, "panels": panels}
+    missing = unscanned(diagnosis)
+    if missing:
+        fig.suptitle(unscanned_sentence(missing), fontsize=8, color="0.3")
+    return {"figure": fig, "panels": panels, "unscanned": missing}

@@ -17,6 +17,7 @@ and returns a dict of what it drew so tests can inspect it.
 from __future__ import annotations
 
 import os
+import textwrap
 
 import numpy as np
 
@@ -185,24 +186,57 @@ def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
 
 
 def plot_errors(result, fig=None) -> dict:
-    """Errors |δ| before and |δ*| after the correction, per test and mode (bars, %)."""
-    fig = fig or new_figure(figsize=(max(6.0, 1.2 * sum(len(t.modes) for t in result.tests) / 2), 4),
-                         layout="constrained")
-    ax = fig.subplots()
-    labels, before, after = [], [], []
-    for t in result.tests:
-        for k, b, a in zip(t.modes, t.before_error, t.after_error):
-            labels.append(f"{t.name}\nmode {k}" if len(result.tests) > 1 else f"mode {k}")
-            before.append(abs(b))
-            after.append(abs(a))
-    x = np.arange(len(labels))
-    b1 = ax.bar(x - 0.2, before, 0.4, label=f"before (rms {result.rms_before:.2f} %)", color="tab:gray")
-    b2 = ax.bar(x + 0.2, after, 0.4, label=f"corrected (rms {result.rms_after:.2f} %)", color="tab:blue")
-    ax.set_xticks(x, labels, fontsize=7)
-    ax.set_ylabel("|error| (%)")
-    ax.set_title(f"{result.method}: {', '.join(result.names)}", fontsize=9)
-    ax.legend(fontsize=8)
-    return {"figure": fig, "axes": ax, "before": b1, "after": b2}
+    """Signed errors before and after the correction, per test and mode (bars, %), with the measurement's 1σ.
+
+    One panel per test (up to three side by side). The error is
+    (computed − measured) / measured × 100, so its sign shows on which side
+    each model lies; the whisker on each bar is ± one standard uncertainty
+    of the measured frequency in % of it (the error can be no better known).
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    fig : matplotlib.figure.Figure, optional
+
+    Returns
+    -------
+    dict with the figure, the axes (one per test), the bars ``before`` and
+    ``after`` (Rectangles, in test and mode order) and the ``errorbars``.
+    """
+    tests = list(result.tests)
+    ncols = min(3, len(tests))
+    nrows = -(-len(tests) // ncols)
+    width = max(7.5, 4.2 * ncols + 0.4)  # one test's panel alone is wide enough for the legend's one row
+    fig = fig or new_figure(figsize=(width, 2.6 * nrows + 0.7), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    before, after, errorbars = [], [], []
+    for i, (t, ax) in enumerate(zip(tests, axes)):
+        x = np.asarray(t.modes, float)
+        sigma = np.asarray(t.uncertainty, float) / np.asarray(t.measured, float) * 100.0
+        for errors, dx, colour, bars in ((t.before_error, -0.2, "tab:gray", before),
+                                         (t.after_error, 0.2, "tab:blue", after)):
+            drawn = ax.bar(x + dx, errors, 0.4, color=colour)
+            bars.extend(drawn.patches)
+            errorbars.append(ax.errorbar(x + dx, errors, yerr=sigma, fmt="none", ecolor="k", elinewidth=0.8,
+                                         capsize=2))
+        ax.axhline(0.0, color="0.4", lw=0.6)
+        ax.set_xticks(t.modes)
+        ax.set_title(f"{t.name}: rms {t.rms_before:.2f} % before, {t.rms_after:.2f} % corrected", fontsize=8)
+        ax.grid(True, axis="y", lw=0.3, alpha=0.6)
+        if i % ncols == 0:
+            ax.set_ylabel("error (%)")
+        if i >= len(tests) - ncols:
+            ax.set_xlabel("mode")
+    for ax in axes[len(tests):]:
+        ax.set_visible(False)
+    handles = [_patch("tab:gray", ""), _patch("tab:blue", ""), errorbars[0]]
+    labels = [f"before (rms {result.rms_before:.2f} %)", f"corrected (rms {result.rms_after:.2f} %)",
+              "± 1σ of the measured frequency"]
+    fig.legend(handles, labels, loc="outside lower center", ncols=3, fontsize=8, frameon=False)
+    fig.suptitle(textwrap.fill(f"{result.method}: {', '.join(result.names)} fitted; error = (computed − measured) "
+                               f"/ measured", int(12 * width)), fontsize=9)
+    return {"figure": fig, "axes": list(axes[:len(tests)]), "before": before, "after": after,
+            "errorbars": errorbars}
 
 
 def save_identify_figures(result, directory, lsq=None) -> list[str]:

@@ -17,7 +17,7 @@ import os
 import pandas as pd
 
 from ..core import files
-from ..core.formatting import STYLES, number, rms, table_lines
+from ..core.formatting import STYLES, number, plus_minus, rms, table_lines
 from ..identify.problem import printed_step
 
 
@@ -64,8 +64,8 @@ def _parameter_lines(result) -> list[list[str]]:
     for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
                               result.value_uncertainty):
         unit = p.unit
-        out.append([p.name, f"{x:.5g}", f"{s:.2g}", f"{number(p.nominal, '{:.5g}')} {unit}",
-                    f"{number(v, '{:.5g}')} ± {number(vs, '{:.5g}')} {unit}"])
+        out.append([p.name, f"{x:.5g}", f"{s:.2g}", plus_minus(p.nominal, None, unit, digits=5),
+                    plus_minus(v, vs, unit, digits=5)])
     return out
 
 

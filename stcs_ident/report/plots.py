@@ -18,7 +18,13 @@ def new_figure(**kwargs):
 
 
 def plot_test_spectra(spectra, fig=None) -> dict:
-    """Combined and per-channel spectra of one test, picked peaks labelled by mode.
+    """Combined and per-channel spectra of one test, picked peaks labelled by mode, the nominal model marked.
+
+    The upper panel is the combined spectrum: each channel's PSD divided by
+    its noise floor, averaged over the channels (1 where there is only
+    noise), on which peaks are picked. A blue triangle at its top marks each
+    frequency of the nominal model the peaks were numbered against, so that
+    how far the cable is from its model shows at a glance.
 
     Parameters
     ----------
@@ -27,14 +33,15 @@ def plot_test_spectra(spectra, fig=None) -> dict:
 
     Returns
     -------
-    dict with the figure, both axes, the spectrum lines and the peak labels
-    (``labels``: list of matplotlib Text, one per picked peak).
+    dict with the figure, both axes, the spectrum lines, the peak labels
+    (``labels``: list of matplotlib Text, one per picked peak) and the
+    nominal model's markers (``nominal``: Line2D, or None without them).
     """
     fig = fig or new_figure(figsize=(10, 6.5), layout="constrained")
     ax_c, ax_ch = fig.subplots(2, 1, sharex=True)
     result = spectra.peaks
     f = result.frequency_axis
-    combined = ax_c.semilogy(f, result.combined_spectrum, color="k", lw=0.8, label="combined")[0]
+    combined = ax_c.semilogy(f, result.combined_spectrum, color="k", lw=0.8, label="combined spectrum")[0]
     channel_lines = []
     names = [n for n in result.channel_names] if hasattr(result, "channel_names") else None
     for i in range(result.channel_spectra.shape[1]):
@@ -52,13 +59,29 @@ def plot_test_spectra(spectra, fig=None) -> dict:
     if len(top):
         low, high = ax_c.get_ylim()
         ax_c.set_ylim(low, max(high, 3.0 * float(np.max(top))))  # headroom for the labels on a log axis
-    ax_c.set_ylabel("combined spectrum")
+    nominal = _nominal_markers(ax_c, spectra, f)
+    ax_c.set_ylabel("combined spectrum\n(PSD / noise floor, channel mean)")
     ax_c.set_title(f"{spectra.name}: {len(spectra.modes)} modes picked ({result.kind}); "
-                   "red = mode number, orange ? = doubtful, dotted = unassigned", fontsize=9)
+                   "red = mode number, orange ? = doubtful, dotted = unassigned"
+                   + ("; blue ▼ = nominal model" if nominal is not None else ""), fontsize=9)
     ax_ch.set_ylabel("channel PSD (m/s²)²/Hz")
     ax_ch.set_xlabel("frequency (Hz)")
     ax_ch.legend(fontsize=7, ncols=4, loc="upper right")
-    return {"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels}
+    return {"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels,
+            "nominal": nominal}
+
+
+def _nominal_markers(ax, spectra, f):
+    """Triangles at the top of ``ax`` at the nominal model's frequencies inside the plotted band (or None)."""
+    nominal = getattr(spectra, "nominal_frequencies", None)
+    if nominal is None or not len(f):
+        return None
+    shown = np.asarray(nominal, float)
+    shown = shown[(shown >= f[0]) & (shown <= f[-1])]
+    if not shown.size:
+        return None
+    return ax.plot(shown, np.full(shown.size, 0.97), "v", color="tab:blue", ms=6,
+                   transform=ax.get_xaxis_transform(), label="nominal model's frequencies")[0]
 
 
 def save_figure(fig, path) -> None:

@@ -17,8 +17,12 @@ import numpy as np
 import pandas as pd
 
 from ..core.files import write_atomic, write_csv, write_figure
+from .plots import new_figure
 
-__all__ = ["records_csv_table", "write_report"]
+__all__ = ["plot_cable_history", "records_csv_table", "write_report"]
+
+#: Markers of the frequency panel, one per ten modes (the colours repeat every ten: tab10).
+MODE_MARKERS = (".", "x", "+", "1", "d")
 
 
 def write_report(result, out: str | Path | None = None) -> Path:
@@ -38,7 +42,7 @@ def write_report(result, out: str | Path | None = None) -> Path:
     write_csv(events, out / "events.csv", index=False)
     for spec in result.specs:
         rows, history = result.histories[spec.name]
-        write_figure(_figure(spec, result.table, rows, history), out / f"{spec.name}.png")
+        write_figure(plot_cable_history(spec, result.table, rows, history)["figure"], out / f"{spec.name}.png")
     write_atomic(out / "report.md", _markdown(result.summary(), cables, events))
     return out
 
@@ -58,10 +62,25 @@ def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     return plain
 
 
-def _figure(spec, table: pd.DataFrame, rows, history):
-    from matplotlib.figure import Figure
+def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> dict:
+    """One cable's history: tension (identified, normalised, level, events), temperature, frequency / mode.
 
-    fig = Figure(figsize=(10, 7.5), layout="constrained")
+    Parameters
+    ----------
+    spec : the cable's specification in the run (``name``, ``campaign``, ``reference_tension``)
+    table : DataFrame
+        One row per record (``start_time``, ``tension``, ``tension_sigma``,
+        ``level``, ``temperature``, ``modes``, ``frequencies``).
+    rows : the labels of this cable's rows in ``table``
+    history : the cable's tension history (``normalised``, ``mean_temperature``, ``events``)
+    fig : matplotlib.figure.Figure, optional
+
+    Returns
+    -------
+    dict with the figure, the three axes (``axes``: tension, temperature, frequency) and the frequency
+    panel's lines by mode (``modes``: {mode: Line2D}); past mode 10 the colours repeat with another marker.
+    """
+    fig = fig or new_figure(figsize=(10, 7.5), layout="constrained")
     top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.2, 2))
     data = table.loc[rows]
     t = data["start_time"].dt.tz_convert(None) if len(data) else data["start_time"]
@@ -85,16 +104,21 @@ def _figure(spec, table: pd.DataFrame, rows, history):
         middle.plot(t, data["temperature"], "-", color="tab:green", lw=0.8)
     middle.set_ylabel("temperature (°C)")
     modes = sorted({m for ms in data["modes"] for m in ms})
-    for mode in modes:
+    colours = [f"C{i}" for i in range(10)]
+    drawn = {}
+    for i, mode in enumerate(modes):
         pairs = [(time, f[list(ms).index(mode)]) for time, ms, f in zip(t, data["modes"], data["frequencies"])
                  if mode in list(ms)]
         times, freq = zip(*pairs)
-        bottom.plot(times, np.asarray(freq) / mode, ".", ms=2, label=f"mode {mode}")
+        marker = MODE_MARKERS[(i // 10) % len(MODE_MARKERS)]
+        drawn[mode] = bottom.plot(times, np.asarray(freq) / mode, marker, color=colours[i % 10],
+                                  ms=2 if marker == "." else 3, mew=0.6, label=f"mode {mode}")[0]
     bottom.set_ylabel("frequency / mode number (Hz)")
     bottom.set_xlabel("time (UTC)")
     if modes:
-        bottom.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=7, ncol=1 + len(modes) // 12)
-    return fig
+        bottom.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=7, ncol=1 + len(modes) // 12,
+                      markerscale=2)
+    return {"figure": fig, "axes": (top, middle, bottom), "modes": drawn}
 
 
 def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:

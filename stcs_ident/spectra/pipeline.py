@@ -47,6 +47,8 @@ class TestSpectra(Result):
     unassigned : (frequency, uncertainty) of peaks left without a number
     dropped : (channel, reason) removed when the record was read
     peaks, numbering : the full intermediate results (for plots)
+    nominal_frequencies : the nominal model's frequencies of modes 1, 2, ... that the peaks were numbered
+        against (Hz; for plots), or None
     """
 
     __test__ = False
@@ -64,6 +66,7 @@ class TestSpectra(Result):
     peaks: PeakResult
     numbering: Numbering
     damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
+    nominal_frequencies: np.ndarray | None = None
 
     main_table = "modes"
 
@@ -163,6 +166,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         dropped=tuple(record.dropped), peaks=result, numbering=numbering,
         damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
                                       for i in order]),
+        nominal_frequencies=np.asarray(nominal, float),
     )
 
 

@@ -1,0 +1,99 @@
+"""What the figures show, drawn from small stand-ins for the results (no fit is run).
+
+Each figure function returns what it drew; these tests check the defects of
+issue 21 stay fixed: the residuals legend inside the figure for one test,
+the nominal model marked on the spectra, a flat profile scan left out,
+track's modes told apart past ten.
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+from stcs_ident.report import diagnose_figures
+from stcs_ident.report.plots import plot_test_spectra
+from stcs_ident.report.track import plot_cable_history
+
+
+def _inside(artist, fig) -> bool:
+    """Whether ``artist``'s drawn extent lies within the figure's (pixels, one pixel of slack for rounding)."""
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    box, page = artist.get_window_extent(canvas.get_renderer()), fig.bbox
+    return box.x0 >= page.x0 - 1 and box.x1 <= page.x1 + 1 and box.y0 >= page.y0 - 1 and box.y1 <= page.y1 + 1
+
+
+def _diagnosis(n_tests: int):
+    """A stand-in for a Diagnosis with ``n_tests`` tests of 6 modes and three distinct models."""
+    modes = np.arange(1, 7)
+    measured = [SimpleNamespace(name=f"T{i}", modes=modes, frequencies=7.0 * modes, uncertainty=np.full(6, 0.003),
+                                test=SimpleNamespace(setup="bare", tension=1.2e6)) for i in range(n_tests)]
+    fits = {key: SimpleNamespace(name=key, scale=scale) for key, scale in
+            (("nominal", 1.01), ("baseline", 1.005), ("corrected", 1.001))}
+    return SimpleNamespace(measurements=measured, nominal=fits["nominal"], baseline=fits["baseline"],
+                           corrected=fits["corrected"],
+                           per_test=lambda fit: [fit.scale * m.frequencies for m in measured])
+
+
+def test_residuals_legend_is_inside_the_figure_for_one_test():
+    drawn = diagnose_figures.plot_residuals(_diagnosis(1))
+    fig = drawn["figure"]
+    (legend,) = fig.legends
+    assert len(legend.get_texts()) == 4 and _inside(legend, fig)
+
+
+def test_a_flat_profile_scan_is_left_out_and_said(monkeypatch):
+    """The support's scan moves χ² by 0.015 along the span (as han2020's does): no panel, a sentence instead."""
+    monkeypatch.setattr(diagnose_figures.registry, "get",
+                        lambda name: SimpleNamespace(unmodeled=name.startswith("unmodeled"), noun=name.split("_")[-1]))
+    x = np.linspace(0.6, 8.7, 8)
+    mass = SimpleNamespace(effects=("unmodeled_mass",), profile=list(zip(x, 7e4 + 2e4 * (x - 5.2) ** 2)))
+    support = SimpleNamespace(effects=("unmodeled_support",), profile=list(zip(x, 246178.64 + 0.002 * x)))
+    d = SimpleNamespace(selection=SimpleNamespace(effects=("unmodeled_mass", "unmodeled_support")),
+                        corrected=SimpleNamespace(effects=("unmodeled_mass", "unmodeled_support"),
+                                                  profile=mass.profile),
+                        fits={("unmodeled_support",): support})
+    assert list(diagnose_figures.profile_scans(d)) == ["unmodeled_mass"]
+    assert diagnose_figures.unscanned(d) == ["unmodeled_support"]
+    assert "support" in diagnose_figures.unscanned_sentence(["unmodeled_support"])
+    support.profile = list(zip(x, 246178.64 + 0.5 * x))  # a change of 4 in χ² along the span is information
+    assert list(diagnose_figures.profile_scans(d)) == ["unmodeled_mass", "unmodeled_support"]
+
+
+def _spectra():
+    f = np.linspace(0.0, 50.0, 2001)
+    peaks = [7.1, 14.3, 21.6]
+    combined = 1.0 + sum(100.0 / (1.0 + ((f - p) / 0.05) ** 2) for p in peaks)
+    result = SimpleNamespace(frequency_axis=f, combined_spectrum=combined, channel_spectra=np.c_[combined, combined],
+                             channel_names=["A1", "A2"], kind="impulse")
+    return SimpleNamespace(name="T1", peaks=result, modes=(1, 2, 3), frequencies=np.array(peaks),
+                           doubtful=(False, False, False), unassigned=(),
+                           nominal_frequencies=np.array([7.0, 14.1, 21.3, 28.7, 36.2, 51.0]))
+
+
+def test_spectra_mark_the_nominal_model_and_label_the_combined_axis():
+    drawn = plot_test_spectra(_spectra())
+    # the nominal frequencies inside the plotted band (0-50 Hz), not the one at 51 Hz
+    np.testing.assert_array_equal(drawn["nominal"].get_xdata(), [7.0, 14.1, 21.3, 28.7, 36.2])
+    assert "noise floor" in drawn["axes"][0].get_ylabel()
+
+
+def test_spectra_without_nominal_frequencies_draw_no_markers():
+    spectra = _spectra()
+    spectra.nominal_frequencies = None
+    assert plot_test_spectra(spectra)["nominal"] is None
+
+
+def test_track_modes_past_ten_keep_distinct_colour_and_marker():
+    n, modes = 24, tuple(range(1, 15))
+    t = pd.date_range("2026-03-01", periods=n, freq="h", tz="UTC")
+    table = pd.DataFrame({"start_time": t, "tension": 1.3e6, "tension_sigma": 2e3, "level": 1.3e6,
+                          "temperature": 12.0, "modes": [modes] * n,
+                          "frequencies": [tuple(3.1 * k for k in modes)] * n})
+    history = SimpleNamespace(normalised=table["tension"].to_numpy(), mean_temperature=12.0, events=[])
+    spec = SimpleNamespace(name="C1", reference_tension=1.3e6, campaign=SimpleNamespace(cable=SimpleNamespace(EI=5e5)))
+    drawn = plot_cable_history(spec, table, table.index, history)
+    styles = [(line.get_color(), line.get_marker()) for line in drawn["modes"].values()]
+    assert len(styles) == 14 and len(set(styles)) == 14
