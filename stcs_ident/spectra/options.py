@@ -584,8 +584,8 @@ class PickingOptions:
         for key, value in changes.items():
             group, _, name = str(key).partition(".")
             if group not in _GROUPS or name not in {f.name for f in fields(_GROUPS[group])}:
-                raise InputError(f"is not a picking option (options are named 'group.option', e.g. "
-                                 f"'detection.false_alarm')", field=str(key))
+                raise InputError("is not a picking option (options are named 'group.option', e.g. "
+                                 "'detection.false_alarm')", field=str(key))
             groups.setdefault(group, {})[name] = value
         return replace(self, **{g: replace(getattr(self, g), **v) for g, v in groups.items()})
 
