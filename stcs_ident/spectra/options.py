@@ -593,6 +593,24 @@ class PickingOptions:
         """Plain data for JSON: ``{group: {option: value}}`` (tuples as lists)."""
         return _plain(asdict(self))
 
+    @classmethod
+    def from_summary(cls, data: Mapping[str, Mapping[str, object]]) -> PickingOptions:
+        """The options of a :meth:`summary` (as read back from JSON): a result's options rebuilt, to rerun it.
+
+        Groups or options left out keep their defaults; an unknown name is refused.
+        """
+        changes: dict[str, object] = {}
+        for group, values in data.items():
+            if group not in _GROUPS or not isinstance(values, Mapping):
+                raise InputError("is not a group of picking options", field=str(group))
+            for name, value in values.items():
+                if name in ("fine", "coarse") and group == "events" and isinstance(value, Mapping):
+                    value = OnsetScale(**value)
+                elif isinstance(value, list):
+                    value = tuple(value)
+                changes[f"{group}.{name}"] = value
+        return cls().with_values(changes)
+
 
 def _plain(value):
     if isinstance(value, dict):
