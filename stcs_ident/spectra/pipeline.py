@@ -180,13 +180,13 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
 
 
 def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, progress=None,
-                     tension_model: str = "uniform") -> list[TestSpectra]:
-    """:func:`analyse_test` for every selected test that has a record."""
+                     tension_model: str = "uniform", options: PickingOptions | None = None) -> list[TestSpectra]:
+    """:func:`analyse_test` for every selected test that has a record (with the same ``options``)."""
     selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
     with_record = [t for t in selected if t.record is not None]
     out = []
     for k, test in enumerate(with_record, 1):
         if progress is not None:
             progress(f"spectra: test {test.name} ({k} of {len(with_record)})")
-        out.append(analyse_test(campaign, test, tension_model=tension_model))
+        out.append(analyse_test(campaign, test, tension_model=tension_model, options=options))
     return out
