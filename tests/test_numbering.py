@@ -85,7 +85,8 @@ def _assign_reference(f, sigma, family, unassigned):
 def test_the_row_at_once_assignment_equals_the_recurrence_mode_by_mode():
     """assign takes each row of its dynamic programme at once (a running minimum along the modes); on random
     peaks and families, ties included (integer frequencies), it gives the same modes and cost."""
-    from stcs_ident.spectra.numbering import UNASSIGNED_COST, assign
+    from stcs_ident.spectra.numbering import assign
+    from stcs_ident.spectra.options import NumberingOptions
 
     rng = np.random.default_rng(3)
     for trial in range(200):
@@ -96,5 +97,5 @@ def test_the_row_at_once_assignment_equals_the_recurrence_mode_by_mode():
             f, family = np.round(f), np.round(family)
         sigma = rng.uniform(0.5, 3.0, n)
         modes, cost = assign(f, sigma, family[None, :])
-        expected_modes, expected_cost = _assign_reference(f, sigma, family, UNASSIGNED_COST)
+        expected_modes, expected_cost = _assign_reference(f, sigma, family, NumberingOptions().unassigned_cost)
         assert list(modes[0]) == expected_modes and cost[0] == expected_cost

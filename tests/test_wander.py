@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
+from stcs_ident.spectra.options import FitOptions
 from stcs_ident.spectra.wander import (
-    HETEROGENEITY_LEVEL,
     between_events_addition,
     common_wander,
     with_common_wander,
@@ -47,7 +47,7 @@ def test_agreeing_events_add_nothing_most_of_the_time():
     rng = np.random.default_rng(1)
     fired = np.mean([common_wander(_draw(rng, 3, 0.0, 1e-5)[0]) > 0 for _ in range(400)])
     # The test's level, with the binomial scatter of 400 draws (3σ = 0.033).
-    assert fired <= HETEROGENEITY_LEVEL + 0.035
+    assert fired <= FitOptions().heterogeneity_level + 0.035
 
 
 def test_common_wander_restores_coverage_per_mode_tests_miss():

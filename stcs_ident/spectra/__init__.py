@@ -6,7 +6,8 @@
   and :func:`to_sep005` (SDyPy SEP005), all with the same checks
   (:mod:`.validation`, dead and clipped channels dropped by :mod:`.screening`);
 - :func:`find_peaks`: modal frequencies, damping and uncertainties from a
-  record (:class:`PeakResult`, :class:`Peak`);
+  record (:class:`PeakResult`, :class:`Peak`), tuned by :class:`PickingOptions`
+  (recorded in the result);
 - :func:`number_modes`: mode numbers from the nominal model's family
   (:class:`Numbering`);
 - :func:`analyse_test`, :func:`analyse_campaign`: record → checks → peaks →
@@ -20,11 +21,12 @@ from ..io.records.hdf5 import write_record
 from ..io.records.sep005 import from_sep005, to_sep005
 from ..io.records.validation import check_duration, check_positions
 from .numbering import Numbering, number_modes
+from .options import PickingOptions
 from .peaks import Peak, PeakResult, find_peaks
 from .pipeline import TestSpectra, analyse_campaign, analyse_test
 
 __all__ = [
-    "Numbering", "Peak", "PeakResult", "Record", "TestSpectra", "analyse_campaign", "analyse_test", "check_duration",
-    "check_positions", "find_peaks", "from_sep005", "number_modes", "read_record", "record_from_csv", "to_sep005",
-    "write_record",
+    "Numbering", "Peak", "PeakResult", "PickingOptions", "Record", "TestSpectra", "analyse_campaign", "analyse_test",
+    "check_duration", "check_positions", "find_peaks", "from_sep005", "number_modes", "read_record", "record_from_csv",
+    "to_sep005", "write_record",
 ]

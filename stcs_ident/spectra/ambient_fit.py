@@ -51,11 +51,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .decay_fit import pole_statistics
+from .options import FitOptions
 
 __all__ = ["AmbientFit", "fit_ambient"]
 
-MAX_ITERATIONS = 60
-DAMPING_GRID = np.logspace(-4.0, -1.0, 7)
+# The iterations and the start's ζ grid are :class:`.options.FitOptions`.
 _TINY = np.finfo(float).tiny
 SERIAL_BLAS_SIZE = 2048  # elements: OpenBLAS runs a complex matrix-vector product this small on one thread
 
@@ -262,14 +262,15 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     return step
 
 
-def _scoring(theta: np.ndarray, problem: _Problem, limits) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+def _scoring(theta: np.ndarray, problem: _Problem, limits,
+             max_iterations: int) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
     """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits).
 
     Returns θ, whether it converged, and the expected periodogram and its gradient at θ.
     """
     mean, grad = _expected(theta, problem)
     nll = _neg_log_likelihood(mean, problem.periodogram)
-    for _ in range(MAX_ITERATIONS):
+    for _ in range(max_iterations):
         score = grad.T @ ((problem.periodogram - mean) / mean**2)
         fisher = _fisher(grad, mean)
         if not (np.all(np.isfinite(fisher)) and np.all(np.isfinite(score))):
@@ -356,6 +357,7 @@ def fit_ambient(
     neighbours: list[tuple[float, float]] = (),
     peak_width: float = 0.0,
     max_damping: float = 0.2,
+    options: FitOptions | None = None,
 ) -> AmbientFit | None:
     """Fit one mode to the band [f_initial ± half_width] of an ambient record.
 
@@ -380,12 +382,15 @@ def fit_ambient(
         Approximate -3 dB width of the peak, Hz (bins used for the mode shape).
     max_damping : float
         Upper bound on ζ during the search.
+    options : FitOptions, optional
+        Iterations and the start's ζ grid (default: the calibrated values).
 
     Returns
     -------
     AmbientFit or None
         None when the fit leaves the band.
     """
+    options = FitOptions() if options is None else options
     dt = 1.0 / sampling_rate
     df = sampling_rate / n_samples
     k = np.arange(max(1, int(np.ceil((f_initial - half_width) / df))), int(np.floor((f_initial + half_width) / df)) + 1)
@@ -411,8 +416,8 @@ def fit_ambient(
         (f_initial - half_width, f_initial + half_width),
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
     )
-    theta = _grid_start(starts, problem, limits)
-    theta, ok, mean, grad = _scoring(theta, problem, limits)
+    theta = _grid_start(starts, problem, limits, options.ambient_start_damping)
+    theta, ok, mean, grad = _scoring(theta, problem, limits, options.ambient_max_iterations)
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
     try:
@@ -446,11 +451,11 @@ def _smoothed_peak(periodogram: np.ndarray, freq: np.ndarray, width: float) -> f
     return float(freq[int(np.argmax(smooth))])
 
 
-def _grid_start(starts: list[float], problem: _Problem, limits) -> np.ndarray:
-    """The best (least -log-likelihood) of the starting frequencies × DAMPING_GRID, linear terms fitted."""
+def _grid_start(starts: list[float], problem: _Problem, limits, damping_grid) -> np.ndarray:
+    """The best (least -log-likelihood) of the starting frequencies × `damping_grid` (ζ), linear terms fitted."""
     best, best_nll = None, np.inf
     for f_start in starts:
-        for zeta in DAMPING_GRID:
+        for zeta in damping_grid:
             theta_nl = np.array([f_start, zeta * 2 * np.pi * f_start])
             if not limits[1][0] < theta_nl[1] < limits[1][1]:
                 continue

@@ -49,12 +49,12 @@ import numpy as np
 from scipy import stats
 
 from .decay_covariance import forced_response_covariance
+from .options import FitOptions
 from .wander import between_events_addition
 
 __all__ = ["DecayFit", "EventSpectrum", "event_spectra", "fit_decay", "pole_statistics"]
 
-MAX_ITERATIONS = 40
-DAMPING_GRID = np.concatenate([[0.0], np.logspace(-4.5, -1.0, 15)])
+# The iterations, the start's ζ grid and the events' agreement test are :class:`.options.FitOptions`.
 
 
 @dataclass(frozen=True)
@@ -224,11 +224,11 @@ def _normal_equations(state: _State, weights: np.ndarray) -> tuple[np.ndarray, n
     return jtj, jtr
 
 
-def _levenberg_marquardt(theta, bands, dt, weights, limits) -> tuple[np.ndarray, _State, bool]:
+def _levenberg_marquardt(theta, bands, dt, weights, limits, max_iterations: int) -> tuple[np.ndarray, _State, bool]:
     state = _evaluate(theta, bands, dt, weights, with_jacobian=True)
     n_data = sum(b.dft.size for b in bands)
     mu = 1e-3
-    for _ in range(MAX_ITERATIONS):
+    for _ in range(max_iterations):
         jtj, jtr = _normal_equations(state, weights)
         scale = np.sqrt(np.maximum(np.diag(jtj), np.finfo(float).tiny))
         step = np.linalg.solve(jtj / np.outer(scale, scale) + mu * np.eye(2), jtr / scale) / scale
@@ -256,9 +256,9 @@ def _noise_variance(state: _State, n_params: int) -> np.ndarray:
     return np.maximum(rss / dof, np.finfo(float).tiny)
 
 
-def _initial_decay_rate(f0, bands, dt, weights, sigma_limits) -> float:
+def _initial_decay_rate(f0, bands, dt, weights, sigma_limits, damping_grid) -> float:
     best, best_cost = 0.0, np.inf
-    for zeta in DAMPING_GRID:
+    for zeta in damping_grid:
         sigma = zeta * 2 * np.pi * f0
         if not sigma_limits[0] < sigma < sigma_limits[1]:
             continue
@@ -276,6 +276,7 @@ def fit_decay(
     neighbours: list[tuple[float, float]] = (),
     max_damping: float = 0.2,
     min_damping: float = 0.0,
+    options: FitOptions | None = None,
 ) -> DecayFit | None:
     """Fit one mode (common f, σ) to the band [f_initial ± half_width] of the free-decay DFTs.
 
@@ -296,12 +297,17 @@ def fit_decay(
     min_damping : float
         Lower bound on ζ (0: a slightly growing pole is allowed, so that an
         undamped line is fitted without a bound in the way).
+    options : FitOptions, optional
+        Iterations, the start's ζ grid and the events' agreement test
+        (default: the calibrated values).
 
     Returns
     -------
     DecayFit or None
         None when the fit leaves the band or the information matrix is singular.
     """
+    options = FitOptions() if options is None else options
+    iterations = options.decay_max_iterations
     dt = 1.0 / sampling_rate
     all_bands = _bands(spectra, f_initial, half_width, dt, neighbours)
     used = [b.dft.shape[0] > b.background.shape[1] + 2 for b in all_bands]
@@ -314,11 +320,12 @@ def fit_decay(
     sigma_min = min_damping * 2 * np.pi * f_initial if min_damping > 0 else -0.05 * sigma_max
     limits = ((f_initial - half_width, f_initial + half_width), (sigma_min, sigma_max))
     weights = np.ones(n_channels)
-    theta = np.array([f_initial, _initial_decay_rate(f_initial, bands, dt, weights, limits[1])])
-    theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits)
+    start = _initial_decay_rate(f_initial, bands, dt, weights, limits[1], options.decay_start_damping)
+    theta = np.array([f_initial, start])
+    theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits, iterations)
     noise_var = _noise_variance(state, n_params)
     weights = 1.0 / noise_var
-    theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits)
+    theta, state, ok = _levenberg_marquardt(theta, bands, dt, weights, limits, iterations)
     noise_var = _noise_variance(state, n_params)
     weights = 1.0 / noise_var
     try:
@@ -330,8 +337,9 @@ def fit_decay(
     event_f = np.full(len(all_bands), np.nan) if len(spectra) > 1 else np.zeros(0)
     event_v = event_f.copy()
     if len(bands) > 1:
-        event_f[np.flatnonzero(used)], event_v[np.flatnonzero(used)] = _event_estimates(theta, bands, dt, weights, limits)
-        cov[0, 0] += between_events_addition(event_f, event_v, cov[0, 0])
+        event_f[np.flatnonzero(used)], event_v[np.flatnonzero(used)] = _event_estimates(theta, bands, dt, weights,
+                                                                                        limits, iterations)
+        cov[0, 0] += between_events_addition(event_f, event_v, cov[0, 0], options.heterogeneity_level)
     fit = _result(theta, cov, state, bands, dt, noise_var, ok, forced_ratio)
     return replace(fit, event_frequencies=event_f, event_variances=event_v)
 
@@ -345,12 +353,13 @@ def _covariance(theta, bands: list[_Band], dt: float, weights: np.ndarray) -> tu
     return (*forced_response_covariance(z, columns, state, bands, weights, jtj), state)
 
 
-def _event_estimates(theta, bands: list[_Band], dt: float, weights: np.ndarray, limits) -> tuple[np.ndarray, np.ndarray]:
+def _event_estimates(theta, bands: list[_Band], dt: float, weights: np.ndarray, limits,
+                     max_iterations: int) -> tuple[np.ndarray, np.ndarray]:
     """Each band's own fit of the mode from the joint one: f_d (Hz) and its variance (NaN where it fails)."""
     f, v = np.full(len(bands), np.nan), np.full(len(bands), np.nan)
     for i, band in enumerate(bands):
         try:
-            t, _, ok = _levenberg_marquardt(theta.copy(), [band], dt, weights, limits)
+            t, _, ok = _levenberg_marquardt(theta.copy(), [band], dt, weights, limits, max_iterations)
             if not ok:
                 continue
             c, _, _ = _covariance(t, [band], dt, weights)

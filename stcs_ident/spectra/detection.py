@@ -20,7 +20,7 @@ Detection
 
     Free decays are looked at in several resolutions
     (:func:`.overview.decay_overviews`, :func:`detect_multiresolution`): the
-    whole-event periodogram, the same averaged over SMOOTHING cells (weak,
+    whole-event periodogram, the same averaged over a few cells (weak,
     heavily damped modes), and full-Hann windows over the first L samples
     of each event, L = N/4, N/16, … (modes decaying in a small part of the
     event; weak modes on the 1/f² skirts of strong ones). The false-alarm
@@ -42,17 +42,17 @@ import numpy as np
 from scipy import ndimage, signal, special
 
 from .floor import floor_log_variance
+from .options import DetectionOptions, FloorOptions
 from .overview import Overview
 
 __all__ = ["Candidate", "detect_multiresolution", "detect_peaks", "detection_threshold", "peak_candidate"]
 
-FALSE_ALARM = 1e-4  # nominal, per record (measured rates in the module docstring)
-RIPPLE_FALSE_ALARM = 0.5  # per record: ripple bumps that pass the prominence test (the fit rejects them)
-SEPARATION_PROBABILITY = 0.01  # a valley deeper than ripple makes with this probability separates two resonances
+# The probabilities (false alarm, ripple, separation) are :class:`.options.DetectionOptions`.
 
 
 def detection_threshold(
-    overview: Overview, n_cells: int, per_channel: bool = False, false_alarm: float = FALSE_ALARM
+    overview: Overview, n_cells: int, false_alarm: float, per_channel: bool = False, *,
+    floor_options: FloorOptions | None = None,
 ) -> np.ndarray:
     """Height over the floor (per bin) that pure noise exceeds somewhere with probability `false_alarm` / 2.
 
@@ -64,23 +64,25 @@ def detection_threshold(
     :func:`.floor.floor_log_variance`, divided by the number of channels
     whose floors average (d / dof), and the quantile is solved for over
     that spread (Gauss–Hermite quadrature). Tabulated on a grid of d and
-    interpolated.
+    interpolated. `floor_options`: how the floor was estimated (default:
+    the calibrated values).
     """
     n_channels = overview.channel_spectra.shape[1]
     per_cell = 0.5 * false_alarm / max(n_cells, 1) / (n_channels if per_channel else 1)
     dof = overview.channel_dof if per_channel else overview.combined_dof
     grid = np.geomspace(dof.min(), dof.max(), 24) if dof.max() > dof.min() else dof[:1]
     floor_dof = overview.dof if overview.floor_dof is None else overview.floor_dof
-    table = _threshold_with_floor_error(grid, overview.dof, per_cell, floor_dof)
+    table = _threshold_with_floor_error(grid, overview.dof, per_cell, floor_dof, floor_options)
     return np.interp(dof, grid, table) if grid.size > 1 else np.full(dof.shape, table[0])
 
 
 def _threshold_with_floor_error(
-    dof: np.ndarray, channel_dof: float, probability: float, floor_dof: float | None = None
+    dof: np.ndarray, channel_dof: float, probability: float, floor_dof: float | None = None,
+    floor_options: FloorOptions | None = None,
 ) -> np.ndarray:
     """t with E_F[P(χ²_d / d > t F)] = probability for each d in `dof`, log F normal (see detection_threshold)."""
     floor_dof = channel_dof if floor_dof is None else floor_dof
-    log_floor_var = floor_log_variance(floor_dof) / np.maximum(dof / channel_dof, 1.0)
+    log_floor_var = floor_log_variance(floor_dof, floor_options) / np.maximum(dof / channel_dof, 1.0)
     nodes, weights = np.polynomial.hermite_e.hermegauss(16)
     weights = weights / weights.sum()
     shifts = np.exp(np.sqrt(log_floor_var)[:, None] * nodes[None, :])  # (grid, nodes)
@@ -141,7 +143,8 @@ class Candidate:
 
 
 def detect_peaks(
-    overview: Overview, f_min: float, f_max: float, min_snr_db: float | None = None, share: float = 1.0
+    overview: Overview, f_min: float, f_max: float, min_snr_db: float | None = None, share: float = 1.0, *,
+    options: DetectionOptions | None = None, floor_options: FloorOptions | None = None,
 ) -> tuple[list[Candidate], np.ndarray]:
     """Peaks within [f_min, f_max] (see the module docstring).
 
@@ -149,8 +152,10 @@ def detect_peaks(
     channels of spectrum / floor (sensitive when all channels see a mode)
     and the largest single channel's (sensitive when only one does, where
     the mean would dilute it C times). `share` is the fraction of the
-    record's false-alarm budgets (FALSE_ALARM, RIPPLE_FALSE_ALARM) given to
-    this overview (:func:`detect_multiresolution` splits them).
+    record's false-alarm budgets (``options.false_alarm``,
+    ``options.ripple_false_alarm``) given to this overview
+    (:func:`detect_multiresolution` splits them). `options`,
+    `floor_options`: default the calibrated values.
 
     Returns
     -------
@@ -164,17 +169,19 @@ def detect_peaks(
     lo = max(int(np.ceil(f_min / df)), 3 * overview.cell)
     hi = min(int(np.floor(f_max / df)), f.size - 2)
     n_cells = max(hi - lo, 1) // overview.cell
-    false_alarm = share * FALSE_ALARM
+    options = DetectionOptions() if options is None else options
+    false_alarm = share * options.false_alarm
     statistics = [
         (
             overview.combined / overview.combined_floor,
-            detection_threshold(overview, n_cells, false_alarm=false_alarm),
+            detection_threshold(overview, n_cells, false_alarm, floor_options=floor_options),
             overview.combined_dof,
         )
     ]
     if overview.channel_spectra.shape[1] > 1:
         largest = np.max(overview.channel_spectra / overview.channel_floor, axis=1)
-        per_channel = detection_threshold(overview, n_cells, per_channel=True, false_alarm=false_alarm)
+        per_channel = detection_threshold(overview, n_cells, false_alarm, per_channel=True,
+                                          floor_options=floor_options)
         statistics.append((largest, per_channel, overview.channel_dof))
     if min_snr_db is not None:
         statistics = [(r, np.maximum(t, 10 ** (min_snr_db / 10)), d) for r, t, d in statistics]
@@ -182,13 +189,14 @@ def detect_peaks(
         return [], statistics[0][1]
     candidates = []
     for ratio, t, dof in statistics:
-        index = _exceedances(overview, ratio, t, dof, lo, hi, n_cells / share)
+        index = _exceedances(overview, ratio, t, dof, lo, hi, n_cells / share, options.ripple_false_alarm)
         candidates += [peak_candidate(overview, ratio, int(k), t[k], dof[k]) for k in index]
-    return _suppress_shoulders(overview, candidates), statistics[0][1]
+    return _suppress_shoulders(overview, candidates, options.separation_probability), statistics[0][1]
 
 
 def detect_multiresolution(
-    overviews: list[Overview], f_min: float, f_max: float, min_snr_db: float | None = None
+    overviews: list[Overview], f_min: float, f_max: float, min_snr_db: float | None = None, *,
+    options: DetectionOptions | None = None, floor_options: FloorOptions | None = None,
 ) -> tuple[list[Candidate], np.ndarray]:
     """Peaks of several overviews of one record (finest first), on the first one's frequency grid.
 
@@ -198,6 +206,7 @@ def detect_multiresolution(
     (it is a resonance the finer overviews did not see), carried over to
     the first overview's nearest bin with its own frequency, height and
     width (its ``spectrum`` becomes the first overview's combined one).
+    `options`, `floor_options`: as :func:`detect_peaks`.
 
     Returns
     -------
@@ -207,11 +216,13 @@ def detect_multiresolution(
         The first overview's threshold on the combined spectrum.
     """
     share = 1.0 / len(overviews)
-    candidates, threshold = detect_peaks(overviews[0], f_min, f_max, min_snr_db, share)
+    candidates, threshold = detect_peaks(overviews[0], f_min, f_max, min_snr_db, share, options=options,
+                                         floor_options=floor_options)
     frequency = overviews[0].frequency
     combined = overviews[0].combined / overviews[0].combined_floor
     for overview in overviews[1:]:
-        extra, _ = detect_peaks(overview, f_min, f_max, min_snr_db, share)
+        extra, _ = detect_peaks(overview, f_min, f_max, min_snr_db, share, options=options,
+                                floor_options=floor_options)
         for c in extra:
             if all(abs(c.frequency - k.frequency) > max(c.half_power_width, k.half_power_width) for k in candidates):
                 index = int(np.argmin(np.abs(frequency - c.frequency)))
@@ -219,7 +230,8 @@ def detect_multiresolution(
     return sorted(candidates, key=lambda c: c.frequency), threshold
 
 
-def _exceedances(overview: Overview, ratio, t, dof, lo: int, hi: int, n_cells: float) -> np.ndarray:
+def _exceedances(overview: Overview, ratio, t, dof, lo: int, hi: int, n_cells: float,
+                 ripple_false_alarm: float) -> np.ndarray:
     """Local maxima of `ratio` in [lo, hi] above `t`, with a prominence of `t` (and the F quantile if random)."""
     log_ratio = np.log10(np.maximum(ratio, np.finfo(float).tiny))
     index, _ = signal.find_peaks(log_ratio, distance=max(1, overview.cell))
@@ -230,7 +242,7 @@ def _exceedances(overview: Overview, ratio, t, dof, lo: int, hi: int, n_cells: f
     prominence = signal.peak_prominences(log_ratio, index)[0]
     needed = t[index]
     if overview.random_ripple:
-        needed = np.maximum(needed, _f_isf(RIPPLE_FALSE_ALARM / max(n_cells, 1), dof[index]))
+        needed = np.maximum(needed, _f_isf(ripple_false_alarm / max(n_cells, 1), dof[index]))
     return index[prominence >= np.log10(needed)]
 
 
@@ -243,18 +255,20 @@ def _f_isf(probability: float, dof):
     return special.fdtri(dof, dof, 1.0 - probability)
 
 
-def _suppress_shoulders(overview: Overview, candidates: list[Candidate]) -> list[Candidate]:
+def _suppress_shoulders(overview: Overview, candidates: list[Candidate],
+                        separation_probability: float) -> list[Candidate]:
     """Keep one candidate per resonance (see :func:`_separated`), the one that exceeds its threshold most."""
     kept: list[Candidate] = []
     for c in sorted(candidates, key=lambda c: c.exceedance, reverse=True):
-        if all(_separated(overview, c, k) for k in kept):
+        if all(_separated(overview, c, k, separation_probability) for k in kept):
             kept.append(c)
     return sorted(kept, key=lambda c: c.frequency)
 
 
-def _separated(overview: Overview, weak: Candidate, strong: Candidate) -> bool:
+def _separated(overview: Overview, weak: Candidate, strong: Candidate, separation_probability: float) -> bool:
     """Two candidates are two resonances if, between them, the smoothed spectrum falls to the floor, or
-    below the weaker peak by the detection threshold (ambient: or by more than its ripple does, F quantile 1 %).
+    below the weaker peak by the detection threshold (ambient: or by more than its ripple does, upper F
+    quantile at `separation_probability`).
 
     The smoothing (a running mean over half the stronger peak's -3 dB
     width, at least 5 cells) keeps the random ripple on one resonance (its
@@ -271,10 +285,10 @@ def _separated(overview: Overview, weak: Candidate, strong: Candidate) -> bool:
     depth = weak.threshold
     if overview.random_ripple:
         # Welch spectrum, degrees of freedom known: two values of its running mean differ by this factor with
-        # probability SEPARATION_PROBABILITY. (For free decays the ripple of a random response under the decay
+        # probability separation_probability. (For free decays the ripple of a random response under the decay
         # is not known inside a resonance: the threshold itself is the depth asked for.)
         dof = weak.dof * n / overview.cell
-        depth = min(depth, float(_f_isf(SEPARATION_PROBABILITY, dof)))
+        depth = min(depth, float(_f_isf(separation_probability, dof)))
     return bool(valley <= max(1.0, smooth[weak.index - a] / depth))
 
 

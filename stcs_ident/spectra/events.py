@@ -42,16 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .options import EventOptions, OnsetScale
+
 __all__ = ["Event", "detect_events", "whole_record_event"]
 
-CONFIRM_DB = 3.0
-FINE = (0.01, 1.0, 4, 10.0)  # frame (s), history (s), minimum samples per frame, jump (dB): first difference
-COARSE = (0.1, 2.0, 8, 10.0)  # the same for the acceleration itself
-PERSIST = 3  # frames averaged after a candidate onset
-MIN_GAP = 0.5  # s, onsets closer than this belong to one blow
-FORCE_SEARCH = 0.25  # s after an onset within which the blow is over
-CONFIRM_AFTER, CONFIRM_BEFORE = 0.5, 1.0  # s
-MIN_EVENT = 0.5  # s, shorter segments are not used
+# The tuning values (frames, jumps, confirmation, shortest event) are :class:`.options.EventOptions`.
 BLOCK_SAMPLES = 65536  # rows at a time in the scans of the whole record (bounded temporaries)
 
 
@@ -85,8 +80,8 @@ class _Onset:
     start: int  # first sample after the blow
 
 
-def _frame_length(scale: tuple[float, float, int], sampling_rate: float) -> int:
-    return max(scale[2], round(scale[0] * sampling_rate))
+def _frame_length(scale: OnsetScale, sampling_rate: float) -> int:
+    return max(scale.min_samples, round(scale.frame * sampling_rate))
 
 
 def _frame_energy(signal: np.ndarray, frame: int, difference: bool = False) -> np.ndarray:
@@ -111,40 +106,40 @@ def _frame_energy(signal: np.ndarray, frame: int, difference: bool = False) -> n
     return energy
 
 
-def _jumps(energy: np.ndarray, history: int, jump_db: float) -> np.ndarray:
-    """Frames k where the mean of frames k … k+PERSIST−1 exceeds every such mean in the `history` frames before by `jump_db`.
+def _jumps(energy: np.ndarray, history: int, jump_db: float, persist: int) -> np.ndarray:
+    """Frames k where the mean of frames k … k+persist−1 exceeds every such mean in the `history` frames before by `jump_db`.
 
-    Averaging PERSIST frames gives even a 4-sample frame enough degrees of
+    Averaging `persist` frames gives even a 4-sample frame enough degrees of
     freedom; comparing with the largest earlier mean (not their average)
     makes a narrow-band random response that recovers from a fade no
     onset, since it only returns to a level it had within the history.
     """
-    first = max(2 * PERSIST, history // 4)  # at least a quarter of the history must be seen
-    if energy.size < first + PERSIST:
+    first = max(2 * persist, history // 4)  # at least a quarter of the history must be seen
+    if energy.size < first + persist:
         return np.array([], dtype=int)
     cum = np.concatenate([[0.0], np.cumsum(energy)])
-    ahead = (cum[PERSIST:] - cum[:-PERSIST]) / PERSIST  # ahead[k]: mean of frames k … k+PERSIST−1
-    span = history - PERSIST + 1
-    # Largest mean over windows starting in [k − history, k − PERSIST] (all ending before k); near the
+    ahead = (cum[persist:] - cum[:-persist]) / persist  # ahead[k]: mean of frames k … k+persist−1
+    span = history - persist + 1
+    # Largest mean over windows starting in [k − history, k − persist] (all ending before k); near the
     # record's start the filter repeats the first value, so the window stays inside the frames seen so far.
     largest = ndimage.maximum_filter1d(ahead, size=span, origin=(span - 1) // 2, mode="nearest")
     k = np.arange(first, ahead.size)
-    before = largest[k - PERSIST]
+    before = largest[k - persist]
     return k[ahead[k] >= 10 ** (jump_db / 10) * before]
 
 
-def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale, energy: np.ndarray | None = None,
-                  difference: bool = False) -> list[_Onset]:
+def _scale_onsets(signal: np.ndarray, sampling_rate: float, scale: OnsetScale, options: EventOptions,
+                  energy: np.ndarray | None = None, difference: bool = False) -> list[_Onset]:
     """Onsets at one scale (of the first difference with ``difference``); `energy`: the signal's
     :func:`_frame_energy` at this scale, if already computed."""
     frame = _frame_length(scale, sampling_rate)
     energy = _frame_energy(signal, frame, difference) if energy is None else energy
     if energy.size < 8:
         return []
-    history = max(4, round(scale[1] * sampling_rate / frame))
-    search = max(1, int(np.ceil(FORCE_SEARCH * sampling_rate / frame)))
+    history = max(4, round(scale.history * sampling_rate / frame))
+    search = max(1, int(np.ceil(options.force_search * sampling_rate / frame)))
     onsets = []
-    for k in _jumps(energy, history, scale[3]):
+    for k in _jumps(energy, history, scale.jump_db, options.persist):
         peak = k + int(np.argmax(energy[k : k + search]))
         onsets.append(_Onset(sample=int(k * frame), frame=frame, start=int((peak + 1) * frame)))
     return onsets
@@ -160,12 +155,12 @@ def _normalised_power(x: np.ndarray) -> np.ndarray:
     return out
 
 
-def _confirmed(x2: np.ndarray, onset: _Onset, sampling_rate: float) -> bool:
-    after = x2[onset.sample : onset.sample + int(CONFIRM_AFTER * sampling_rate)].mean()
-    before_lo = max(0, onset.sample - int(CONFIRM_BEFORE * sampling_rate))
+def _confirmed(x2: np.ndarray, onset: _Onset, sampling_rate: float, options: EventOptions) -> bool:
+    after = x2[onset.sample : onset.sample + int(options.confirm_after * sampling_rate)].mean()
+    before_lo = max(0, onset.sample - int(options.confirm_before * sampling_rate))
     if before_lo == onset.sample:
         return True
-    return after >= 10 ** (CONFIRM_DB / 10) * x2[before_lo : onset.sample].mean()
+    return after >= 10 ** (options.confirm_db / 10) * x2[before_lo : onset.sample].mean()
 
 
 def _merge(fine: list[_Onset], coarse: list[_Onset], gap: int) -> list[_Onset]:
@@ -180,12 +175,13 @@ def _merge(fine: list[_Onset], coarse: list[_Onset], gap: int) -> list[_Onset]:
     return merged
 
 
-def _starts_in_decay(x: np.ndarray, sampling_rate: float, energy: np.ndarray | None = None) -> bool:
+def _starts_in_decay(x: np.ndarray, sampling_rate: float, coarse: OnsetScale,
+                     energy: np.ndarray | None = None) -> bool:
     """The record opens inside a decay: its first second 15 dB above the median of its last quarter.
 
-    `energy`: :func:`_frame_energy` of `x` in COARSE frames, if already computed.
+    `energy`: :func:`_frame_energy` of `x` in `coarse` frames, if already computed.
     """
-    frame = _frame_length(COARSE, sampling_rate)
+    frame = _frame_length(coarse, sampling_rate)
     energy = _frame_energy(x, frame) if energy is None else energy
     head = max(1, round(sampling_rate / frame))
     if energy.size < 4 * head:
@@ -193,7 +189,7 @@ def _starts_in_decay(x: np.ndarray, sampling_rate: float, energy: np.ndarray | N
     return energy[:head].mean() >= 10**1.5 * np.median(energy[3 * energy.size // 4 :])
 
 
-def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]:
+def detect_events(acceleration: np.ndarray, sampling_rate: float, options: EventOptions | None = None) -> list[Event]:
     """Find the blows of a hand-excitation record and its free-decay segments.
 
     Parameters
@@ -202,41 +198,49 @@ def detect_events(acceleration: np.ndarray, sampling_rate: float) -> list[Event]
         Mean-removed acceleration.
     sampling_rate : float
         Hz.
+    options : EventOptions, optional
+        Frames, jumps and confirmation (default: the calibrated values).
 
     Returns
     -------
     list of Event
         Empty for an ambient record (no blow found).
     """
+    options = EventOptions() if options is None else options
     x = np.asarray(acceleration, dtype=float)
-    fine = _scale_onsets(x, sampling_rate, FINE, difference=True)
-    coarse_energy = _frame_energy(x, _frame_length(COARSE, sampling_rate))
-    coarse = _scale_onsets(x, sampling_rate, COARSE, coarse_energy)
+    fine = _scale_onsets(x, sampling_rate, options.fine, options, difference=True)
+    coarse_energy = _frame_energy(x, _frame_length(options.coarse, sampling_rate))
+    coarse = _scale_onsets(x, sampling_rate, options.coarse, options, coarse_energy)
     onsets = []
     if fine or coarse:  # (an ambient record has none: the normalised power is not needed)
         # Each candidate confirmed before they are merged: at a low sampling rate a jump is seen up to
-        # PERSIST − 1 frames (0.8 s at 20 Hz) before the blow, so the earliest candidate's CONFIRM_AFTER
+        # persist − 1 frames (0.8 s at 20 Hz) before the blow, so the earliest candidate's confirm_after
         # may end before the blow; merged first, it took the later ones with it (a blow of 46 dB lost).
-        # Where every candidate is confirmed (a blow seen at most CONFIRM_AFTER early) nothing changes.
+        # Where every candidate is confirmed (a blow seen at most confirm_after early) nothing changes.
         x2 = _normalised_power(x)
-        fine = [o for o in fine if _confirmed(x2, o, sampling_rate)]
-        coarse = [o for o in coarse if _confirmed(x2, o, sampling_rate)]
-        onsets = _merge(fine, coarse, int(MIN_GAP * sampling_rate))
-    if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, coarse_energy):
-        frame = _frame_length(COARSE, sampling_rate)
+        fine = [o for o in fine if _confirmed(x2, o, sampling_rate, options)]
+        coarse = [o for o in coarse if _confirmed(x2, o, sampling_rate, options)]
+        onsets = _merge(fine, coarse, int(options.min_gap * sampling_rate))
+    if (not onsets or onsets[0].sample > 2 * sampling_rate) and _starts_in_decay(x, sampling_rate, options.coarse,
+                                                                                  coarse_energy):
+        frame = _frame_length(options.coarse, sampling_rate)
         onsets.insert(0, _Onset(sample=0, frame=frame, start=0))
     events = []
     for i, onset in enumerate(onsets):
         stop = onsets[i + 1].sample - onsets[i + 1].frame if i + 1 < len(onsets) else x.shape[0]
-        if stop - onset.start >= MIN_EVENT * sampling_rate:
+        if stop - onset.start >= options.min_event * sampling_rate:
             events.append(Event(onset=onset.sample, start=onset.start, stop=stop))
     return events
 
 
-def whole_record_event(acceleration: np.ndarray, sampling_rate: float) -> Event:
-    """The decay from the record's most energetic frame to its end (when a blow is assumed but none found)."""
-    frame = _frame_length(COARSE, sampling_rate)
+def whole_record_event(acceleration: np.ndarray, sampling_rate: float, options: EventOptions | None = None) -> Event:
+    """The decay from the record's most energetic frame to its end (when a blow is assumed but none found).
+
+    Its frames are the coarse scale of ``options``; a decay shorter than ``options.min_event`` is not taken.
+    """
+    options = EventOptions() if options is None else options
+    frame = _frame_length(options.coarse, sampling_rate)
     energy = _frame_energy(np.asarray(acceleration, dtype=float), frame)
     peak = int(np.argmax(energy)) if energy.size else 0
-    start = min(peak * frame, max(0, acceleration.shape[0] - int(MIN_EVENT * sampling_rate)))
+    start = min(peak * frame, max(0, acceleration.shape[0] - int(options.min_event * sampling_rate)))
     return Event(onset=start, start=start, stop=acceleration.shape[0])

@@ -23,24 +23,21 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage, special, stats
 
+from .options import FloorOptions
+
 __all__ = ["floor_log_variance", "noise_floor", "ripple_dof"]
 
-BLOCK_CELLS = 8  # smallest floor block, resolution cells
-BLOCK_RELATIVE = 0.03  # floor blocks grow to 3 % of their frequency
-FLOOR_BLOCKS = 7  # running median over this many blocks
-FLOOR_PASSES = 3
-MASK_PROBABILITY = 0.01  # a bin above this chi-squared quantile starts a masked peak region
-MASK_SMOOTHING = 8  # cells averaged to find broad peaks for the mask
+# The tuning values (blocks, passes, mask) are :class:`.options.FloorOptions`.
 CHUNK_VALUES = 2**20  # noise_floor: values of the spectra treated at once
 
 
-def _blocks(n: int, cell: int) -> list[tuple[int, int]]:
-    """Frequency blocks [lo, hi): at least BLOCK_CELLS cells, growing to BLOCK_RELATIVE of their frequency."""
+def _blocks(n: int, cell: int, options: FloorOptions) -> list[tuple[int, int]]:
+    """Frequency blocks [lo, hi): at least ``block_cells`` cells, growing to ``block_relative`` of their frequency."""
     blocks = []
     lo = 1
-    min_width = BLOCK_CELLS * cell
+    min_width = options.block_cells * cell
     while lo < n:
-        hi = min(n, lo + max(min_width, int(BLOCK_RELATIVE * lo)))
+        hi = min(n, lo + max(min_width, int(options.block_relative * lo)))
         blocks.append((lo, hi))
         lo = hi
     return blocks
@@ -52,18 +49,18 @@ def _quantile_to_mean(dof, quantile: float):
     return special.gammaincinv(dof / 2.0, quantile) / (dof / 2.0)
 
 
-def _block_floor(spectra: np.ndarray, cell: int) -> np.ndarray:
-    """Running median (over FLOOR_BLOCKS blocks) of block medians, interpolated in log; nan bins are left out."""
+def _block_floor(spectra: np.ndarray, cell: int, options: FloorOptions) -> np.ndarray:
+    """Running median (over ``floor_blocks`` blocks) of block medians, interpolated in log; nan bins are left out."""
     n = spectra.shape[0]
-    blocks = _blocks(n, cell)
+    blocks = _blocks(n, cell, options)
     centres = np.array([0.5 * (lo + hi - 1) for lo, hi in blocks])
     medians = np.full((len(blocks), spectra.shape[1]), np.nan)
     for i, (lo, hi) in enumerate(blocks):
         medians[i] = _nan_median(spectra[lo:hi], axis=0, min_count=max(2, (hi - lo) // 4))
     log_med = np.log(np.maximum(medians, np.finfo(float).tiny))
-    half = FLOOR_BLOCKS // 2
+    half = options.floor_blocks // 2
     padded = np.pad(log_med, ((half, half), (0, 0)), constant_values=np.nan)
-    windows = np.lib.stride_tricks.sliding_window_view(padded, FLOOR_BLOCKS, axis=0)
+    windows = np.lib.stride_tricks.sliding_window_view(padded, options.floor_blocks, axis=0)
     smooth = _nan_median(windows, axis=-1, min_count=1)
     index = np.arange(n)
     columns = []
@@ -84,35 +81,41 @@ def _nan_median(values: np.ndarray, axis: int, min_count: int) -> np.ndarray:
     return np.squeeze(median, axis=axis)
 
 
-def noise_floor(spectra: np.ndarray, dof, cell: int, passes: int = FLOOR_PASSES) -> np.ndarray:
+def noise_floor(spectra: np.ndarray, dof, cell: int, passes: int | None = None,
+                options: FloorOptions | None = None) -> np.ndarray:
     """Local noise floor of each column of `spectra` (mean level of the noise; see the module docstring).
 
     `dof` is a number or one per bin (degrees of freedom of the spectrum).
     `passes` = 1 takes the running median without leaving peaks out (for
-    a spectrum whose peaks have been taken out already).
+    a spectrum whose peaks have been taken out already); by default
+    ``options.passes``. `options`: blocks, passes and mask (default: the
+    calibrated values).
 
     Columns are independent; a large array is done a group of columns at
     a time (its temporaries, some ten times its size, stay bounded).
     """
+    options = FloorOptions() if options is None else options
+    passes = options.passes if passes is None else passes
     group = max(1, CHUNK_VALUES // max(1, spectra.shape[0]))
     if spectra.shape[1] > group:
-        return np.concatenate([noise_floor(spectra[:, c:c + group], dof, cell, passes)
+        return np.concatenate([noise_floor(spectra[:, c:c + group], dof, cell, passes, options)
                                for c in range(0, spectra.shape[1], group)], axis=1)
     dof = np.broadcast_to(np.asarray(dof, dtype=float), spectra.shape[:1])
     # The quantiles once per distinct value (often one for all bins), then spread over the bins.
     dof, bins = np.unique(dof, return_inverse=True)
     correction = _quantile_to_mean(dof, 0.5)[bins][:, None]
-    threshold = (stats.chi2.isf(MASK_PROBABILITY, dof) / dof)[bins][:, None]
+    threshold = (stats.chi2.isf(options.mask_probability, dof) / dof)[bins][:, None]
     # A broad peak may stand only a few times above a first floor that it lifts itself: it is found in the
-    # spectrum averaged over MASK_SMOOTHING cells, whose scatter is that many times smaller.
-    smoothing = MASK_SMOOTHING * cell
-    smooth_dof = dof * MASK_SMOOTHING
+    # spectrum averaged over mask_smoothing cells, whose scatter is that many times smaller.
+    smoothing = options.mask_smoothing * cell
+    smooth_dof = dof * options.mask_smoothing
     # At least twice the floor: a smooth spectrum a little off its floor (curvature) is no peak.
-    smooth_threshold = np.maximum(stats.chi2.isf(MASK_PROBABILITY, smooth_dof) / smooth_dof, 2.0)[bins][:, None]
+    smooth_threshold = np.maximum(stats.chi2.isf(options.mask_probability, smooth_dof) / smooth_dof,
+                                  2.0)[bins][:, None]
     masked = spectra
     floor = None
     for k in range(passes):
-        floor = _block_floor(masked, cell) / correction
+        floor = _block_floor(masked, cell, options) / correction
         if k == passes - 1:
             break
         ratio = spectra / floor
@@ -146,7 +149,7 @@ def _peak_regions(ratio: np.ndarray, threshold: np.ndarray, smooth: np.ndarray |
     return np.cumsum(mask, axis=0)[:n] > 0
 
 
-def ripple_dof(ratio: np.ndarray, cell: int, low: float, high: float) -> np.ndarray:
+def ripple_dof(ratio: np.ndarray, cell: int, low: float, high: float, options: FloorOptions | None = None) -> np.ndarray:
     """Local degrees of freedom of a spectrum from the scatter of its logarithm.
 
     A mean of C channels' periodograms has 2C degrees of freedom where the
@@ -155,14 +158,16 @@ def ripple_dof(ratio: np.ndarray, cell: int, low: float, high: float) -> np.ndar
     through a decay), and many where the smooth deterministic skirts of
     the decaying modes stand far above the noise. var(log χ²_d) = ψ'(d/2)
     is independent of the level, so its local value, over every `cell`-th
-    bin outside peak regions, gives d; clipped to [low, high].
+    bin outside peak regions, gives d; clipped to [low, high]. `options`: the
+    floor's blocks and mask (default: the calibrated values).
     """
+    options = FloorOptions() if options is None else options
     log_ratio = np.log(np.maximum(ratio, np.finfo(float).tiny))
-    threshold = np.full((ratio.size, 1), stats.chi2.isf(MASK_PROBABILITY, low) / low)
+    threshold = np.full((ratio.size, 1), stats.chi2.isf(options.mask_probability, low) / low)
     peaks = _peak_regions(ratio[:, None], threshold)[:, 0]
     sample = np.zeros(ratio.size, dtype=bool)
     sample[::cell] = True
-    blocks = _blocks(ratio.size, cell)
+    blocks = _blocks(ratio.size, cell, options)
     centres, variances = [], []
     for lo, hi in blocks:
         values = log_ratio[lo:hi][sample[lo:hi] & ~peaks[lo:hi]]
@@ -171,7 +176,7 @@ def ripple_dof(ratio: np.ndarray, cell: int, low: float, high: float) -> np.ndar
             variances.append(np.var(values, ddof=1))
     if not variances:
         return np.full(ratio.size, low)
-    variances = ndimage.median_filter(np.array(variances), size=FLOOR_BLOCKS, mode="nearest")
+    variances = ndimage.median_filter(np.array(variances), size=options.floor_blocks, mode="nearest")
     dof = 2.0 * _inverse_trigamma(np.maximum(variances, 1e-12))
     return np.clip(np.interp(np.arange(ratio.size), centres, dof), low, high)
 
@@ -187,14 +192,15 @@ def _inverse_trigamma(value: np.ndarray) -> np.ndarray:
     return np.sqrt(lo * hi)
 
 
-def floor_log_variance(dof: float) -> float:
+def floor_log_variance(dof: float, options: FloorOptions | None = None) -> float:
     """Variance of log(floor estimate / true floor) in pure noise of `dof` degrees of freedom.
 
-    The floor is a median of about n = BLOCK_CELLS · FLOOR_BLOCKS
-    independent values: 1 / (4 n p(m)² m²), p the density of the spectrum
-    (mean 1) and m its median.
+    The floor is a median of about n = block_cells · floor_blocks
+    independent values (of `options`, default the calibrated ones):
+    1 / (4 n p(m)² m²), p the density of the spectrum (mean 1) and m its median.
     """
+    options = FloorOptions() if options is None else options
     half = dof / 2.0
     median = special.gammaincinv(half, 0.5) / half
     density = stats.gamma.pdf(median, half, scale=1.0 / half)
-    return float(1.0 / (4.0 * BLOCK_CELLS * FLOOR_BLOCKS * density**2 * median**2))
+    return float(1.0 / (4.0 * options.block_cells * options.floor_blocks * density**2 * median**2))

@@ -12,7 +12,8 @@ programming; a peak may stay unassigned at a fixed cost, for spurious or
 out-of-plane peaks), with residuals scaled by the measurement uncertainty
 plus a model tolerance. The best family gives the numbers; a peak whose
 number differs in any family almost as good (within ``ambiguity`` in
-cost) is flagged doubtful — never silently guessed.
+cost) is flagged doubtful — never silently guessed. The tolerances, costs
+and ranges are :class:`.options.NumberingOptions`.
 """
 
 from __future__ import annotations
@@ -28,12 +29,7 @@ from scipy.optimize import least_squares
 from ..core.errors import InputError, NumberingWarning
 from ..core.model import Attachment, Cable
 from ..forward import batch_frequencies
-
-#: Cost of leaving a peak unassigned (in squared standardised residuals):
-#: a peak 4σ from every prediction is cheaper to call spurious.
-UNASSIGNED_COST = 16.0
-#: The relaxed pass allows this many times the model tolerance (0.3 % → 3 %).
-RELAXED_TOLERANCE = 10.0
+from .options import NumberingOptions
 
 
 @dataclass(frozen=True)
@@ -63,7 +59,7 @@ class Numbering:
     alternatives: tuple
 
 
-def assign(frequencies, sigma, families):
+def assign(frequencies, sigma, families, unassigned_cost: float = NumberingOptions.unassigned_cost):
     """Order-preserving assignment of peaks to families (dynamic programming,
     vectorised over the families).
 
@@ -71,6 +67,7 @@ def assign(frequencies, sigma, families):
     ----------
     frequencies, sigma : arrays (n_peaks,), ascending frequencies
     families : array (n_families, n_modes), ascending predicted frequencies
+    unassigned_cost : cost of leaving a peak unassigned (squared standardised residuals)
 
     Returns
     -------
@@ -89,7 +86,7 @@ def assign(frequencies, sigma, families):
         # Row j at once: the match or unassigned option per mode k (ties to the match), then the skip option
         # (best[j, k-1], ties to it) is a running minimum along k, as the recurrence taken mode by mode.
         match = best[:, j - 1, :-1] + resid[:, j - 1, :]
-        unassigned = best[:, j - 1, :] + UNASSIGNED_COST
+        unassigned = best[:, j - 1, :] + unassigned_cost
         options = unassigned.copy()
         options[:, 1:] = np.minimum(match, unassigned[:, 1:])
         row_choice = np.full((F, K + 1), 2, dtype=np.int8)
@@ -117,25 +114,27 @@ def assign(frequencies, sigma, families):
 
 
 def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], cable: Cable,
-                 attachments: Sequence[Attachment], tension: float, *, model_tolerance: float = 0.003,
-                 tension_range: tuple[float, float] = (0.6, 1.5), EI_range: tuple[float, float] = (0.2, 5.0),
-                 ambiguity: float = 6.0, tension_model: str = "uniform") -> Numbering:
+                 attachments: Sequence[Attachment], tension: float, *, options: NumberingOptions | None = None,
+                 tension_model: str = "uniform") -> Numbering:
     """Number the peaks by matching the whole family of the cable model.
 
     Parameters
     ----------
     frequencies, uncertainties : peak frequencies and 1σ uncertainties, Hz
     cable, attachments, tension : the nominal model of the test
-    model_tolerance : relative misfit the model is allowed per mode after
-        tension and EI are fitted (attachments, sag, end conditions). Peaks
-        left unassigned are retried with :data:`RELAXED_TOLERANCE` times
-        it; the relaxed numbers are kept only if they keep every strict
-        number not flagged doubtful and none of the added peaks is doubtful.
-    tension_range, EI_range : ratios to nominal searched (tension 0.6–1.5
-        covers frequencies 23 % below to 22 % above the nominal).
-    ambiguity : cost difference within which another family counts as
-        equally good (a χ² difference; 6 ≈ 2.4σ on one mode).
+    options : NumberingOptions, optional
+        Default: the calibrated values. ``model_tolerance`` is the relative
+        misfit the model is allowed per mode after tension and EI are
+        fitted (attachments, sag, end conditions). Peaks left unassigned
+        are retried with ``relaxed_tolerance`` times it; the relaxed
+        numbers are kept only if they keep every strict number not flagged
+        doubtful and none of the added peaks is doubtful.
+        ``tension_range`` and ``EI_range`` are the ratios to nominal
+        searched; another family within ``ambiguity`` in cost counts as
+        equally good; a peak left unassigned costs ``unassigned_cost``.
+    tension_model : the forward model's tension model
     """
+    options = NumberingOptions() if options is None else options
     f = np.asarray(frequencies, float)
     u = np.asarray(uncertainties, float)
     if f.ndim != 1 or f.shape != u.shape:
@@ -145,13 +144,13 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
     order = np.argsort(f)
     f, u = f[order], u[order]
     modes, doubtful, cost, tr, er, family, alternatives = _number(
-        f, u, cable, attachments, tension, model_tolerance, tension_range, EI_range, ambiguity, tension_model)
+        f, u, cable, attachments, tension, options.model_tolerance, options, tension_model)
     if np.any(modes == 0):
         # A hidden effect (an unrecorded mass, a moved attachment) can shift single modes by a few per
         # cent, beyond the model tolerance, and the strict pass leaves them unassigned. A relaxed pass
         # may add them, provided it keeps every sure strict number and is unambiguous about the added ones.
-        relaxed = _number(f, u, cable, attachments, tension, RELAXED_TOLERANCE * model_tolerance, tension_range,
-                          EI_range, ambiguity, tension_model)
+        relaxed = _number(f, u, cable, attachments, tension, options.relaxed_tolerance * options.model_tolerance,
+                          options, tension_model)
         r_modes, r_doubtful = relaxed[0], relaxed[1]
         added = (modes == 0) & (r_modes > 0)
         sure = (modes > 0) & ~doubtful
@@ -169,9 +168,10 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
     return result
 
 
-def _number(f, u, cable, attachments, tension, model_tolerance, tension_range, EI_range, ambiguity, tension_model):
-    """One numbering pass over sorted peaks: (modes, doubtful, cost, tension ratio, EI ratio, family,
-    alternatives)."""
+def _number(f, u, cable, attachments, tension, model_tolerance, options: NumberingOptions, tension_model):
+    """One numbering pass over sorted peaks with a model tolerance: (modes, doubtful, cost, tension ratio,
+    EI ratio, family, alternatives)."""
+    tension_range, EI_range, cost_unassigned = options.tension_range, options.EI_range, options.unassigned_cost
     sigma = np.sqrt(u**2 + (model_tolerance * f) ** 2)
     t_ratio = np.geomspace(*tension_range, 49)
     ei_ratio = np.geomspace(*EI_range, 15) if cable.EI > 0 else np.array([1.0])
@@ -179,7 +179,7 @@ def _number(f, u, cable, attachments, tension, model_tolerance, tension_range, E
     fam = batch_frequencies(cable, attachments, tension * t_ratio[:, None], n_modes,
                             EI=cable.EI * ei_ratio[None, :], tension_model=tension_model)
     flat = fam.reshape(-1, n_modes)
-    all_modes, all_cost = assign(f, sigma, flat)
+    all_modes, all_cost = assign(f, sigma, flat, cost_unassigned)
     # candidate numberings from the best grid families, each refined by a
     # continuous fit of (tension, EI) and re-assigned until stable
     candidates = {}
@@ -191,7 +191,7 @@ def _number(f, u, cable, attachments, tension, model_tolerance, tension_range, E
     refined = {}
     for key, (t0, r0) in candidates.items():
         modes, cost, tr, er, family = _refine(f, sigma, np.array(key), t0, r0, cable, attachments, tension,
-                                              tension_model, n_modes, tension_range, EI_range)
+                                              tension_model, n_modes, tension_range, EI_range, cost_unassigned)
         if tuple(modes) not in refined or refined[tuple(modes)][0] > cost:
             refined[tuple(modes)] = (cost, tr, er, family)
     ranked = sorted(refined.items(), key=lambda kv: kv[1][0])
@@ -200,13 +200,14 @@ def _number(f, u, cable, attachments, tension, model_tolerance, tension_range, E
     doubtful = np.zeros(f.size, bool)
     alternatives = []
     for m, (c, *_rest) in ranked[1:]:
-        if c - cost <= ambiguity:
+        if c - cost <= options.ambiguity:
             doubtful |= np.array(m) != modes
             alternatives.append((c, np.array(m)))
     return modes, doubtful, cost, tr, er, family, alternatives
 
 
-def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model, n_modes, tension_range, EI_range):
+def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model, n_modes, tension_range, EI_range,
+            unassigned_cost):
     """Fit (tension, EI) ratios to the assigned peaks (within the searched
     ranges), re-assign, repeat."""
     fit_ei = cable.EI > 0
@@ -225,11 +226,11 @@ def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model,
 
             x = least_squares(residual, np.clip(x, lower, upper), bounds=(lower, upper), x_scale=0.1).x
         family = _family(x, cable, attachments, tension, tension_model, n_modes)
-        new_modes, cost = assign(f, sigma, family[None, :])
+        new_modes, cost = assign(f, sigma, family[None, :], unassigned_cost)
         if np.array_equal(new_modes[0], modes):
             break
         modes = new_modes[0]
-    _, cost = assign(f, sigma, family[None, :])
+    _, cost = assign(f, sigma, family[None, :], unassigned_cost)
     ratios = np.exp(x)
     return modes, float(cost[0]), float(ratios[0]), float(ratios[1]) if fit_ei else 1.0, family
 

@@ -38,6 +38,7 @@ from scipy.fft import next_fast_len, rfft
 
 from .events import Event
 from .floor import noise_floor, ripple_dof
+from .options import FloorOptions, OverviewOptions
 
 __all__ = [
     "Overview",
@@ -48,12 +49,8 @@ __all__ = [
     "smoothed_overview",
 ]
 
-DECAY_PADDING = 2
-RIPPLE_DOF_CAP = 8  # free decays: local degrees of freedom at most 8 C ν
-WELCH_SEGMENTS = 16
-DECAY_WINDOW_RATIO = 4  # successive decay-matched windows are this much shorter
-MIN_DECAY_WINDOW = 64  # samples, shortest decay-matched window
-SMOOTHING = 4  # cells averaged in the smoothed overview
+# The tuning values (padding, Welch segments, decay-matched windows, smoothing) are
+# :class:`.options.OverviewOptions`; the floors' are :class:`.options.FloorOptions`.
 
 
 @dataclass(frozen=True)
@@ -97,17 +94,20 @@ class Overview:
 
 
 def decay_overview(
-    x: np.ndarray, sampling_rate: float, events: list[Event], window_length: int | None = None
+    x: np.ndarray, sampling_rate: float, events: list[Event], window_length: int | None = None, *,
+    options: OverviewOptions | None = None, floor_options: FloorOptions | None = None,
 ) -> Overview:
     """Overview of free decays: tapered, zero-padded periodograms averaged over events.
 
     By default each whole event under a right-half Hann taper. With
     `window_length`, a decay-matched overview instead: a full Hann window
     over the first `window_length` samples of each event (see
-    :func:`decay_overviews`).
+    :func:`decay_overviews`). `options`, `floor_options`: padding and
+    floors (default: the calibrated values).
     """
+    options = OverviewOptions() if options is None else options
     longest = max(e.n_samples for e in events) if window_length is None else int(window_length)
-    n_fft = next_fast_len(DECAY_PADDING * longest, real=True)
+    n_fft = next_fast_len(options.decay_padding * longest, real=True)
     total = np.zeros((n_fft // 2 + 1, x.shape[1]))
     weight = 0.0
     for event in events:
@@ -123,26 +123,30 @@ def decay_overview(
     frequency = np.arange(psd.shape[0]) * sampling_rate / n_fft
     cell = max(1, round(n_fft / longest))
     dof = 2.0 * len(events)
-    floor = noise_floor(psd, dof, cell)
+    floor = noise_floor(psd, dof, cell, options=floor_options)
     ratio = psd / floor
-    high = RIPPLE_DOF_CAP * dof * psd.shape[1]
-    combined_dof = ripple_dof(ratio.mean(axis=1), cell, dof, high)
-    channel_dof = ripple_dof(ratio.max(axis=1), cell, dof, high)
+    high = options.ripple_dof_cap * dof * psd.shape[1]
+    combined_dof = ripple_dof(ratio.mean(axis=1), cell, dof, high, floor_options)
+    channel_dof = ripple_dof(ratio.max(axis=1), cell, dof, high, floor_options)
     return _overview(frequency, psd, floor, dof, combined_dof, channel_dof, cell, random_ripple=False)
 
 
-def decay_window_lengths(events: list[Event]) -> list[int]:
-    """Lengths of the decay-matched windows: the longest event over 4, 16, … while at least MIN_DECAY_WINDOW samples."""
+def decay_window_lengths(events: list[Event], options: OverviewOptions | None = None) -> list[int]:
+    """Lengths of the decay-matched windows: the longest event over 4, 16, … while at least 64 samples
+    (``options.decay_window_ratio``, ``options.min_decay_window``)."""
+    options = OverviewOptions() if options is None else options
     longest = max(e.n_samples for e in events)
     lengths = []
-    length = longest // DECAY_WINDOW_RATIO
-    while length >= MIN_DECAY_WINDOW:
+    length = longest // options.decay_window_ratio
+    while length >= options.min_decay_window:
         lengths.append(int(length))
-        length //= DECAY_WINDOW_RATIO
+        length //= options.decay_window_ratio
     return lengths
 
 
-def decay_overviews(x: np.ndarray, sampling_rate: float, events: list[Event]) -> list[Overview]:
+def decay_overviews(x: np.ndarray, sampling_rate: float, events: list[Event], *,
+                    options: OverviewOptions | None = None,
+                    floor_options: FloorOptions | None = None) -> list[Overview]:
     """The whole-event overview, the same smoothed over frequency, then decay-matched ones.
 
     A mode that decays in a small part of the event is drowned, in the
@@ -153,16 +157,20 @@ def decay_overviews(x: np.ndarray, sampling_rate: float, events: list[Event]) ->
     peak. A full Hann window over the first L samples of each event (L a
     few decay times; :func:`decay_window_lengths`) catches both. A weak,
     heavily damped mode spreads over many cells of the whole-event
-    periodogram: averaged over SMOOTHING cells (:func:`smoothed_overview`),
-    its peak keeps its height while the scatter falls.
+    periodogram: averaged over ``options.smoothing`` cells
+    (:func:`smoothed_overview`), its peak keeps its height while the
+    scatter falls.
     """
-    main = decay_overview(x, sampling_rate, events)
-    overviews = [main, smoothed_overview(main, SMOOTHING)]
-    overviews += [decay_overview(x, sampling_rate, events, n) for n in decay_window_lengths(events)]
+    options = OverviewOptions() if options is None else options
+    main = decay_overview(x, sampling_rate, events, options=options, floor_options=floor_options)
+    overviews = [main, smoothed_overview(main, options.smoothing, options=options, floor_options=floor_options)]
+    overviews += [decay_overview(x, sampling_rate, events, n, options=options, floor_options=floor_options)
+                  for n in decay_window_lengths(events, options)]
     return overviews
 
 
-def smoothed_overview(overview: Overview, factor: int) -> Overview:
+def smoothed_overview(overview: Overview, factor: int, *, options: OverviewOptions | None = None,
+                      floor_options: FloorOptions | None = None) -> Overview:
     """The overview's spectra averaged over `factor` resolution cells (a Daniell estimate), on a coarser grid.
 
     Running means over factor · cell bins, taken every half of that (two
@@ -172,6 +180,7 @@ def smoothed_overview(overview: Overview, factor: int) -> Overview:
     noise does not change; a floor estimated afresh on the coarse grid
     would span many resonances), and keeps its own scatter (``floor_dof``).
     """
+    options = OverviewOptions() if options is None else options
     width = factor * overview.cell
     step = max(1, width // 2)
     kernel = np.ones(width) / width
@@ -189,9 +198,9 @@ def smoothed_overview(overview: Overview, factor: int) -> Overview:
         channel_dof = np.full(centres.shape, dof)
     else:
         ratio = psd / floor
-        high = RIPPLE_DOF_CAP * dof * psd.shape[1]
-        combined_dof = ripple_dof(ratio.mean(axis=1), cell, dof, high)
-        channel_dof = ripple_dof(ratio.max(axis=1), cell, dof, high)
+        high = options.ripple_dof_cap * dof * psd.shape[1]
+        combined_dof = ripple_dof(ratio.mean(axis=1), cell, dof, high, floor_options)
+        channel_dof = ripple_dof(ratio.max(axis=1), cell, dof, high, floor_options)
     combined = (psd / floor).mean(axis=1)
     return Overview(
         overview.frequency[centres], psd, floor, combined, np.ones_like(combined), float(dof), combined_dof,
@@ -205,9 +214,11 @@ def _one_sided(psd: np.ndarray) -> np.ndarray:
     return psd
 
 
-def welch_length(n_samples: int) -> int:
-    """Segment length for the ambient Welch spectrum: a power of two near 2N/17 (about 16 segments)."""
-    target = max(256, n_samples * 2 // (WELCH_SEGMENTS + 1))
+def welch_length(n_samples: int, options: OverviewOptions | None = None) -> int:
+    """Segment length for the ambient Welch spectrum: a power of two near 2N/17 (about 16 segments,
+    ``options.welch_segments``)."""
+    options = OverviewOptions() if options is None else options
+    target = max(256, n_samples * 2 // (options.welch_segments + 1))
     return int(min(n_samples, 2 ** int(np.round(np.log2(target)))))
 
 
@@ -240,7 +251,8 @@ def _n_segments(n_samples: int, nperseg: int) -> int:
     return max(1, (n_samples - nperseg) // (nperseg // 2) + 1)
 
 
-def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
+def ambient_overview(x: np.ndarray, sampling_rate: float, *, options: OverviewOptions | None = None,
+                     floor_options: FloorOptions | None = None) -> Overview:
     """Overview of an ambient record: Welch PSD per channel (Hann, 50 % overlap).
 
     The combined spectrum's degrees of freedom are local: where a mode's
@@ -254,8 +266,11 @@ def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
     sums band by band of frequency (each band's DFTs recomputed: a few
     passes over a large record), so that beside the record about half
     its size is held at most (or BLOCK_BYTES).
+
+    `options`, `floor_options`: Welch segments and floors (default: the
+    calibrated values).
     """
-    nperseg = welch_length(x.shape[0])
+    nperseg = welch_length(x.shape[0], options)
     n_segments = _n_segments(x.shape[0], nperseg)
     window = signal.windows.hann(nperseg, sym=False)
     window_power = float(np.sum(window**2))
@@ -268,7 +283,7 @@ def ambient_overview(x: np.ndarray, sampling_rate: float) -> Overview:
     # Equivalent degrees of freedom of Welch's average (Hann, 50 % overlap: correlation 0.167 between segments).
     rho2 = 0.167**2 if n_segments > 1 else 0.0
     dof = 2.0 * n_segments / (1.0 + 2.0 * rho2 * (1.0 - 1.0 / n_segments))
-    floor = noise_floor(psd, dof, cell=2)
+    floor = noise_floor(psd, dof, cell=2, options=floor_options)
     trace, frobenius = _whitened_sums(x, nperseg, window, floor, window_power * sampling_rate / 2.0, budget)
     combined_dof = _coherent_dof(trace, frobenius, dof, n_channels=x.shape[1])
     channel_dof = np.full(frequency.shape, dof)

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.result import Result
+from .options import PickingOptions
 
 __all__ = ["Peak", "PeakResult"]
 
@@ -80,6 +81,8 @@ class PeakResult(Result):
     threshold : ndarray (n_freq,)
         Detection threshold on combined / floor (linear; it depends on the
         local degrees of freedom): a peak must reach floor × threshold.
+    options : PickingOptions
+        The options the peaks were picked with (how the result was made).
     """
 
     peaks: list[Peak]
@@ -92,13 +95,14 @@ class PeakResult(Result):
     channel_floor: np.ndarray
     channel_names: tuple[str, ...]
     threshold: np.ndarray
+    options: PickingOptions = field(default_factory=PickingOptions)
 
     main_table = "peaks"
 
     @property
-    def settings(self) -> None:
-        """None: the peak picking records no settings yet."""
-        return None
+    def settings(self) -> PickingOptions:
+        """How the result was made: its picking options (``options``)."""
+        return self.options
 
     @property
     def notes(self) -> tuple:
@@ -136,7 +140,7 @@ class PeakResult(Result):
         return pd.DataFrame(rows, columns=columns)
 
     def summary(self) -> dict:
-        """Plain data (JSON-serialisable): kind, events and per-peak lists, ordered by frequency."""
+        """Plain data (JSON-serialisable): kind, events and per-peak lists, ordered by frequency, and the options."""
         return {
             "kind": self.kind,
             "events": [list(e) for e in self.events],
@@ -146,4 +150,5 @@ class PeakResult(Result):
             "damping_uncertainty": [p.damping_uncertainty for p in self.peaks],
             "snr_db": [p.snr_db for p in self.peaks],
             "channels": [list(p.channels) for p in self.peaks],
+            "options": self.options.summary(),
         }

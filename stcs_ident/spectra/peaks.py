@@ -109,23 +109,17 @@ from .ambient_fit import AmbientFit, fit_ambient
 from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution
 from .events import Event, detect_events, whole_record_event
+from .options import DecayCheckOptions, PickingOptions
 from .overview import Overview, ambient_overview, decay_overviews
 from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
 from .peak_result import Peak, PeakResult
-from .refine import MAX_DAMPING, refine
+from .refine import refine
 from .residual import residual_candidates
 from .wander import common_wander, with_common_wander
 
-__all__ = ["Peak", "PeakResult", "find_peaks", "is_mains_hum"]
+__all__ = ["Peak", "PeakResult", "PickingOptions", "find_peaks", "is_mains_hum"]
 
-CHANNEL_SNR_DB = 6.0  # a channel saw a peak standing this high above its own floor
-MAX_RESIDUAL_EXCESS = 2.0  # decay-fit residual under the peak / away from it, beyond which Whittle is tried
-MAX_FORCED_RATIO = 0.3  # random response / free decay in the band beyond which the record's Whittle fit is used
-NARROW_DAMPING = 1e-3  # a decay fit below this ζ (cables: ≥ 1e-3 and rarely below 5e-4) is checked against Whittle
-BROADER_PEAK = 10.0  # ... and replaced by it when the record's peak is this many times broader (ζ)
-WHITTLE_MAX_STD = 0.25  # a Whittle fit whose 1σ exceeds this fraction of its band's half-width locates nothing
-BAND_MIN_BINS = 24  # free decays: narrowest band, DFT bins of the longest event
-BAND_MIN_WELCH_BINS = 12  # ambient: narrowest band, Welch resolution cells
+# Every value that changes what is reported is in :class:`.options.PickingOptions`, recorded in the result.
 KINDS = ("auto", "impulse", "ambient")
 
 
@@ -138,6 +132,7 @@ def find_peaks(
     max_peaks: int | None = None,
     min_snr_db: float | None = None,
     overwrite: bool = False,
+    options: PickingOptions | None = None,
 ) -> PeakResult:
     """Modal frequencies present in a record, with 1σ uncertainty, damping and the channels that saw them.
 
@@ -161,6 +156,9 @@ def find_peaks(
         instead of from a copy (as scipy's ``overwrite_x``): for a caller
         that read the record itself and needs no second copy of it in
         memory. The record then holds the mean-removed acceleration.
+    options : PickingOptions, optional
+        The tuning of every step (default: the calibrated values); recorded
+        in the result.
 
     Returns
     -------
@@ -172,21 +170,28 @@ def find_peaks(
         For a bad argument (the message names it) or a non-finite record.
     """
     fs = record.sampling_rate
+    if options is None:
+        options = PickingOptions()
+    elif not isinstance(options, PickingOptions):
+        raise InputError(f"must be a PickingOptions, got {options!r}", field="options")
     f_lo, f_hi = _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db)
     x = record.acceleration
     if overwrite and x.flags.writeable:
         x -= x.mean(axis=0)
     else:
         x = x - x.mean(axis=0)
-    events: list[Event] = [] if kind == "ambient" else detect_events(x, fs)
+    events: list[Event] = [] if kind == "ambient" else detect_events(x, fs, options.events)
     if kind == "impulse" and not events:
-        events = [whole_record_event(x, fs)]
-    overviews = decay_overviews(x, fs, events) if events else [ambient_overview(x, fs)]
+        events = [whole_record_event(x, fs, options.events)]
+    spectral = {"options": options.overview, "floor_options": options.floor}
+    overviews = decay_overviews(x, fs, events, **spectral) if events else [ambient_overview(x, fs, **spectral)]
     overview = overviews[0]
-    candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db)
+    candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db, options=options.detection,
+                                                   floor_options=options.floor)
     refine = _refine_decays if events else _refine_ambient
-    peaks = deduplicate(refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi)))
-    peaks = [p for p in peaks if not is_mains_hum(p)]
+    peaks = refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi), options)
+    peaks = deduplicate(peaks, options.filters)
+    peaks = [p for p in peaks if not is_mains_hum(p, options.filters)]
     if max_peaks is not None and len(peaks) > max_peaks:
         # After the fits: the overview's strongest candidates may include some that are not modes.
         strongest = sorted(peaks, key=lambda p: p.snr_db, reverse=True)[:max_peaks]
@@ -202,6 +207,7 @@ def find_peaks(
         channel_floor=overview.channel_floor,
         channel_names=record.channel_names,
         threshold=threshold,
+        options=options,
     )
 
 
@@ -227,17 +233,19 @@ def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple
     return f_lo, f_hi
 
 
-def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -> list[Peak]:
+def _refine_decays(x, fs, events, overview: Overview, candidates, names, band, options: PickingOptions) -> list[Peak]:
     spectra = event_spectra(x, [(e.start, e.stop) for e in events])
     resolution = 1.0 / (max(e.n_samples for e in events) / fs)
-    whittle = _whittle_band(x, fs, overview)
+    whittle = _whittle_band(x, fs, overview, options)
+    check = options.decay_check
+    max_damping = 2 * options.refine.max_damping
 
     def fit_band(f0, half_width, poles, peak_width):
-        fit = fit_decay(spectra, fs, f0, half_width, poles, max_damping=2 * MAX_DAMPING)
-        if fit is not None and (fit.residual_excess > MAX_RESIDUAL_EXCESS or fit.damping < NARROW_DAMPING
-                                or fit.forced_ratio > MAX_FORCED_RATIO):
+        fit = fit_decay(spectra, fs, f0, half_width, poles, max_damping=max_damping, options=options.fit)
+        if fit is not None and (fit.residual_excess > check.max_residual_excess or fit.damping < check.narrow_damping
+                                or fit.forced_ratio > check.max_forced_ratio):
             # A random response under the decay: the decay fit's 1σ allows for it (decay_fit's noise model);
-            # a forced ratio beyond MAX_FORCED_RATIO alone calls for the comparison too (a weak blow under
+            # a forced ratio beyond max_forced_ratio alone calls for the comparison too (a weak blow under
             # wind, calibrate_damping hum stay seed 1 #4, mode 4: a decay fit of ζ 0.0012 ± 0.0004 with
             # forced ratio 0.5 and residual excess 1.5 stood for a mode of ζ 0.0145, z = −30);
             # the stationary model of the whole record is kept where it pins the mode down better, and where
@@ -245,10 +253,10 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
             # one noise bin of a random response (a blow at the mode's node leaves nothing else to fit;
             # calibrate_spectra hum60 stay seed 7 #10, mode 3: ζ 5e-5 for 0.0085, z = 76).
             other = whittle(f0, half_width, poles, peak_width)
-            if _sound(other, half_width) and (
+            if _sound(other, half_width, check) and (
                 other.frequency_std < fit.frequency_std
-                or fit.forced_ratio > MAX_FORCED_RATIO
-                or fit.damping * BROADER_PEAK < other.damping
+                or fit.forced_ratio > check.max_forced_ratio
+                or fit.damping * check.broader_peak < other.damping
             ):
                 return other
         return fit
@@ -261,30 +269,35 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band) -
         return fit
 
     cell_width = overview.cell * (overview.frequency[1] - overview.frequency[0])
-    fitted = refine(candidates, fit_band_noted, resolution, BAND_MIN_BINS * resolution, 0.5 * fs, cell_width)
+    fitted = refine(candidates, fit_band_noted, resolution, options.refine.band_min_bins * resolution, 0.5 * fs,
+                    cell_width, options=options.refine)
     fitted, widened = _without_lines(fitted, calls, lambda f0, hw, poles, zeta: fit_decay(
-        spectra, fs, f0, hw, poles, max_damping=2 * MAX_DAMPING, min_damping=zeta))
+        spectra, fs, f0, hw, poles, max_damping=max_damping, min_damping=zeta, options=options.fit), options)
     # The events' common offset, pooled over modes (a tension wander moves them all; wander.common_wander).
     decays = [fit for _, fit in fitted if isinstance(fit, DecayFit)]
-    tau2 = common_wander([(f.frequency, f.event_frequencies, f.event_variances) for f in decays])
+    tau2 = common_wander([(f.frequency, f.event_frequencies, f.event_variances) for f in decays],
+                         options.fit.heterogeneity_level)
+    snr_db = options.filters.channel_snr_db
     peaks = []
     for c, fit in fitted:
         if fit is None:
-            peaks.append(_overview_peak(c, overview, names))
+            peaks.append(_overview_peak(c, overview, names, snr_db))
         elif isinstance(fit, AmbientFit):
-            peaks.append(_ambient_peak(c, fit, overview, names))
+            peaks.append(_ambient_peak(c, fit, overview, names, snr_db))
         else:
             std = with_common_wander(fit.frequency_std, fit.frequency, fit.event_variances, tau2)
-            peak = _decay_peak(c, replace(fit, frequency_std=std), names)
+            peak = _decay_peak(c, replace(fit, frequency_std=std), names, snr_db)
             peaks.append(replace(peak, damping=None, damping_uncertainty=None) if id(fit) in widened else peak)
     return peaks
 
 
-def _without_lines(fitted: list, calls: dict, refit: Callable) -> tuple[list, set]:
+def _without_lines(fitted: list, calls: dict, refit: Callable,
+                   options: PickingOptions | None = None) -> tuple[list, set]:
     """Decay fits that do not decay, among modes that do: refitted, or kept with the 1σ of the mode's own width.
 
-    A pole ten times narrower than the record's other modes and below
-    NARROW_DAMPING, which the record's Whittle fit could not replace, is a
+    A pole ten times (``decay_check.broader_peak``) narrower than the
+    record's other modes and below ``decay_check.narrow_damping``, which
+    the record's Whittle fit could not replace, is a
     fit to one noise bin of the mode's random response (a blow at the
     mode's node under wind: calibrate_spectra seed 11, four stay modes with
     ζ 1e-5–2e-4 among modes of 0.5–1 %, z = 5–64). A cable's damping
@@ -295,16 +308,19 @@ def _without_lines(fitted: list, calls: dict, refit: Callable) -> tuple[list, se
     1σ of ζ_median · f: the random response's maximum lies anywhere
     within about half the mode's half-power band. Returns the pairs and
     the ids of the fits so widened (their damping is not known).
+    `options`: default the calibrated values.
     """
+    options = PickingOptions() if options is None else options
+    check = options.decay_check
     zetas = [fit.damping for _, fit in fitted if isinstance(fit, DecayFit)]
     if len(zetas) < 3:
         return fitted, set()
     median = float(np.median(zetas))
     out, widened = [], set()
     for c, fit in fitted:
-        narrow = isinstance(fit, DecayFit) and fit.damping < min(NARROW_DAMPING, median / BROADER_PEAK)
-        if narrow and id(fit) in calls and not at_mains_harmonic(fit.frequency):
-            other = refit(*calls[id(fit)], 3.0 * median / BROADER_PEAK)
+        narrow = isinstance(fit, DecayFit) and fit.damping < min(check.narrow_damping, median / check.broader_peak)
+        if narrow and id(fit) in calls and not at_mains_harmonic(fit.frequency, options.filters):
+            other = refit(*calls[id(fit)], 3.0 * median / check.broader_peak)
             if other is not None and other.converged:
                 fit = other
             else:
@@ -314,40 +330,42 @@ def _without_lines(fitted: list, calls: dict, refit: Callable) -> tuple[list, se
     return out, widened
 
 
-def _sound(fit: AmbientFit | None, half_width: float) -> bool:
-    """A converged Whittle fit that locates its mode: 1σ within a quarter of the band's half-width.
+def _sound(fit: AmbientFit | None, half_width: float, options: DecayCheckOptions | None = None) -> bool:
+    """A converged Whittle fit that locates its mode: 1σ within a quarter (``options.whittle_max_std``) of the
+    band's half-width.
 
     A pole narrower than the record resolves (ζ at its lower bound) leaves
     the likelihood flat in frequency: the fit "converges" with a 1σ of
     hertz, which is no estimate.
     """
+    options = DecayCheckOptions() if options is None else options
     return fit is not None and fit.converged and bool(np.isfinite(fit.frequency_std)) and (
-        fit.frequency_std <= WHITTLE_MAX_STD * half_width
+        fit.frequency_std <= options.whittle_max_std * half_width
     )
 
 
-def _decay_peak(c: Candidate, fit: DecayFit, names) -> Peak:
+def _decay_peak(c: Candidate, fit: DecayFit, names, channel_snr_db: float) -> Peak:
     strongest = int(np.argmax((np.abs(fit.amplitude) ** 2).sum(axis=1)))
     return Peak(
         frequency=fit.frequency,
         uncertainty=fit.frequency_std,
         damping=fit.damping,
         damping_uncertainty=fit.damping_std,
-        channels=_channels(fit.channel_snr_db, names),
+        channels=_channels(fit.channel_snr_db, names, channel_snr_db),
         amplitude=_signed(fit.amplitude[strongest]),
         snr_db=c.snr_db,
         channel_snr_db=fit.channel_snr_db,
     )
 
 
-def _ambient_peak(c: Candidate, fit: AmbientFit, overview: Overview, names) -> Peak:
+def _ambient_peak(c: Candidate, fit: AmbientFit, overview: Overview, names, channel_snr_db: float) -> Peak:
     snr = _channel_ratio_db(overview, fit.frequency)
     return Peak(
         frequency=fit.frequency,
         uncertainty=fit.frequency_std,
         damping=fit.damping,
         damping_uncertainty=fit.damping_std,
-        channels=_channels(snr, names),
+        channels=_channels(snr, names, channel_snr_db),
         amplitude=fit.amplitude,
         snr_db=c.snr_db,
         channel_snr_db=snr,
@@ -364,10 +382,11 @@ def _record_dft(x: np.ndarray) -> np.ndarray:
     return out
 
 
-def _whittle_band(x: np.ndarray, fs: float, overview: Overview) -> Callable:
+def _whittle_band(x: np.ndarray, fs: float, overview: Overview, options: PickingOptions) -> Callable:
     """A band fitter using the debiased Whittle likelihood of the whole record (DFT computed once, on demand)."""
     n = x.shape[0]
     cache: dict = {}
+    max_damping = 2 * options.refine.max_damping
 
     def fit_band(f0, half_width, poles, peak_width):
         if "dft" not in cache:
@@ -375,35 +394,37 @@ def _whittle_band(x: np.ndarray, fs: float, overview: Overview) -> Callable:
         # Noise variance per DFT bin = one-sided PSD · fs / 2 (only the ratios between channels matter).
         floor = np.array([np.interp(f0, overview.frequency, col) for col in overview.channel_floor.T])
         noise_scale = np.sqrt(floor * fs / 2.0)
-        return fit_ambient(
-            cache["dft"], n, fs, f0, half_width, noise_scale, poles, peak_width=peak_width, max_damping=2 * MAX_DAMPING
-        )
+        return fit_ambient(cache["dft"], n, fs, f0, half_width, noise_scale, poles, peak_width=peak_width,
+                           max_damping=max_damping, options=options.fit)
 
     return fit_band
 
 
-def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band) -> list[Peak]:
+def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band, options: PickingOptions) -> list[Peak]:
     """Whittle fits of the candidates, then of what the fitted modes leave unexplained (:mod:`.residual`)."""
     resolution = overview.frequency[1] - overview.frequency[0]
-    fit_band = _whittle_band(x, fs, overview)
+    fit_band = _whittle_band(x, fs, overview, options)
     cache: dict = {}
+    min_half_width = options.refine.band_min_welch_bins * resolution
 
     def fitted(candidates):
         return refine(
-            candidates, fit_band, 1.5 * resolution, BAND_MIN_WELCH_BINS * resolution, 0.5 * fs, resolution, cache
+            candidates, fit_band, 1.5 * resolution, min_half_width, 0.5 * fs, resolution, cache, options.refine
         )
 
     pairs = fitted(candidates)
     modes = [(fit.frequency, fit.decay_rate, fit.amplitude) for _, fit in pairs if fit is not None]
-    extra = residual_candidates(overview, fs, modes, candidates, *band)
+    extra = residual_candidates(overview, fs, modes, candidates, *band, options=options.residual,
+                                detection_options=options.detection, floor_options=options.floor)
     if extra:
         pairs = fitted(sorted([c for c, _ in pairs] + extra, key=lambda c: c.frequency))
+    snr_db = options.filters.channel_snr_db
     peaks = []
     for c, fit in pairs:
         if fit is None:
-            peaks.append(_overview_peak(c, overview, names))
+            peaks.append(_overview_peak(c, overview, names, snr_db))
         else:
-            peaks.append(_ambient_peak(c, fit, overview, names))
+            peaks.append(_ambient_peak(c, fit, overview, names, snr_db))
     return peaks
 
 
@@ -412,9 +433,9 @@ def _channel_ratio_db(overview: Overview, frequency: float) -> np.ndarray:
     return 10 * np.log10(np.array([np.interp(frequency, overview.frequency, col) for col in ratio.T]))
 
 
-def _channels(snr_db: np.ndarray, names: tuple[str, ...]) -> tuple[str, ...]:
-    """Channels at or above CHANNEL_SNR_DB; if none, the best one (the peak was seen in the combination)."""
-    seen = np.flatnonzero(snr_db >= CHANNEL_SNR_DB)
+def _channels(snr_db: np.ndarray, names: tuple[str, ...], channel_snr_db: float) -> tuple[str, ...]:
+    """Channels at or above `channel_snr_db`; if none, the best one (the peak was seen in the combination)."""
+    seen = np.flatnonzero(snr_db >= channel_snr_db)
     if seen.size == 0:
         seen = [int(np.argmax(snr_db))]
     return tuple(names[k] for k in seen)
@@ -426,7 +447,7 @@ def _signed(amplitude: np.ndarray) -> np.ndarray:
     return np.abs(amplitude) * np.sign(np.cos(np.angle(amplitude) - np.angle(ref)))
 
 
-def _overview_peak(c: Candidate, overview: Overview, names) -> Peak:
+def _overview_peak(c: Candidate, overview: Overview, names, channel_snr_db: float) -> Peak:
     """Fallback when the fit fails: the interpolated overview peak.
 
     Its 1σ is a quarter of the -3 dB width, and at least the uniform 1σ
@@ -442,7 +463,7 @@ def _overview_peak(c: Candidate, overview: Overview, names) -> Peak:
         uncertainty=float(max(overview.cell * df / np.sqrt(12.0), 0.25 * c.half_power_width)),
         damping=None,
         damping_uncertainty=None,
-        channels=_channels(snr, names),
+        channels=_channels(snr, names, channel_snr_db),
         amplitude=amplitude,
         snr_db=c.snr_db,
         channel_snr_db=snr,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -22,6 +22,7 @@ from ..forward import natural_frequencies
 from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
+from .options import PickingOptions
 from .peaks import PeakResult, find_peaks
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -49,6 +50,7 @@ class TestSpectra(Result):
     peaks, numbering : the full intermediate results (for plots)
     nominal_frequencies : the nominal model's frequencies of modes 1, 2, ... that the peaks were numbered
         against (Hz; for plots), or None
+    options : the picking and numbering options used (how the result was made)
     """
 
     __test__ = False
@@ -67,13 +69,14 @@ class TestSpectra(Result):
     numbering: Numbering
     damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
     nominal_frequencies: np.ndarray | None = None
+    options: PickingOptions = field(default_factory=PickingOptions)
 
     main_table = "modes"
 
     @property
-    def settings(self) -> None:
-        """None: the peak picking records no settings yet."""
-        return None
+    def settings(self) -> PickingOptions:
+        """How the result was made: its picking options (``options``)."""
+        return self.options
 
     @property
     def notes(self) -> tuple:
@@ -107,6 +110,7 @@ class TestSpectra(Result):
             "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
             "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
+            "options": self.options.summary(),
         }
 
 
@@ -130,17 +134,23 @@ def record_path(campaign: Campaign, test: Test) -> str:
 
 
 def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
-                 tension_model: str = "uniform") -> TestSpectra:
+                 tension_model: str = "uniform", options: PickingOptions | None = None) -> TestSpectra:
     """Pick and number the modal frequencies of one test's record (in any format io reads; the test's
-    ``channels`` give the positions a file lacks)."""
+    ``channels`` give the positions a file lacks).
+
+    ``options`` tunes the picking and the numbering (default: the
+    calibrated values); the result records them.
+    """
     path = record_path(campaign, test)
     record = read_record(path, positions=dict(test.channels) or None)
-    return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model)
+    return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model,
+                          options=options)
 
 
 def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *, max_modes: int = DEFAULT_MAX_MODES,
-                   tension_model: str = "uniform") -> TestSpectra:
+                   tension_model: str = "uniform", options: PickingOptions | None = None) -> TestSpectra:
     """:func:`analyse_test` of a record already read (from ``path``); its mean is removed in place."""
+    options = PickingOptions() if options is None else options
     cable = campaign.cable
     atts = campaign.setup(test.setup).attachments
     check_positions(record, cable.length, file=path)
@@ -149,10 +159,12 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     usable = 0.45  # of the sampling rate: the analysis band ends below the anti-aliasing filter's roll-off
     check_bandwidth(record, nominal[0], usable=usable, file=path)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
-    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True)  # the record is ours
+    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True,  # the record is ours
+                        options=options)
     freqs = np.array([p.frequency for p in result.peaks])
     unc = np.array([p.uncertainty for p in result.peaks])
-    numbering = number_modes(freqs, unc, cable, atts, test.tension, tension_model=tension_model)
+    numbering = number_modes(freqs, unc, cable, atts, test.tension, options=options.numbering,
+                             tension_model=tension_model)
     order = [i for i in np.argsort(numbering.modes) if numbering.modes[i] > 0]
     peaks = result.peaks
     return TestSpectra(
@@ -167,17 +179,18 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
+        options=options,
     )
 
 
 def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, progress=None,
-                     tension_model: str = "uniform") -> list[TestSpectra]:
-    """:func:`analyse_test` for every selected test that has a record."""
+                     tension_model: str = "uniform", options: PickingOptions | None = None) -> list[TestSpectra]:
+    """:func:`analyse_test` for every selected test that has a record (with the same ``options``)."""
     selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
     with_record = [t for t in selected if t.record is not None]
     out = []
     for k, test in enumerate(with_record, 1):
         if progress is not None:
             progress(f"spectra: test {test.name} ({k} of {len(with_record)})")
-        out.append(analyse_test(campaign, test, tension_model=tension_model))
+        out.append(analyse_test(campaign, test, tension_model=tension_model, options=options))
     return out

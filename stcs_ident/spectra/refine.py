@@ -32,16 +32,11 @@ from collections.abc import Callable
 import numpy as np
 
 from .detection import Candidate
+from .options import RefineOptions
 
-__all__ = ["FALLBACK_SNR_DB", "MAX_DAMPING", "MIN_SIGNIFICANCE", "refine"]
+__all__ = ["refine"]
 
-MIN_SIGNIFICANCE = 6.0  # a fitted mode below this z-like score is a detection on a skirt or on noise
-FALLBACK_SNR_DB = 10.0  # a peak whose fit failed is still reported (overview estimate) if this strong
-MAX_DAMPING = 0.1  # a fitted ζ at or above this describes a broad spectral shape, not a cable mode
-BAND_HALF_POWER_WIDTHS = 8.0
-BAND_NEIGHBOUR_FRACTION = 0.45
-BAND_NEIGHBOUR_FRACTION_WIDE = 0.9  # last try for a doubtful fit: the band reaches over to the neighbours' peaks
-BAND_MAX_RELATIVE = 0.25
+# The bands' sizes and what a mode is (significance, damping, fallback) are :class:`.options.RefineOptions`.
 
 # A band fitter: (centre Hz, half-width Hz, neighbour poles [(f, σ)], -3 dB width Hz) -> fit or None; a fit
 # has .frequency, .decay_rate, .damping, .significance and .converged.
@@ -53,38 +48,38 @@ def _candidate_pole(c: Candidate, resolution: float) -> tuple[float, float]:
     return c.frequency, np.pi * max(c.half_power_width - resolution, 0.25 * resolution)
 
 
-def _band_limit(
-    c: Candidate, neighbours: list[Candidate], nyquist: float, fraction: float = BAND_NEIGHBOUR_FRACTION
-) -> float:
+def _band_limit(c: Candidate, neighbours: list[Candidate], nyquist: float, fraction: float,
+                max_relative: float) -> float:
     gaps = [abs(n.frequency - c.frequency) for n in neighbours]
-    return min([fraction * g for g in gaps] + [BAND_MAX_RELATIVE * c.frequency, nyquist - c.frequency])
+    return min([fraction * g for g in gaps] + [max_relative * c.frequency, nyquist - c.frequency])
 
 
-def _plausible(c: Candidate, fit, cell_width: float) -> bool:
-    """A converged fit that describes the detected peak: a cable mode (ζ < MAX_DAMPING) near the candidate.
+def _plausible(c: Candidate, fit, cell_width: float, max_damping: float) -> bool:
+    """A converged fit that describes the detected peak: a cable mode (ζ < `max_damping`) near the candidate.
 
     Near means within two half-power widths (the candidate's or the
     fitted one, 2σ/2π), or three resolution cells: on a randomly excited
     resonance the highest bin can lie well off the pole.
     """
-    if fit is None or not fit.converged or fit.damping >= MAX_DAMPING:
+    if fit is None or not fit.converged or fit.damping >= max_damping:
         return False
     width = max(c.half_power_width, fit.decay_rate / np.pi)
     return abs(fit.frequency - c.frequency) <= max(2.0 * width, 3.0 * cell_width)
 
 
-def _strong(c: Candidate, cell_width: float) -> bool:
-    """A peak to report even when its fit fails: FALLBACK_SNR_DB high and as narrow as a cable mode (2ζf).
+def _strong(c: Candidate, cell_width: float, options: RefineOptions) -> bool:
+    """A peak to report even when its fit fails: ``fallback_snr_db`` high and as narrow as a cable mode (2ζf).
 
     (Or no wider than four resolution cells: the overview cannot resolve a narrower peak.) A proposal of
     a coarser overview is never strong: only its fit can confirm it.
     """
-    narrow = c.half_power_width <= max(2 * MAX_DAMPING * c.frequency, 4 * cell_width)
-    return c.snr_db >= FALLBACK_SNR_DB and narrow and not c.proposal
+    narrow = c.half_power_width <= max(2 * options.max_damping * c.frequency, 4 * cell_width)
+    return c.snr_db >= options.fallback_snr_db and narrow and not c.proposal
 
 
 def _fit_candidate(
-    c: Candidate, neighbours: list[Candidate], fit_band: BandFitter, resolution, min_half_width, nyquist, cell_width
+    c: Candidate, neighbours: list[Candidate], fit_band: BandFitter, resolution, min_half_width, nyquist, cell_width,
+    options: RefineOptions,
 ):
     """Fit one candidate in a band of about eight half-power widths.
 
@@ -95,28 +90,29 @@ def _fit_candidate(
     the way to the neighbours (kept only if it then describes a significant
     mode near the detection).
     """
-    limit = _band_limit(c, neighbours, nyquist)
-    width = max(BAND_HALF_POWER_WIDTHS * max(c.half_power_width - resolution, resolution), min_half_width)
+    o = options
+    limit = _band_limit(c, neighbours, nyquist, o.band_neighbour_fraction, o.band_max_relative)
+    width = max(o.band_half_power_widths * max(c.half_power_width - resolution, resolution), min_half_width)
     half_width = min(width, limit)
     poles = [_candidate_pole(n, resolution) for n in neighbours]
     fit = fit_band(c.frequency, half_width, poles, c.half_power_width)
-    if _plausible(c, fit, cell_width) and fit.significance >= MIN_SIGNIFICANCE:
-        wanted = min(BAND_HALF_POWER_WIDTHS * fit.decay_rate / np.pi, limit)
+    if _plausible(c, fit, cell_width, o.max_damping) and fit.significance >= o.min_significance:
+        wanted = min(o.band_half_power_widths * fit.decay_rate / np.pi, limit)
         start = fit.frequency
     else:
         wanted, start = limit, c.frequency
     if wanted > 1.5 * half_width:
         wider = fit_band(start, wanted, poles, c.half_power_width)
-        if _plausible(c, wider, cell_width):
+        if _plausible(c, wider, cell_width, o.max_damping):
             fit = wider
-    if neighbours and not (_plausible(c, fit, cell_width) and fit.significance >= MIN_SIGNIFICANCE):
+    if neighbours and not (_plausible(c, fit, cell_width, o.max_damping) and fit.significance >= o.min_significance):
         # A broad mode between close neighbours: within 0.45 of the gap its skirts look like the background
         # (constant, slope, the neighbours' tails) and the fit settles on ripple. Reaching over to the
         # neighbours' peaks pins the background down.
-        widest = _band_limit(c, neighbours, nyquist, BAND_NEIGHBOUR_FRACTION_WIDE)
+        widest = _band_limit(c, neighbours, nyquist, o.band_neighbour_fraction_wide, o.band_max_relative)
         if widest > 1.2 * max(half_width, wanted):
             wide = fit_band(c.frequency, widest, poles, c.half_power_width)
-            if _plausible(c, wide, cell_width) and wide.significance >= MIN_SIGNIFICANCE:
+            if _plausible(c, wide, cell_width, o.max_damping) and wide.significance >= o.min_significance:
                 fit = wide
     return fit
 
@@ -129,6 +125,7 @@ def refine(
     nyquist: float,
     cell_width: float,
     cache: dict | None = None,
+    options: RefineOptions | None = None,
 ) -> list[tuple[Candidate, object]]:
     """Fit every candidate with its active neighbours, dropping non-modes one at a time (module docstring).
 
@@ -148,7 +145,10 @@ def refine(
     cache : dict, optional
         Fits by candidate and neighbours, shared between calls on the same
         record (a second call with more candidates refits only the
-        candidates whose neighbours changed).
+        candidates whose neighbours changed, so it is only shared between
+        calls with the same `options`).
+    options : RefineOptions, optional
+        Bands and what a mode is (default: the calibrated values).
 
     Returns
     -------
@@ -156,15 +156,16 @@ def refine(
         The candidates kept, in frequency order; None where the fit failed
         on a peak too strong to drop.
     """
+    options = RefineOptions() if options is None else options
     active = list(range(len(candidates)))
     cache = {} if cache is None else cache
     fits: dict = {}
 
     def doubtful(i):
         fit = fits[i]
-        if not _plausible(candidates[i], fit, cell_width):
-            return not _strong(candidates[i], cell_width)
-        return fit.significance < MIN_SIGNIFICANCE
+        if not _plausible(candidates[i], fit, cell_width, options.max_damping):
+            return not _strong(candidates[i], cell_width, options)
+        return fit.significance < options.min_significance
 
     while True:
         for pos, i in enumerate(active):
@@ -179,20 +180,21 @@ def refine(
                     min_half_width,
                     nyquist,
                     cell_width,
+                    options,
                 )
             fits[i] = cache[key]
         weak = [i for i in active if doubtful(i)]
         if not weak:
-            return _without_satellites([(candidates[i], fits[i]) for i in active], cell_width)
+            return _without_satellites([(candidates[i], fits[i]) for i in active], cell_width, options.max_damping)
         active.remove(min(weak, key=lambda i: candidates[i].snr_db))
 
 
-def _without_satellites(pairs, cell_width: float) -> list[tuple[Candidate, object]]:
+def _without_satellites(pairs, cell_width: float, max_damping: float) -> list[tuple[Candidate, object]]:
     """Failed fits become None; a failed one within two half-power widths of a fitted mode is ripple on it: dropped."""
-    modes = [fit for c, fit in pairs if _plausible(c, fit, cell_width)]
+    modes = [fit for c, fit in pairs if _plausible(c, fit, cell_width, max_damping)]
     out = []
     for c, fit in pairs:
-        if _plausible(c, fit, cell_width):
+        if _plausible(c, fit, cell_width, max_damping):
             out.append((c, fit))
         elif all(abs(c.frequency - m.frequency) > 2 * max(c.half_power_width, m.decay_rate / np.pi) for m in modes):
             out.append((c, None))

@@ -50,14 +50,14 @@ import numpy as np
 from scipy import signal
 from scipy.fft import irfft, rfft
 
-from .detection import FALSE_ALARM, Candidate, detection_threshold, peak_candidate
+from .detection import Candidate, detection_threshold, peak_candidate
 from .floor import noise_floor
+from .options import DetectionOptions, FloorOptions, ResidualOptions
 from .overview import Overview
 
 __all__ = ["model_spectra", "residual_candidates"]
 
-RESIDUAL_FALSE_ALARM_SHARE = 0.5  # of the record's false-alarm probability, on top of the overview's
-CLEARANCE_WIDTHS = 1.0  # a residual peak within this many half-power widths of a fitted mode is its misfit
+# The share of the false-alarm probability and the clearance are :class:`.options.ResidualOptions`.
 
 
 def model_spectra(overview: Overview, sampling_rate: float, modes: list[tuple[float, float, np.ndarray]]) -> np.ndarray:
@@ -105,6 +105,10 @@ def residual_candidates(
     tried: list[Candidate],
     f_min: float,
     f_max: float,
+    *,
+    options: ResidualOptions | None = None,
+    detection_options: DetectionOptions | None = None,
+    floor_options: FloorOptions | None = None,
 ) -> list[Candidate]:
     """Proposals where the Welch spectrum exceeds the fitted modes' expectation (see the module docstring).
 
@@ -120,6 +124,10 @@ def residual_candidates(
         Candidates already fitted: no proposal within their half-power width.
     f_min, f_max : float
         Band searched, Hz.
+    options, detection_options, floor_options : optional
+        The pass's share of the false-alarm probability and clearance, the
+        record's false-alarm probability, the floors (default: the
+        calibrated values).
 
     Returns
     -------
@@ -127,6 +135,8 @@ def residual_candidates(
         Proposals (``proposal=True``) in frequency order, on the overview's
         grid, their ``spectrum`` the overview's combined one.
     """
+    options = ResidualOptions() if options is None else options
+    detection_options = DetectionOptions() if detection_options is None else detection_options
     f = overview.frequency
     df = f[1] - f[0]
     lo = max(int(np.ceil(f_min / df)), 3 * overview.cell)
@@ -138,31 +148,33 @@ def residual_candidates(
     # The floor afresh, of what the modes leave: where resonances fill the band, the overview's floor holds
     # their tails (it follows the valleys between them), and with the model on top they would count twice.
     floor = (
-        noise_floor(np.maximum(overview.channel_spectra - model, 0.0), overview.dof, overview.cell, passes=1)
+        noise_floor(np.maximum(overview.channel_spectra - model, 0.0), overview.dof, overview.cell, passes=1,
+                    options=floor_options)
         if modes
         else overview.channel_floor
     )
     expected = floor + model
     ratio = overview.channel_spectra / expected
-    false_alarm = RESIDUAL_FALSE_ALARM_SHARE * FALSE_ALARM
+    false_alarm = options.false_alarm_share * detection_options.false_alarm
     statistics = [(ratio.mean(axis=1), overview.combined_dof, False)]
     if ratio.shape[1] > 1:
         statistics.append((ratio.max(axis=1), overview.channel_dof, True))
     found: list[Candidate] = []
     for statistic, dof, per_channel in statistics:
-        threshold = detection_threshold(overview, n_cells, per_channel=per_channel, false_alarm=false_alarm)
+        threshold = detection_threshold(overview, n_cells, false_alarm, per_channel=per_channel,
+                                        floor_options=floor_options)
         index, _ = signal.find_peaks(statistic, distance=max(1, overview.cell))
         index = index[(index >= lo) & (index <= hi)]
         for k in index[statistic[index] >= threshold[index]]:
             c = peak_candidate(overview, statistic, int(k), threshold[k], dof[k])
-            if _clear(c, modes, tried + found):
+            if _clear(c, modes, tried + found, options.clearance_widths):
                 found.append(replace(c, spectrum=overview.combined / overview.combined_floor, proposal=True))
     return sorted(found, key=lambda c: c.frequency)
 
 
-def _clear(c: Candidate, modes, others: list[Candidate]) -> bool:
-    """Away from every fitted mode (CLEARANCE_WIDTHS half-power widths) and from every candidate's peak."""
+def _clear(c: Candidate, modes, others: list[Candidate], clearance_widths: float) -> bool:
+    """Away from every fitted mode (`clearance_widths` half-power widths) and from every candidate's peak."""
     for frequency, decay, _ in modes:
-        if abs(c.frequency - frequency) <= CLEARANCE_WIDTHS * max(decay / np.pi, c.half_power_width):
+        if abs(c.frequency - frequency) <= clearance_widths * max(decay / np.pi, c.half_power_width):
             return False
     return all(abs(c.frequency - k.frequency) > max(c.half_power_width, k.half_power_width) for k in others)

@@ -6,7 +6,8 @@ Blows minutes apart ring at frequencies that differ by more than their
 noise, and the mean is then known only as well as the events' scatter
 allows. Two estimates of that scatter, both random-effects
 (DerSimonian–Laird) and both taken only where Cochran's Q shows that the
-events disagree (level HETEROGENEITY_LEVEL; without the test, chance
+events disagree (level ``heterogeneity_level`` of
+:class:`.options.FitOptions`, 0.05; without the test, chance
 scatter of two or three clean events made the 1σ too large, 78–88 %
 within 1σ on clean records):
 
@@ -26,10 +27,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
+from .options import FitOptions
+
 __all__ = ["between_events_addition", "common_wander", "random_effects_variance", "with_common_wander"]
-
-HETEROGENEITY_LEVEL = 0.05  # Cochran's Q test of the events' agreement before a between-event variance is added
-
 
 def random_effects_variance(variances: np.ndarray, tau2: float) -> float:
     """Variance of the random-effects mean of estimates of variance ``variances`` scattered by τ²: 1 / Σ 1/(v_i + τ²)."""
@@ -37,31 +37,33 @@ def random_effects_variance(variances: np.ndarray, tau2: float) -> float:
     return 1.0 / float(np.sum(1.0 / (v + tau2)))
 
 
-def _dersimonian_laird(values: np.ndarray, variances: np.ndarray) -> float:
-    """τ² of the values' scatter beyond their variances, 0 unless Cochran's Q rejects agreement."""
+def _dersimonian_laird(values: np.ndarray, variances: np.ndarray, level: float) -> float:
+    """τ² of the values' scatter beyond their variances, 0 unless Cochran's Q rejects agreement at `level`."""
     w = 1.0 / variances
     mean = np.sum(w * values) / np.sum(w)
     q = float(np.sum(w * (values - mean) ** 2))
-    if q <= stats.chi2.isf(HETEROGENEITY_LEVEL, values.size - 1):
+    if q <= stats.chi2.isf(level, values.size - 1):
         return 0.0
     return max(0.0, (q - (values.size - 1)) / float(np.sum(w) - np.sum(w**2) / np.sum(w)))
 
 
-def between_events_addition(frequencies: np.ndarray, variances: np.ndarray, joint_variance: float) -> float:
+def between_events_addition(frequencies: np.ndarray, variances: np.ndarray, joint_variance: float,
+                            level: float = FitOptions.heterogeneity_level) -> float:
     """What to add to a joint fit's frequency variance for its events' disagreement (0 with fewer than two).
 
     ``frequencies`` and ``variances`` are the events' own fits of the mode
     (NaN where one failed); the joint estimate is given the random-effects
-    variance of the mean where that exceeds ``joint_variance``.
+    variance of the mean where that exceeds ``joint_variance``, if Cochran's
+    Q rejects the events' agreement at ``level``.
     """
     f, v = _usable(frequencies, variances)
     if f.size < 2:
         return 0.0
-    tau2 = _dersimonian_laird(f, v)
+    tau2 = _dersimonian_laird(f, v, level)
     return max(0.0, random_effects_variance(v, tau2) - joint_variance) if tau2 > 0 else 0.0
 
 
-def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]]) -> float:
+def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]], level: float = FitOptions.heterogeneity_level) -> float:
     """Relative τ² of the events' common frequency offset, pooled over modes (0 where the events agree).
 
     Parameters
@@ -70,6 +72,8 @@ def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]]) -> float:
         Per mode, its joint estimate and its events' own fits (Hz, Hz²;
         NaN where an event's fit failed), the events in the same order
         for every mode.
+    level : float
+        Level of Cochran's Q test of the events' agreement.
 
     The offset of event i is the weighted mean over modes of
     f_ik / f_k − 1; their scatter about their weighted mean is tested
@@ -95,7 +99,7 @@ def common_wander(modes: list[tuple[float, np.ndarray, np.ndarray]]) -> float:
     seen = den > 0
     if np.sum(seen) < 2:
         return 0.0
-    return _dersimonian_laird(num[seen] / den[seen], 1.0 / den[seen])
+    return _dersimonian_laird(num[seen] / den[seen], 1.0 / den[seen], level)
 
 
 def with_common_wander(std: float, frequency: float, event_variances: np.ndarray, tau2: float) -> float:
