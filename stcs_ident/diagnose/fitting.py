@@ -373,7 +373,11 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         for x in grid:
             hyp = build(campaign, tests, effects, {**positions, scanned: float(x)}, fixed=(scanned,))
             problem = hypothesis_problem(hyp, measurements, tension_model)
-            starts = _starts_from(problem, [previous] if previous else seeds, nominal=not previous)
+            carried = [previous] if previous else list(seeds)
+            amount = (registry.get(scanned).amount_kind, unmodeled_name(scanned))
+            fresh = [{**(previous or {}), amount: a}
+                     for a in registry.get(scanned).amount_starts(campaign, tests, float(x))]
+            starts = _starts_from(problem, carried + fresh, nominal=not previous)
             xb, c = quietly(lambda problem=problem, starts=starts: min(
                 (local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}

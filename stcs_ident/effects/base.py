@@ -234,6 +234,12 @@ class UnmodeledAttachment(Effect):
         """Upper bound of the amplitude (SI)."""
         raise NotImplementedError
 
+    def amount_starts(self, campaign: Campaign, tests: Sequence[Test], position: float) -> tuple[float, ...]:
+        """Amplitudes (SI) from which the diagnosis's profile scan also starts at ``position``, beside the
+        value carried over from the previous position; none by default (an amplitude whose effect grows
+        monotonically needs no other)."""
+        return ()
+
     def unmodeled_parameters(self, campaign: Campaign, tests: Sequence[Test], slots: tuple[tuple[str, int], ...],
                              x0: float, fixed: bool) -> list[Parameter]:
         """The amplitude (and, unless ``fixed``, the position) of the added attachment."""

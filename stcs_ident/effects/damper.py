@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ..core.errors import ModelError
-from ..core.kinds import coefficient_upper
+from ..core.kinds import coefficient_upper, mean_tension
 from ..core.model import Damper
 from .base import Option, Quantity, UnmodeledAttachment
 
@@ -39,6 +39,21 @@ class UnmodeledDamper(UnmodeledAttachment):
 
     def amount_upper(self, campaign, tests):
         return coefficient_upper(campaign)
+
+    def amount_starts(self, campaign, tests, position):
+        """Dashpots a decade below, at and a decade above mode 1's optimum for a damper at ``position``
+        (η₁ = c π d/(l √(H m)) = 0.1, 1, 10, d the distance to the nearer end).
+
+        A damper's damping ratios rise and then fall with its dashpot (Krenk's universal curve), so the
+        fit of a dashpot has a basin on either side of the optimum, and one started from the dashpot of the
+        previous position of the scan could stay in the wrong one, or in a region where the model has no
+        modes to give (a large dashpot far from the ends makes a mode overdamped).
+        """
+        cable = campaign.cable
+        distance = max(min(position, cable.length - position), 1e-6 * cable.length)
+        optimum = math.sqrt(mean_tension(campaign) * cable.mass_per_length) * cable.length / (math.pi * distance)
+        upper = self.amount_upper(campaign, tests)
+        return tuple(min(eta * optimum, upper) for eta in (0.1, 1.0, 10.0))
 
     def check_truth(self, value, field):
         checked = super().check_truth(value, field)
