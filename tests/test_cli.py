@@ -112,7 +112,7 @@ def test_unwritable_json_leaves_nothing(tmp_path, capsys):
 
 
 def _bad_cases():
-    from test_campaign_io import BAD
+    from tests.test_campaign_io import BAD
 
     return BAD
 

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 import pytest
-from random_cables import random_end
+from tests.random_cables import random_end
 from scipy.optimize import minimize_scalar
 
 from stcs_ident.core.errors import ComputationError

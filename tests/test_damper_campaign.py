@@ -7,7 +7,7 @@ import json
 import math
 
 import pytest
-from test_campaign_io import assert_one_line_naming, edited, write_campaign
+from tests.test_campaign_io import assert_one_line_naming, edited, write_campaign
 
 from stcs_ident.cli.main import main
 from stcs_ident.core.errors import CampaignError

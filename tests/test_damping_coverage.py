@@ -1,7 +1,7 @@
 """Coverage of the stated 1σ of the picked damping ratios, with and without a damper (a fast subset).
 
 The records and the scoring are those of ``benchmarks/calibrate_damping.py``
-(loaded from its file: one recipe for the benchmark and the test), on a
+(imported from the benchmarks package: one recipe for the benchmark and the test), on a
 held-out seed: the spectra code was examined and mended on seed 1, the
 benchmark's report is seed 2, this test is seed 3. The truth is the modal ζ
 given to the simulator or, with a damper, the complex mode's −Re(s)/|s|.
@@ -17,13 +17,12 @@ more once in 60 runs). Per kind of record (blows, wind only) the median
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+
+from benchmarks import calibrate_damping as harness
 
 HELD_OUT_SEED = 3
 
@@ -37,18 +36,8 @@ CASES = [
 ]
 
 
-def _harness():
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "calibrate_damping.py"
-    spec = importlib.util.spec_from_file_location("calibrate_damping", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up while the class is built
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
 def pairs():
-    harness = _harness()
     out = []
     for group, case, n in CASES:
         for i in range(n):

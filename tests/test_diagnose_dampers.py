@@ -23,7 +23,7 @@ import math
 import warnings
 
 import pytest
-from diagnose_cases import BENCHES, MAX_MODES
+from tests.diagnose_cases import BENCHES, MAX_MODES
 
 from stcs_ident import effects as registry
 from stcs_ident.core.model import Campaign, Damper, Setup, Test

@@ -20,7 +20,7 @@ import math
 import warnings
 
 import pytest
-from diagnose_cases import BENCHES, simulated
+from tests.diagnose_cases import BENCHES, simulated
 
 from stcs_ident.diagnose import diagnose
 from stcs_ident.simulate.effects import Effects

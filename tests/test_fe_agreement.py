@@ -12,7 +12,7 @@ exact answer.
 
 import numpy as np
 import pytest
-from random_cables import random_configuration
+from tests.random_cables import random_configuration
 
 from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.forward import natural_frequencies

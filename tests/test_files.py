@@ -99,7 +99,7 @@ def test_simulate_killed_at_any_moment_leaves_nothing_half_written(tmp_path):
     import sys
     import time
 
-    from fuzz_inputs import BASE_TOML, _frequencies
+    from tests.fuzz_inputs import BASE_TOML, _frequencies
 
     campaign = tmp_path / "c"
     campaign.mkdir()

@@ -174,7 +174,7 @@ def test_compiled_kernel_matches_numpy_path(monkeypatch):
     random configurations they agree to the refinement tolerance."""
     import os
 
-    from random_cables import random_configuration
+    from tests.random_cables import random_configuration
 
     from stcs_ident.forward import roots
 

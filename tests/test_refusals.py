@@ -9,7 +9,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
-from fuzz_inputs import BASE_TOML, _frequencies, _record
+from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
 
 from stcs_ident.cli.main import main
 

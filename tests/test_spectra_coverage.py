@@ -1,7 +1,7 @@
 """Coverage of the stated 1σ of the picked frequencies under field-like conditions (a fast subset).
 
 The records and the scoring are those of ``benchmarks/calibrate_spectra.py``
-(loaded from its file: one recipe for the benchmark and the test), on a
+(imported from the benchmarks package: one recipe for the benchmark and the test), on a
 held-out seed: no constant of the spectra code was tuned on seed 3 (tuning
 used seed 2). Per condition group the fraction of (record, mode) pairs
 with |error| ≤ 1σ must be 68 % within three binomial standard errors, and
@@ -10,15 +10,12 @@ few errors may exceed 3σ; no mains-hum line may be reported as a mode.
 
 from __future__ import annotations
 
-import functools
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-from case_pool import map_cases
+
+from benchmarks import calibrate_spectra as harness
 
 HELD_OUT_SEED = 3
 
@@ -32,34 +29,15 @@ CASES = [
 ]
 
 
-@functools.cache
-def _harness():
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "calibrate_spectra.py"
-    spec = importlib.util.spec_from_file_location("calibrate_spectra", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up while the class is built
-    spec.loader.exec_module(module)
-    return module
-
-
 def _binomial_se(p: float, n: int) -> float:
     return math.sqrt(p * (1 - p) / n)
 
 
-def _run(case: tuple[str, str, int, int]) -> dict:
-    harness = _harness()
-    return harness.run_case(harness.build_case(*case))
-
-
 @pytest.fixture(scope="module")
 def results():
-    _harness()  # loaded once, before the workers fork
-    cases = [(group, cable, HELD_OUT_SEED, i) for group, cable, n in CASES for i in range(n)]
-    # The records are independent: run on the CPUs available, in order (tests/case_pool.py).
-    done = map_cases(_run, cases)
     out = {}
-    for (group, cable, _, _), result in zip(cases, done):
-        out.setdefault((group, cable), []).append(result)
+    for group, cable, n in CASES:  # in order, once per test run (the tests below share the records)
+        out[(group, cable)] = [harness.run_case(harness.build_case(group, cable, HELD_OUT_SEED, i)) for i in range(n)]
     return out
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from fuzz_inputs import BASE_TOML, _frequencies
+from tests.fuzz_inputs import BASE_TOML, _frequencies
 
 from stcs_ident.cli.main import main
 from stcs_ident.io.campaign import load_campaign
