@@ -23,17 +23,12 @@ import math
 import warnings
 
 import pytest
-from tests.diagnose_cases import BENCHES, MAX_MODES
-
 from stcs_ident import effects as registry
 from stcs_ident.core.model import Campaign, Damper, Setup, Test
 from stcs_ident.diagnose import diagnose
 from stcs_ident.diagnose.hypotheses import applicable
-from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.effects import Effects
-from stcs_ident.simulate.simulate import Impulse
-from stcs_ident.simulate.simulate_campaign import simulate_campaign
-from stcs_ident.spectra.pipeline import analyse_test
+from tests.diagnose_cases import BENCHES
 
 #: Damper position as a fraction of the length: on the stay 2 %, on the hanger 10 % (its boundary layer
 #: √(EI/H) is 0.7 m, 9 % of the length: a damper inside it barely moves the cable, and its dashpot is
@@ -55,17 +50,11 @@ def _campaign(bench: str, with_damper: bool) -> Campaign:
     return Campaign(f"{bench}-damped", b.cable, (Setup("S", points),), tests)
 
 
-def _diagnose(tmp_path, bench: str, nominal: Campaign, hidden: Effects | None, seed: int = 0, **options):
-    b = BENCHES[bench]
-    length = b.length
-    out = tmp_path / f"{bench}-{seed}"
+def _diagnose(bench_records, bench: str, nominal: Campaign, hidden: Effects | None, seed: int = 0, **options):
+    # the records of tests/diagnose_cases.py's recipe (30 dB, ζ 0.5 %, one blow), simulated once per run
+    campaign, picked = bench_records(bench, hidden, seed=seed, nominal=nominal)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a numbering warning on a shifted record is reported, not an error here
-        simulate_campaign(nominal, out, positions=[0.23 * length, 0.5 * length, 0.71 * length],
-                          duration=b.duration, sampling_rate=b.sampling_rate, damping=0.005,
-                          impulses=(Impulse(0.5, 0.17 * length, 1.0),), snr_db=30.0, effects=hidden, seed=seed)
-        campaign = load_campaign(out)
-        picked = {t.name: analyse_test(campaign, t, max_modes=MAX_MODES) for t in campaign.tests}
         return diagnose(campaign, picked=picked, **options)
 
 
@@ -75,10 +64,10 @@ def _cause(d) -> dict:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("bench", list(BENCHES))
-def test_a_leaking_damper_is_named_and_sized(tmp_path, bench):
+def test_a_leaking_damper_is_named_and_sized(bench_records, bench):
     nominal = _campaign(bench, with_damper=True)
     true = 0.3 * _damper(bench).coefficient
-    cause = _cause(_diagnose(tmp_path, bench, nominal, Effects(damper_coefficients={"D1": true}), max_effects=1))
+    cause = _cause(_diagnose(bench_records, bench, nominal, Effects(damper_coefficients={"D1": true}), max_effects=1))
     assert cause["effects"] == ["damper_coefficient"], cause["statement"]
     found = cause["parameters"]["damper_coefficient"]["coefficient"]["D1"]
     assert found == pytest.approx(true, rel=0.25)
@@ -86,12 +75,12 @@ def test_a_leaking_damper_is_named_and_sized(tmp_path, bench):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("bench", list(BENCHES))
-def test_a_missing_damper_is_named_sized_and_placed(tmp_path, bench):
+def test_a_missing_damper_is_named_sized_and_placed(bench_records, bench):
     """Asked for, a missing damper makes the measured damping ratios data for every hypothesis (the nominal
     model's ratios are the cable's own, one for all modes)."""
     nominal = _campaign(bench, with_damper=False)
     damper = _damper(bench)
-    cause = _cause(_diagnose(tmp_path, bench, nominal, Effects(extra_damper=(damper.coefficient, damper.position)),
+    cause = _cause(_diagnose(bench_records, bench, nominal, Effects(extra_damper=(damper.coefficient, damper.position)),
                              effects=[e for e in registry.names() if e != "damper_coefficient"], max_effects=1))
     assert cause["effects"] == ["damper"], cause["statement"]
     found = cause["parameters"]["damper"]
@@ -102,8 +91,8 @@ def test_a_missing_damper_is_named_sized_and_placed(tmp_path, bench):
 
 
 @pytest.mark.slow
-def test_a_healthy_damped_hanger_has_no_cause(tmp_path):
-    cause = _cause(_diagnose(tmp_path, "hanger", _campaign("hanger", with_damper=True), None, seed=3,
+def test_a_healthy_damped_hanger_has_no_cause(bench_records):
+    cause = _cause(_diagnose(bench_records, "hanger", _campaign("hanger", with_damper=True), None, seed=3,
                              max_effects=1))
     assert cause["effects"] == [], cause["statement"]
 

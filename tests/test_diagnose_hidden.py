@@ -17,13 +17,12 @@ simulations without any effect must give an empty cause (at least 19 of 20).
 from __future__ import annotations
 
 import math
-import warnings
 
 import pytest
-from tests.diagnose_cases import BENCHES, simulated
 
 from stcs_ident.diagnose import diagnose
 from stcs_ident.simulate.effects import Effects
+from tests.diagnose_cases import BENCHES
 
 
 def _effects(bench: str) -> dict[str, tuple[Effects, dict]]:
@@ -52,10 +51,8 @@ def _effects(bench: str) -> dict[str, tuple[Effects, dict]]:
 CASES = [(bench, effect) for bench in BENCHES for effect in _effects(bench)]
 
 
-def _diagnose(tmp_path, bench, effects, seed=0):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a numbering warning on a shifted record is reported, not an error here
-        campaign, picked = simulated(tmp_path, bench, effects, seed=seed)
+def _diagnose(bench_records, bench, effects, seed=0):
+    campaign, picked = bench_records(bench, effects, seed=seed)  # simulated once per run (tests/conftest.py)
     return diagnose(campaign, picked=picked)
 
 
@@ -83,9 +80,9 @@ def _check(effect: str, found: dict, expected: dict, length: float) -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("bench", "effect"), CASES)
-def test_hidden_effect_is_named_and_sized(tmp_path, bench, effect):
+def test_hidden_effect_is_named_and_sized(bench_records, bench, effect):
     hidden, expected = _effects(bench)[effect]
-    d = _diagnose(tmp_path, bench, hidden)
+    d = _diagnose(bench_records, bench, hidden)
     cause = d.summary()["cause"]
     assert cause["effects"] == [effect] and cause["principal"] == effect, (cause["effects"], cause["statement"])
     _check(effect, cause["parameters"][effect], expected, BENCHES[bench].length)
@@ -98,11 +95,11 @@ def test_hidden_effect_is_named_and_sized(tmp_path, bench, effect):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("bench", list(BENCHES))
-def test_compound_tension_error_and_unmodeled_mass_are_both_named(tmp_path, bench):
+def test_compound_tension_error_and_unmodeled_mass_are_both_named(bench_records, bench):
     b = BENCHES[bench]
     mass = 0.03 * b.cable.mass_per_length * b.length
     hidden = Effects(tension_ratio=0.97, extra_mass=(mass, 0.4 * b.length))
-    cause = _diagnose(tmp_path, bench, hidden).summary()["cause"]
+    cause = _diagnose(bench_records, bench, hidden).summary()["cause"]
     assert set(cause["effects"]) == {"tension", "unmodeled_mass"}, cause["statement"]
     found = cause["parameters"]
     for ratio in found["tension"]["ratio"].values():
@@ -113,11 +110,11 @@ def test_compound_tension_error_and_unmodeled_mass_are_both_named(tmp_path, benc
 
 @pytest.mark.slow
 @pytest.mark.parametrize("bench", list(BENCHES))
-def test_a_tension_within_tolerance_beside_a_hidden_mass_is_a_correction(tmp_path, bench):
+def test_a_tension_within_tolerance_beside_a_hidden_mass_is_a_correction(bench_records, bench):
     b = BENCHES[bench]
     mass = 0.03 * b.cable.mass_per_length * b.length
     hidden = Effects(tension_ratio=1.01, extra_mass=(mass, 0.4 * b.length))  # 1 %: within the 2 % tolerance
-    cause = _diagnose(tmp_path, bench, hidden).summary()["cause"]
+    cause = _diagnose(bench_records, bench, hidden).summary()["cause"]
     assert cause["effects"] == ["unmodeled_mass"], cause["statement"]
     assert list(cause["corrections"]) == ["tension"]
     for ratio in cause["corrections"]["tension"]["ratio"].values():
@@ -125,11 +122,11 @@ def test_a_tension_within_tolerance_beside_a_hidden_mass_is_a_correction(tmp_pat
     assert cause["parameters"]["unmodeled_mass"]["mass"] == pytest.approx(mass, rel=0.25)
 
 
-def test_no_effect_gives_an_empty_cause_in_at_least_19_of_20(tmp_path):
+def test_no_effect_gives_an_empty_cause_in_at_least_19_of_20(bench_records):
     named = []
     for seed in range(20):
         bench = list(BENCHES)[seed % 2]
-        d = _diagnose(tmp_path, bench, None, seed=100 + seed)
+        d = _diagnose(bench_records, bench, None, seed=100 + seed)
         if d.selection.effects:
             named.append((seed, bench, d.selection.effects, d.selection.p_value))
     assert len(named) <= 1, named

@@ -1,0 +1,36 @@
+"""Fixtures shared by the test files.
+
+Simulated campaigns are made once per test run (once per pytest-xdist worker) in a session directory of
+``tmp_path_factory``, not once per test: a test that reads them must not change them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+
+from stcs_ident.core.model import Campaign
+from stcs_ident.simulate.effects import Effects
+from tests.diagnose_cases import simulated
+
+BenchRecords = Callable[..., tuple[Campaign, dict]]
+
+
+@pytest.fixture(scope="session")
+def bench_records(tmp_path_factory) -> BenchRecords:
+    """``bench_records(bench, effects, seed=0, nominal=None)``: (campaign, spectra by test) of
+    tests/diagnose_cases.py's :func:`simulated`, simulated and picked once per session for each argument set.
+
+    The records of each set are written in their own directory, under the name ``simulated`` gives them.
+    """
+    made: dict[str, tuple[Campaign, dict]] = {}
+
+    def records(bench: str, effects: Effects | None = None, seed: int = 0,
+                nominal: Campaign | None = None) -> tuple[Campaign, dict]:
+        key = repr((bench, effects, seed, nominal))  # Effects holds dicts: keyed by its repr, as exact
+        if key not in made:
+            made[key] = simulated(tmp_path_factory.mktemp("bench"), bench, effects, seed=seed, nominal=nominal)
+        return made[key]
+
+    return records
