@@ -18,13 +18,13 @@ import math
 
 import numpy as np
 import pytest
-from tests.random_cables import random_end
 from scipy.optimize import minimize_scalar
 
 from stcs_ident.core.errors import ComputationError
 from stcs_ident.core.model import Attachment, Cable, Damper
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.fem_damped import fe_complex_modes
+from tests.random_cables import random_end
 
 FREQUENCY_RTOL = 1e-6  # the requirement for the exact solver, relative
 DAMPING_ATOL = 1e-4  # the requirement, absolute in ζ

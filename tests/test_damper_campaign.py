@@ -7,12 +7,12 @@ import json
 import math
 
 import pytest
-from tests.test_campaign_io import assert_one_line_naming, edited, write_campaign
 
 from stcs_ident.cli.main import main
 from stcs_ident.core.errors import CampaignError
 from stcs_ident.core.model import Damper
 from stcs_ident.io.campaign import campaign_to_toml, load_campaign
+from tests.test_campaign_io import assert_one_line_naming, edited, write_campaign
 
 D1 = """
   [[setup.damper]]

@@ -23,6 +23,7 @@ import math
 import warnings
 
 import pytest
+
 from stcs_ident import effects as registry
 from stcs_ident.core.model import Campaign, Damper, Setup, Test
 from stcs_ident.diagnose import diagnose

@@ -12,12 +12,12 @@ exact answer.
 
 import numpy as np
 import pytest
-from tests.random_cables import random_configuration
 
 from stcs_ident.core.model import Attachment, Cable
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.forward.fem import fe_frequencies, fe_modes
 from stcs_ident.forward.shapes import modal_masses, mode_shapes
+from tests.random_cables import random_configuration
 
 N_CONFIGS = 200
 N_MODES = 12

@@ -174,9 +174,8 @@ def test_compiled_kernel_matches_numpy_path(monkeypatch):
     random configurations they agree to the refinement tolerance."""
     import os
 
-    from tests.random_cables import random_configuration
-
     from stcs_ident.forward import roots
+    from tests.random_cables import random_configuration
 
     if not roots.use_kernel():
         assert not os.environ.get("CI"), "the compiled kernel must build in CI"

@@ -16,6 +16,7 @@ from __future__ import annotations
 import random
 
 import pytest
+
 from tests.fuzz_inputs import FINDINGS, KINDS, make_case, run, run_case
 
 #: Seconds one case may take: the slowest correct run here (a diagnosis of the small campaign) takes

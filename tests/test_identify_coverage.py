@@ -5,9 +5,9 @@ are standard normal (Kolmogorov–Smirnov)."""
 import numpy as np
 import pytest
 from scipy import stats
-from tests.test_identify import synthetic
 
 from stcs_ident.identify import identify
+from tests.test_identify import synthetic
 
 TRIALS = 200
 NOISE = 0.01  # Hz, one standard deviation, equal to the stated uncertainty

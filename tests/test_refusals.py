@@ -9,9 +9,9 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
-from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
 
 from stcs_ident.cli.main import main
+from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
 
 
 @pytest.fixture

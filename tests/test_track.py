@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from tests.fuzz_inputs import BASE_TOML, _frequencies
 
 from stcs_ident.cli.main import main
 from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.archive import ArchiveOptions, TensionChange, simulate_archive
 from stcs_ident.track.api import track
 from stcs_ident.track.events import analyse_history
+from tests.fuzz_inputs import BASE_TOML, _frequencies
 
 CHANGE = TensionChange("C2", "2026-03-02T12:00:00+00:00", -0.015)
 
