@@ -24,6 +24,8 @@ import pytest
 
 from benchmarks import calibrate_damping as harness
 
+pytestmark = pytest.mark.slow  # a statistical set
+
 HELD_OUT_SEED = 3
 
 # (group, case, records): each scores 8 modes. The dampers' records span ζ 0.3–1.2 %, the bare ones 0.2–5 %.

@@ -48,7 +48,10 @@ def _effects(bench: str) -> dict[str, tuple[Effects, dict]]:
     }
 
 
-CASES = [(bench, effect) for bench in BENCHES for effect in _effects(bench)]
+#: The fast tier's end-to-end diagnosis (records, spectra, every hypothesis); the other cases are slow.
+FAST_CASE = ("hanger", "bending_stiffness")
+CASES = [pytest.param(bench, effect, marks=() if (bench, effect) == FAST_CASE else pytest.mark.slow)
+         for bench in BENCHES for effect in _effects(bench)]
 
 
 def _diagnose(bench_records, bench, effects, seed=0):
@@ -78,7 +81,6 @@ def _check(effect: str, found: dict, expected: dict, length: float) -> None:
         assert found["length"] == pytest.approx(expected["length"], rel=0.002)
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(("bench", "effect"), CASES)
 def test_hidden_effect_is_named_and_sized(bench_records, bench, effect):
     hidden, expected = _effects(bench)[effect]
@@ -122,6 +124,7 @@ def test_a_tension_within_tolerance_beside_a_hidden_mass_is_a_correction(bench_r
     assert cause["parameters"]["unmodeled_mass"]["mass"] == pytest.approx(mass, rel=0.25)
 
 
+@pytest.mark.slow
 def test_no_effect_gives_an_empty_cause_in_at_least_19_of_20(bench_records):
     named = []
     for seed in range(20):

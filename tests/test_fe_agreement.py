@@ -57,6 +57,7 @@ def test_frequencies_agree_with_finite_elements():
     print(f"largest relative difference over {N_CONFIGS} configurations: {worst:.2e}")
 
 
+@pytest.mark.slow
 def test_mode_shapes_are_mass_orthogonal_and_match_finite_elements():
     """Mass orthogonality to 1e-8 (quadrature good to ~1e-13), and the shapes
     agree with the FE eigenvectors at the FE nodes (MAC > 0.9999)."""

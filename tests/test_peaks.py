@@ -202,6 +202,7 @@ def _free_decay_errors(seed: int) -> tuple[list, list, list]:
     return ratio, z, ratio_idft
 
 
+@pytest.mark.slow
 def test_free_decay_accuracy_against_cramer_rao_and_honest_uncertainty():
     """40 records, 3 channels, 3 modes, SNR drawn in 20–40 dB (A²/2s² of a unit mode)."""
     ratio, z, ratio_idft = [], [], []
@@ -480,7 +481,7 @@ def _node_case(name):
 BLOWN_AT_NODE = {"hum60 seed 7 #10": 3, "drift seed 11 #5": 7}
 
 
-@pytest.mark.parametrize("case", ["hum60 seed 7 #10", "drift seed 11 #5"])
+@pytest.mark.parametrize("case", ["hum60 seed 7 #10", pytest.param("drift seed 11 #5", marks=pytest.mark.slow)])
 def test_a_blow_at_a_node_under_wind_is_not_fitted_to_one_noise_bin(case):
     """A mode blown at its node under wind: nothing decays at its frequency, only its random response is there.
 

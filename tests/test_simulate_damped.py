@@ -195,7 +195,7 @@ def _scored(result, frequencies, damping):
     return np.array(out)
 
 
-@pytest.mark.parametrize("case", ["impulse", "ambient_field"])
+@pytest.mark.parametrize("case", ["impulse", pytest.param("ambient_field", marks=pytest.mark.slow)])
 def test_spectra_find_the_complex_modes_in_the_records(case):
     """find_peaks on a record of the stay with its damper recovers each complex mode's |s|/2π and
     −Re s/|s| within 4σ (16 comparisons: with an honest 1σ all pass but once in 1000 runs; the 1σ of
