@@ -24,7 +24,8 @@ import pytest
 
 from benchmarks import calibrate_damping as harness
 
-pytestmark = pytest.mark.slow  # a statistical set
+# a statistical set; with -n, on one worker: the records (the module fixture) are made once
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("damping_coverage")]
 
 HELD_OUT_SEED = 3
 

@@ -32,6 +32,8 @@ EXACT = {"rtol": 1e-12, "atol": 0.0}
 CABLE = Cable(length=20.0, mass_per_length=10.0, EI=2000.0)
 TENSION = 10.0 * (2 * 20.0 * 3.0) ** 2
 
+pytestmark = pytest.mark.xdist_group("diagnose_report")  # with -n, on one worker: its module fixtures are made once
+
 
 @pytest.fixture(scope="module")
 def han_diagnosis():

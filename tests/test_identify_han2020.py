@@ -14,6 +14,7 @@ from stcs_ident.report.identify_figures import plot_contours, plot_errors, plot_
 
 ROOT = Path(__file__).resolve().parents[1]
 LEVELS = ("case1-L4", "case1-L5")
+pytestmark = pytest.mark.xdist_group("identify_han2020")  # with -n, on one worker: its module fixtures are made once
 
 
 @pytest.fixture(scope="module")

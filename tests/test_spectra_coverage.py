@@ -17,6 +17,8 @@ import pytest
 
 from benchmarks import calibrate_spectra as harness
 
+pytestmark = pytest.mark.xdist_group("spectra_coverage")  # with -n, on one worker: the records are made once
+
 HELD_OUT_SEED = 3
 
 # (group, cable, records): the cases. Each hanger record scores 8 modes, each stay record 12.

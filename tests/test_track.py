@@ -54,6 +54,7 @@ def tracked(archive):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("track_archive")  # with -n, on one worker: the archive is tracked once
 def test_the_hidden_tension_loss_is_found_on_its_cable_only(archive, tracked):
     summary, out = tracked
     truth = json.loads((archive / "truth.json").read_text())
@@ -78,6 +79,7 @@ def test_the_hidden_tension_loss_is_found_on_its_cable_only(archive, tracked):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("track_archive")
 def test_a_dask_local_cluster_gives_the_same_rows(archive, tracked, tmp_path):
     """C2's records (the cable with the hidden change) through Dask: each cable's rows and history are computed
     from its own records alone, so one cable checks the transport, the batches (5 of 16 records on 2 workers:
