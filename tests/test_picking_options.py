@@ -12,13 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_peaks import free_decay, make_record
 
 from stcs_ident.core.errors import InputError, NumberingWarning
 from stcs_ident.io.campaign import load_campaign
 from stcs_ident.spectra.options import FloorOptions, OnsetScale, PickingOptions
 from stcs_ident.spectra.peaks import find_peaks
 from stcs_ident.spectra.pipeline import analyse_test
+from tests.test_peaks import free_decay, make_record
 
 CAMPAIGNS = Path(__file__).resolve().parent.parent / "campaigns"
 MODES = np.array([2.0, 4.05, 6.1])  # Hz

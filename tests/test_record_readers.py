@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fuzz_inputs import BASE_TOML, _frequencies
 
 from stcs_ident.core.errors import InputError
 from stcs_ident.core.record import Record
@@ -30,6 +29,7 @@ from stcs_ident.simulate.simulate_campaign import simulate_campaign
 from stcs_ident.spectra.pipeline import analyse_test
 from stcs_ident.track.api import track
 from stcs_ident.track.archive import discover, record_paths
+from tests.fuzz_inputs import BASE_TOML, _frequencies
 
 FS = 200.0  # Hz
 NAMES = ("A1", "A2", "A3")

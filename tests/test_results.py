@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from fuzz_inputs import BASE_TOML, _frequencies
 
 import stcs_ident as si
 from stcs_ident.core.result import Result
+from tests.fuzz_inputs import BASE_TOML, _frequencies
 
 CABLE = si.Cable(length=12.0, mass_per_length=5.0, EI=2.0e3)
 TENSION = 2.0e5
