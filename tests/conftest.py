@@ -6,6 +6,7 @@ Simulated campaigns are made once per test run (once per pytest-xdist worker) in
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 
 import pytest
@@ -15,6 +16,22 @@ from stcs_ident.simulate.effects import Effects
 from tests.diagnose_cases import simulated
 
 BenchRecords = Callable[..., tuple[Campaign, dict]]
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config) -> int | None:
+    """``-n auto``: the CPUs this process may use, as the diagnosis counts them (os.sched_getaffinity).
+
+    pytest-xdist's own count (psutil's physical cores when psutil is installed, as dask installs it)
+    ignores the affinity a CI runner or ``taskset`` gives and counts two hyperthreads as one core.
+    PYTEST_XDIST_AUTO_NUM_WORKERS, when set, is left to pytest-xdist.
+    """
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
 @pytest.fixture(scope="session")
