@@ -97,3 +97,26 @@ def test_track_modes_past_ten_keep_distinct_colour_and_marker():
     drawn = plot_cable_history(spec, table, table.index, history)
     styles = [(line.get_color(), line.get_marker()) for line in drawn["modes"].values()]
     assert len(styles) == 14 and len(set(styles)) == 14
+
+
+def test_every_plotting_function_returns_what_it_drew_as_a_figure_a_notebook_shows():
+    """Each ``plot_*`` of report/ returns a Drawn: its artists by name, and the figure itself where a user
+    meets it (``.figure``, ``.savefig``, a PNG in a notebook)."""
+    import importlib
+    import inspect
+
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from stcs_ident.report.damped_figures import plot_tension_bias
+    from stcs_ident.report.plots import Drawn
+
+    modules = ["plots", "damped_figures", "diagnose_figures", "identify_figures", "track"]
+    functions = [f for m in modules for name, f in vars(importlib.import_module(f"stcs_ident.report.{m}")).items()
+                 if name.startswith("plot_") and inspect.isfunction(f) and f.__module__.endswith(m)]
+    assert len(functions) >= 10
+    for f in functions:
+        assert inspect.signature(f).return_annotation in (Drawn, "Drawn"), f.__qualname__
+    drawn = plot_tension_bias(np.logspace(-1, 1, 5), {"stay": np.linspace(0.0, 1.0, 5)})
+    assert isinstance(drawn, Drawn) and isinstance(drawn.figure, Figure) and drawn["lines"]
+    assert drawn._repr_png_().startswith(b"\x89PNG")

@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from .plots import new_figure
+from .plots import Drawn, new_figure
 
 
 def krenk(eta) -> np.ndarray:
@@ -18,7 +18,7 @@ def krenk(eta) -> np.ndarray:
     return eta / (1.0 + eta**2)
 
 
-def plot_universal_curve(series: Mapping[str, tuple[np.ndarray, np.ndarray]], fig=None) -> dict:
+def plot_universal_curve(series: Mapping[str, tuple[np.ndarray, np.ndarray]], fig=None) -> Drawn:
     """ζ_n/(x_d/l) against η_n = c π n x_d/(l √(H m)): Krenk's curve, and the exact model's points.
 
     Parameters
@@ -39,10 +39,10 @@ def plot_universal_curve(series: Mapping[str, tuple[np.ndarray, np.ndarray]], fi
     ax.set_title("Universal curve: the exact complex modes over Krenk's asymptote", fontsize=10)
     ax.legend(fontsize=8, loc="upper left")
     ax.set_ylim(0, 0.6)
-    return {"figure": fig, "axes": ax, "curve": line, "points": points}
+    return Drawn({"figure": fig, "axes": ax, "curve": line, "points": points})
 
 
-def plot_complex_shapes(shapes, length: float, dampers: Sequence[float], n_modes: int = 4, fig=None) -> dict:
+def plot_complex_shapes(shapes, length: float, dampers: Sequence[float], n_modes: int = 4, fig=None) -> Drawn:
     """Modulus and phase of the first ``n_modes`` complex mode shapes along the span.
 
     Parameters
@@ -72,10 +72,10 @@ def plot_complex_shapes(shapes, length: float, dampers: Sequence[float], n_modes
     ax_m.set_title("Complex mode shapes: modulus and phase (red dashed: damper)", fontsize=10)
     ax_p.set_ylabel("phase (deg, from mid-span)")
     ax_p.set_xlabel("position from end A (m)")
-    return {"figure": fig, "axes": (ax_m, ax_p), "lines": lines}
+    return Drawn({"figure": fig, "axes": (ax_m, ax_p), "lines": lines})
 
 
-def plot_tension_bias(eta: np.ndarray, bias: Mapping[str, np.ndarray], fig=None) -> dict:
+def plot_tension_bias(eta: np.ndarray, bias: Mapping[str, np.ndarray], fig=None) -> Drawn:
     """Tension bias (%) of models that ignore the damper, against mode 1's damper parameter η₁.
 
     Parameters
@@ -95,4 +95,4 @@ def plot_tension_bias(eta: np.ndarray, bias: Mapping[str, np.ndarray], fig=None)
     ax.set_ylabel("tension error when the damper is ignored (%)")
     ax.set_title("Tension identified from modes 1–10 with a model without the damper", fontsize=10)
     ax.legend(fontsize=7, loc="upper left")
-    return {"figure": fig, "axes": ax, "lines": lines}
+    return Drawn({"figure": fig, "axes": ax, "lines": lines})

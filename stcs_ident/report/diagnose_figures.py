@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .. import effects as registry
-from .plots import new_figure
+from .plots import Drawn, new_figure
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {
@@ -33,7 +33,7 @@ def _models(diagnosis) -> dict:
     return out
 
 
-def plot_residuals(diagnosis, fig=None) -> dict:
+def plot_residuals(diagnosis, fig=None) -> Drawn:
     """Error in % per mode for each test: nominal, baseline and corrected.
 
     The grey band is ± one standard uncertainty of the measured frequency,
@@ -86,7 +86,7 @@ def plot_residuals(diagnosis, fig=None) -> dict:
     # One test's panel is too narrow for the four entries side by side: two rows then, not a clipped row.
     fig.legend(handles, labels, loc="outside upper center", ncols=len(labels) if ncols > 1 else 2, fontsize=8,
                frameon=False)
-    return {"figure": fig, "axes": list(axes[:n]), "lines": lines, "bands": bands}
+    return Drawn({"figure": fig, "axes": list(axes[:n]), "lines": lines, "bands": bands})
 
 
 #: A profile whose χ² varies by less than this over the whole span says nothing about the position
@@ -134,7 +134,7 @@ def unscanned_sentence(effects) -> str:
             "flat along the span.")
 
 
-def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
+def plot_profile(diagnosis, effect: str | None = None, ax=None) -> Drawn:
     """χ² against the position of an unmodeled mass or support of the named cause (the profile scan).
 
     Every other parameter is refitted at each position of the grid; the
@@ -188,10 +188,10 @@ def plot_profile(diagnosis, effect: str | None = None, ax=None) -> dict:
     ax.set_title(f"{' + '.join(d.corrected.effects)}: where is the {registry.get(effect).noun}?", fontsize=9)
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # never over the data
-    return {"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": scan}
+    return Drawn({"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": scan})
 
 
-def plot_profiles(diagnosis, fig=None) -> dict:
+def plot_profiles(diagnosis, fig=None) -> Drawn:
     """:func:`plot_profile` of every scanned unmodeled attachment of the cause, one above the other.
 
     An unmodeled attachment of the cause without an informative scan
@@ -211,4 +211,4 @@ def plot_profiles(diagnosis, fig=None) -> dict:
     missing = unscanned(diagnosis)
     if missing:
         fig.suptitle(unscanned_sentence(missing), fontsize=8, color="0.3")
-    return {"figure": fig, "panels": panels, "unscanned": missing}
+    return Drawn({"figure": fig, "panels": panels, "unscanned": missing})

@@ -21,7 +21,7 @@ import textwrap
 
 import numpy as np
 
-from .plots import new_figure, save_figure
+from .plots import Drawn, new_figure, save_figure
 
 
 def parameter_label(p) -> str:
@@ -55,7 +55,7 @@ def _mode_indices(sweep, modes, test):
     return found
 
 
-def plot_surfaces(result, modes=(1, 6), test: str | None = None, fig=None) -> dict:
+def plot_surfaces(result, modes=(1, 6), test: str | None = None, fig=None) -> Drawn:
     """Frequency surfaces of two modes with their contours at the measured values (Fig. 23).
 
     Parameters
@@ -105,10 +105,10 @@ def plot_surfaces(result, modes=(1, 6), test: str | None = None, fig=None) -> di
         ax.set_title(f"{sweep.labels[k]}: surface cut at the measured {level:.2f} Hz", fontsize=9)
         axes.append(ax)
         surfaces.append(surf)
-    return {"figure": fig, "axes": axes, "surfaces": surfaces, "contours": contours, "planes": floors}
+    return Drawn({"figure": fig, "axes": axes, "surfaces": surfaces, "contours": contours, "planes": floors})
 
 
-def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
+def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> Drawn:
     """Contours of every measured mode at its measured value, their intersection region and the estimate.
 
     Parameters
@@ -138,7 +138,7 @@ def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
     axes = fig.subplots(1, 2 if zoom else 1)
     axes = list(np.atleast_1d(axes))
     panels = [sweep, sweep.zoom if sweep.zoom is not None else sweep][: len(axes)]
-    out = {"figure": fig, "axes": axes, "contours": [], "region": [], "estimate": [], "errorbar": [], "lsq": []}
+    out = Drawn({"figure": fig, "axes": axes, "contours": [], "region": [], "estimate": [], "errorbar": [], "lsq": []})
     styles = _styles(sweep.labels)
     for n, (ax, sw) in enumerate(zip(axes, panels)):
         X, Y = np.meshgrid(sw.axes[0], sw.axes[1], indexing="ij")
@@ -185,7 +185,7 @@ def plot_contours(result, fig=None, lsq=None, zoom: bool = True) -> dict:
     return out
 
 
-def plot_errors(result, fig=None) -> dict:
+def plot_errors(result, fig=None) -> Drawn:
     """Signed errors before and after the correction, per test and mode (bars, %), with the measurement's 1σ.
 
     One panel per test (up to three side by side). The error is
@@ -235,8 +235,8 @@ def plot_errors(result, fig=None) -> dict:
     fig.legend(handles, labels, loc="outside lower center", ncols=3, fontsize=8, frameon=False)
     fig.suptitle(textwrap.fill(f"{result.method}: {', '.join(result.names)} fitted; error = (computed − measured) "
                                f"/ measured", int(12 * width)), fontsize=9)
-    return {"figure": fig, "axes": list(axes[:len(tests)]), "before": before, "after": after,
-            "errorbars": errorbars}
+    return Drawn({"figure": fig, "axes": list(axes[:len(tests)]), "before": before, "after": after,
+            "errorbars": errorbars})
 
 
 def save_identify_figures(result, directory, lsq=None) -> list[str]:

@@ -9,6 +9,31 @@ import numpy as np
 from ..core.files import write_figure
 
 
+class Drawn(dict):
+    """What a plotting function drew: its ``"figure"`` and the artists by name (``"axes"``, ``"lines"``...).
+
+    A dict, so that tests and callers reach each artist by name, that also behaves as its figure where a
+    user meets it: ``drawn.figure``, ``drawn.savefig(path)``, and in a notebook it shows as the picture
+    (``_repr_png_``), not as a dict of artists.
+    """
+
+    @property
+    def figure(self):
+        """The :class:`matplotlib.figure.Figure` drawn on."""
+        return self["figure"]
+
+    def savefig(self, *args, **kwargs):
+        """:meth:`matplotlib.figure.Figure.savefig` of the figure."""
+        return self["figure"].savefig(*args, **kwargs)
+
+    def _repr_png_(self) -> bytes:
+        import io
+
+        buffer = io.BytesIO()
+        self["figure"].savefig(buffer, format="png")
+        return buffer.getvalue()
+
+
 def new_figure(**kwargs):
     """A :class:`matplotlib.figure.Figure` (``kwargs`` as its constructor's), never pyplot's: the one
     place the figure modules get a figure from, so matplotlib is imported only when one is drawn."""
@@ -17,7 +42,7 @@ def new_figure(**kwargs):
     return Figure(**kwargs)
 
 
-def plot_test_spectra(spectra, fig=None) -> dict:
+def plot_test_spectra(spectra, fig=None) -> Drawn:
     """Combined and per-channel spectra of one test, picked peaks labelled by mode, the nominal model marked.
 
     The upper panel is the combined spectrum: each channel's PSD divided by
@@ -67,8 +92,8 @@ def plot_test_spectra(spectra, fig=None) -> dict:
     ax_ch.set_ylabel("channel PSD (m/s²)²/Hz")
     ax_ch.set_xlabel("frequency (Hz)")
     ax_ch.legend(fontsize=7, ncols=4, loc="upper right")
-    return {"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels,
-            "nominal": nominal}
+    return Drawn({"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels,
+            "nominal": nominal})
 
 
 def _nominal_markers(ax, spectra, f):

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.files import write_atomic, write_csv, write_figure
-from .plots import new_figure
+from .plots import Drawn, new_figure
 
 __all__ = ["plot_cable_history", "records_csv_table", "write_report"]
 
@@ -62,7 +62,7 @@ def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     return plain
 
 
-def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> dict:
+def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Drawn:
     """One cable's history: tension (identified, normalised, level, events), temperature, frequency / mode.
 
     Parameters
@@ -118,7 +118,7 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> di
     if modes:
         bottom.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=7, ncol=1 + len(modes) // 12,
                       markerscale=2)
-    return {"figure": fig, "axes": (top, middle, bottom), "modes": drawn}
+    return Drawn({"figure": fig, "axes": (top, middle, bottom), "modes": drawn})
 
 
 def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
