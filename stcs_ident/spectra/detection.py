@@ -113,7 +113,8 @@ class Candidate:
     snr_db : float
         Height above the floor in the statistic that found it, dB.
     half_power_width : float
-        -3 dB width above the floor, Hz.
+        -3 dB width above the floor, Hz (on a side where a stronger
+        resonance rises first, to the valley before it).
     threshold : float
         That statistic's detection threshold at the peak (linear).
     dof : float
@@ -295,7 +296,17 @@ def _separated(overview: Overview, weak: Candidate, strong: Candidate, separatio
 def peak_candidate(overview: Overview, ratio: np.ndarray, k: int, threshold: float, dof: float) -> Candidate:
     """The :class:`Candidate` at index ``k`` of ``ratio`` (spectrum over floor): interpolated frequency
     (parabola through the log) and -3 dB width (above the floor, 1); shared with the residual pass
-    (:mod:`.residual`), which finds peaks the same way."""
+    (:mod:`.residual`), which finds peaks the same way.
+
+    Each side of the width ends where the running mean falls to half power,
+    or, where it climbs first above the peak's own height (into a stronger
+    resonance beside it), at the valley between the two: that side's extent
+    is all this resonance shows. Without that stop, a peak on the skirt of a
+    stronger one took the width of the whole run of resonances (the mode 7
+    of seed 100 of tests/test_spectra_acceptance.py, seen best by one
+    channel whose spectrum stays above the half-power level down to mode 1:
+    7.32 Hz for 0.78, which then hid mode 8 from detection, refinement and
+    the residual pass)."""
     f = overview.frequency
     df = f[1] - f[0]
     y = np.log(np.maximum(ratio[k - 1 : k + 2], np.finfo(float).tiny))
@@ -307,11 +318,24 @@ def peak_candidate(overview: Overview, ratio: np.ndarray, k: int, threshold: flo
     smooth = ndimage.uniform_filter1d(ratio[lo:hi], n, mode="nearest")
     centre = k - lo
     half = 1.0 + 0.5 * (smooth[centre] - 1.0)
-    below = np.flatnonzero(smooth <= half)
-    left = below[below < centre]
-    right = below[below > centre]
-    left = left[-1] if left.size else 0
-    right = right[0] if right.size else smooth.size - 1
+    height = max(ratio[k], smooth[centre])  # the running mean can top a narrow maximum on a broad one
+    left = _half_power_edge(smooth[centre::-1], half, height)
+    right = _half_power_edge(smooth[centre:], half, height)
+    left, right = centre - left, centre + right
     snr = 10 * np.log10(ratio[k])
     frequency = float(f[k] + np.clip(shift, -0.5, 0.5) * df)
     return Candidate(k, frequency, float(snr), float((right - left) * df), float(threshold), float(dof), ratio)
+
+
+def _half_power_edge(side: np.ndarray, half: float, height: float) -> int:
+    """Bins from the peak (``side[0]``) to the first at or below `half`, or to the lowest before `side` first
+    exceeds `height` (a stronger resonance beside the peak); at least one bin, as a crossing is; the side's
+    last bin if neither."""
+    above = np.flatnonzero(side > height)
+    stop = above[0] if above.size else side.size
+    below = np.flatnonzero(side[1:stop] <= half)
+    if below.size:
+        return int(below[0]) + 1
+    if above.size:
+        return int(np.argmin(side[1:stop])) + 1 if stop > 1 else 1
+    return side.size - 1
