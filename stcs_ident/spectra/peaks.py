@@ -84,12 +84,14 @@ Why a parametric fit (measured; seeded simulations, /tmp benchmarks)
 
     On the 105 records of tests/test_spectra_acceptance.py (the project's
     simulator; three cables, 1–5 sensors, ζ 0.1–2 %, 0–40 dB): median
-    |error| / CRB 1.21 over 277 free-decay modes; none of 725 visible
+    |error| / CRB 1.21 over 277 free-decay modes; none of 722 visible
     modes missed (was 9 with the whole-event overview alone and the
     0.45-gap bands, 2 without the residual pass: in an ambient record of
     the stay with ζ ≈ 1.8 %, a mode whose peak rises too little above the
     valley beside it in a band filled with broad resonances, and its
-    neighbour, whose fit then absorbed it).
+    neighbour, whose fit then absorbed it). The counts are of the simulator's
+    records since its wind is the same on every machine (before: 725 visible
+    modes on this machine's BLAS).
 
     Time (this 2-core machine): 16 channels × 600 s × 256 Hz with 20 modes,
     ambient 0.6–0.8 s, ten blows 0.8–0.9 s.
