@@ -51,8 +51,25 @@ class Peak:
     channel_snr_db: np.ndarray = field(repr=False)
 
 
+class PickingResult(Result):
+    """The common face of the spectra step's results: their ``settings`` are the picking options they were
+    made with (an ``options`` field), and they have no notes yet."""
+
+    options: PickingOptions
+
+    @property
+    def settings(self) -> PickingOptions:
+        """How the result was made: its picking options (``options``)."""
+        return self.options
+
+    @property
+    def notes(self) -> tuple:
+        """``()``: the peak picking has no notes yet."""
+        return ()
+
+
 @dataclass(frozen=True, repr=False)
-class PeakResult(Result):
+class PeakResult(PickingResult):
     """Result of :func:`find_peaks`.
 
     ``tables()`` holds ``peaks`` (the main table, :meth:`to_dataframe`).
@@ -98,16 +115,6 @@ class PeakResult(Result):
     options: PickingOptions = field(default_factory=PickingOptions)
 
     main_table = "peaks"
-
-    @property
-    def settings(self) -> PickingOptions:
-        """How the result was made: its picking options (``options``)."""
-        return self.options
-
-    @property
-    def notes(self) -> tuple:
-        """``()``: the peak picking has no notes yet."""
-        return ()
 
     def tables(self) -> dict[str, pd.DataFrame]:
         """``peaks``: one row per peak (:meth:`to_dataframe`)."""

@@ -17,12 +17,12 @@ import pandas as pd
 
 from ..core.model import Campaign, Test
 from ..core.record import Record
-from ..core.result import Result
 from ..forward import natural_frequencies
 from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
 from .options import PickingOptions
+from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -31,7 +31,7 @@ DEFAULT_MAX_MODES = 30
 
 
 @dataclass(frozen=True, repr=False)
-class TestSpectra(Result):
+class TestSpectra(PickingResult):
     """Numbered modal frequencies picked from one test's record.
 
     ``tables()`` holds ``modes`` (the numbered modes, the main table:
@@ -72,16 +72,6 @@ class TestSpectra(Result):
     options: PickingOptions = field(default_factory=PickingOptions)
 
     main_table = "modes"
-
-    @property
-    def settings(self) -> PickingOptions:
-        """How the result was made: its picking options (``options``)."""
-        return self.options
-
-    @property
-    def notes(self) -> tuple:
-        """``()``: the peak picking has no notes yet."""
-        return ()
 
     def tables(self) -> dict[str, pd.DataFrame]:
         """``modes`` (one row per numbered mode) and ``peaks`` (one row per peak found)."""
