@@ -413,3 +413,16 @@ def test_the_nested_rule_does_not_stop_at_a_hypothesis_a_simpler_one_beats():
     fits[("tension", "attachment_mass")] = _fit(("tension", "attachment_mass"), 3, 80.0, n)
     fits[("attachment_mass", "length")] = _fit(("attachment_mass", "length"), 2, 80.0, n)
     assert select(fits, n).fitted == ("tension", "unmodeled_mass")
+
+
+def test_the_diagnosis_is_the_same_in_one_process_and_in_two():
+    """The fits come back from worker processes in the order they finish (which depends on the load); the
+    diagnosis holds them in the serial order, so its ranking, tables and JSON do not depend on the number
+    of processes."""
+    campaign, picked = synthetic(Effects(EI_ratio=1.45), seed=1)
+    one = diagnose(campaign, picked=picked, max_effects=1, workers=1)
+    two = diagnose(campaign, picked=picked, max_effects=1, workers=2)
+    assert list(one.fits) == list(two.fits)
+    strip = lambda s: {k: v for k, v in s.items() if k not in ("elapsed", "timings", "seconds")}  # noqa: E731
+    assert json.dumps(strip(one.summary()), sort_keys=True, default=str) == \
+        json.dumps(strip(two.summary()), sort_keys=True, default=str)

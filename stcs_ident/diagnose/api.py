@@ -163,6 +163,11 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             done += 1
             if progress is not None:
                 progress(done, total, " + ".join(s) if s else "nominal")
+    # In the order of a serial run, whatever order the workers finished in: whatever reads the fits in
+    # turn (the ranking's ties, the report's tables) must not depend on the number of CPUs or the load.
+    order = {s: (len(s), i) for i, s in enumerate(sets)}
+    fits = {s: fits[s] for s in sorted(fits, key=lambda s: order.get(s, (len(s), len(sets))))}
+    timings = {s: timings[s] for s in fits}
     if needs_model_error(fits, n):
         reference = data(campaign, measurements, settings.tension_model)  # the frequencies (and damping ratios)
         for fit in fits.values():
