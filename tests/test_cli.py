@@ -426,3 +426,18 @@ def test_progress_on_a_terminal_is_a_bar_with_the_time_left(capsys, monkeypatch)
     assert "diagnose: 100%" in err and "4/4" in err and "tension" in err
     assert re.search(r"\[\d\d:\d\d<\d\d:\d\d", err)  # elapsed<left, as track shows it
     assert "hypothesis 1 of 4" not in err  # a bar, not lines
+
+
+def test_diagnose_refuses_a_non_empty_out_directory_before_any_work(tmp_path, capsys, monkeypatch):
+    import importlib
+
+    def fail(*args, **options):
+        raise AssertionError("the diagnosis ran before the output was checked")
+
+    monkeypatch.setattr(importlib.import_module("stcs_ident.diagnose"), "diagnose", fail)
+    out = tmp_path / "not-a-report"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine", encoding="utf-8")
+    code, _, err = run(["diagnose", _write(tmp_path, GOOD), "--out", str(out)], capsys)
+    assert code == 2 and "'--out'" in err and "not a report" in err and len(err.strip().splitlines()) == 1
+    assert (out / "notes.txt").read_text(encoding="utf-8") == "mine"

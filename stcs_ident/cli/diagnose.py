@@ -49,6 +49,10 @@ def run(args: argparse.Namespace) -> int:
     from ..report.forward import to_json
 
     campaign, file, tests = prepare(args)
+    if args.out is not None:  # before any work: a report directory that would be refused after it
+        from ..report.diagnose import check_report_directory
+
+        check_report_directory(args.out, field="--out")
     picked = {r.name: r for r in picked_spectra(campaign, tests, file)}
     try:
         result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,

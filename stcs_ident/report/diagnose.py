@@ -282,6 +282,27 @@ def report_markdown(diagnosis, tables: dict, figures: dict, spectra=None) -> str
     return "\n".join(lines)
 
 
+def check_report_directory(out_dir, field: str = "out_dir") -> Path:
+    """``out_dir`` as a Path if a report may be written there: absent, empty, or an earlier report (it is
+    replaced as a whole, so anything else it holds would be lost). Called before any work by the command
+    line (``field="--out"``) and again by :func:`write_report`.
+
+    Raises
+    ------
+    InputError
+        Naming ``field``, if ``out_dir`` exists and is not a directory, or is a non-empty directory
+        without ``report.md``.
+    """
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InputError("exists and is not a directory", field=field, file=str(out))
+    if out.is_dir() and any(out.iterdir()) and not (out / "report.md").is_file():
+        # replacing a directory as a whole deletes what it holds: only ever an earlier report
+        raise InputError("is a non-empty directory without report.md: not a report, not replaced", field=field,
+                         file=str(out))
+    return out
+
+
 def write_report(diagnosis, out_dir, spectra=None) -> Path:
     """Write the diagnosis report into ``out_dir``, whole or not at all.
 
@@ -314,13 +335,7 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
     """
     from . import diagnose_figures as diagnosis_figures
 
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError("exists and is not a directory", field="out_dir", file=str(out))
-    if out.is_dir() and any(out.iterdir()) and not (out / "report.md").is_file():
-        # replacing a directory as a whole deletes what it holds: only ever an earlier report
-        raise InputError("is a non-empty directory without report.md: not a report, not replaced", field="out_dir",
-                         file=str(out))
+    out = check_report_directory(out_dir)
     d = diagnosis
     spectra = d.spectra if spectra is None else spectra
     tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
