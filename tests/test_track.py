@@ -166,6 +166,25 @@ def test_unreadable_records_are_rows_with_their_reason_and_the_rest_go_on(small,
     assert "start_time" in reasons["records/bad/no-time.h5"]
 
 
+def test_a_cable_whose_every_record_failed_gets_its_report_with_the_reasons(tmp_path, capsys):
+    """No traceback and no lost report when nothing of a cable could be processed: its figure says so and
+    report.md lists every failure."""
+    campaign = _campaign(tmp_path / "campaign")
+    arch = simulate_archive({"C1": campaign, "C2": campaign}, tmp_path / "archive",
+                            options=ArchiveOptions(days=1 / 24, interval=1800), seed=3)
+    broken = sorted((arch / "C2" / "records").rglob("*.h5"))
+    for i, path in enumerate(broken):
+        path.write_text(f"not a record {i}\n", encoding="utf-8")  # distinct contents: one failed row each
+    assert main(["track", str(arch), "--out", str(tmp_path / "out")]) == 0
+    out = tmp_path / "out"
+    assert {"report.md", "C1.png", "C2.png", "cables.csv"} <= {p.name for p in out.iterdir()}
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert report.count("not an HDF5 file") == len(broken) >= 2
+    cables = pd.read_csv(out / "cables.csv").set_index("cable")
+    assert cables.loc["C2", "failed"] == len(broken) and cables.loc["C1", "failed"] == 0
+    assert f"C2: 0 of {len(broken)} records with a tension, {len(broken)} failed" in capsys.readouterr().out
+
+
 def test_the_cli_tracks_an_archive_it_simulated(tmp_path, capsys):
     campaign = tmp_path / "campaign"
     _campaign(campaign)

@@ -80,9 +80,16 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
     dict with the figure, the three axes (``axes``: tension, temperature, frequency) and the frequency
     panel's lines by mode (``modes``: {mode: Line2D}); past mode 10 the colours repeat with another marker.
     """
+    data = table.loc[rows]
+    if not data["tension"].notna().any():  # every record failed: say so; the reasons are in report.md
+        fig = fig or new_figure(figsize=(10, 1.2), layout="constrained")
+        ax = fig.subplots()
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, f"{spec.name}: no record with a tension (the failed records and their reasons are "
+                "listed in report.md)", ha="center", va="center", transform=ax.transAxes)
+        return Drawn({"figure": fig, "axes": (ax,), "modes": {}})
     fig = fig or new_figure(figsize=(10, 7.5), layout="constrained")
     top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.2, 2))
-    data = table.loc[rows]
     t = data["start_time"].dt.tz_convert(None) if len(data) else data["start_time"]
     kN = 1e-3
     tension, sigma = data["tension"].to_numpy() * kN, data["tension_sigma"].to_numpy() * kN
