@@ -445,3 +445,49 @@ def test_bad_tolerances_are_refused_naming_the_key(tmp_path, body, field):
     with pytest.raises(CampaignError) as info:
         load_campaign(file)
     assert_one_line_naming(info.value, file, field)
+
+
+# --------------------------------------------------------------------------
+# A test's stated frequency uncertainty
+# --------------------------------------------------------------------------
+
+def test_a_stated_uncertainty_is_one_number_or_one_per_frequency_and_round_trips(tmp_path):
+    one = load_text(tmp_path / "one", edited("frequencies = [7.0, 14.0]\n",
+                                             "frequencies = [7.0, 14.0]\nuncertainty = 0.005\n"))
+    assert one.test("T1").uncertainty == (0.005, 0.005) and one.test("T2").uncertainty is None
+    each = load_text(tmp_path / "each", edited("frequencies = [7.0, 14.0]\n",
+                                               "frequencies = [7.0, 14.0]\nuncertainty = [0.002, 0.004]\n"))
+    assert each.test("T1").uncertainty == (0.002, 0.004)
+    assert reload(tmp_path, each).test("T1").uncertainty == (0.002, 0.004)
+
+
+@pytest.mark.parametrize("value,why", [("[0.002]", "has 1 values but frequencies has 2"),
+                                       ("0.0", "must be > 0 Hz"), ("-1e-3", "must be > 0 Hz"),
+                                       ("20.0", "below its frequency"), ('"0.01"', "must be a number")])
+def test_a_bad_stated_uncertainty_names_its_field(tmp_path, value, why):
+    file = write_campaign(tmp_path / "c", edited("frequencies = [7.0, 14.0]\n",
+                                                 f"frequencies = [7.0, 14.0]\nuncertainty = {value}\n"))
+    with pytest.raises(InputError) as info:
+        load_campaign(file)
+    assert_one_line_naming(info.value, file, "test[T1].uncertainty")
+    assert why in str(info.value)
+
+
+def test_an_uncertainty_without_frequencies_is_refused(tmp_path):
+    file = write_campaign(tmp_path / "c", edited("tension = 1.1e6\n", "tension = 1.1e6\nuncertainty = 0.01\n"))
+    with pytest.raises(InputError) as info:
+        load_campaign(file)
+    assert_one_line_naming(info.value, file, "test[T2].uncertainty")
+    assert "needs the test's frequencies" in str(info.value)
+
+
+def test_identification_weighs_the_frequencies_by_their_stated_uncertainty(tmp_path):
+    from stcs_ident.identify import identify
+
+    plain = load_text(tmp_path / "plain", BASE)
+    stated = load_text(tmp_path / "stated", edited("frequencies = [7.0, 14.0]\n",
+                                                   "frequencies = [7.0, 14.0]\nuncertainty = [0.002, 0.004]\n"))
+    rounded, given = identify(plain, ["T1"], "tension"), identify(stated, ["T1"], "tension")
+    assert given.summary()["tests"][0]["uncertainty_source"] == "stated uncertainty"
+    assert given.summary()["tests"][0]["uncertainty"] == [0.002, 0.004]
+    assert "table rounding" in rounded.summary()["tests"][0]["uncertainty_source"]  # 1 Hz / sqrt 12 from "7.0"

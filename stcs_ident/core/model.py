@@ -360,6 +360,11 @@ class Test:
     channels : tuple of (name, float)
         The record's channel positions, m from end A, for a record whose
         file gives none (CSV); a mapping is accepted.
+    uncertainty : tuple of float or None
+        The stated standard uncertainty (1σ) of ``frequencies``, Hz: one
+        value per frequency (one number is accepted and repeated). None:
+        not stated (the identification then takes the rounding of the
+        table, and says so).
     """
 
     __test__ = False  # not a pytest class
@@ -372,6 +377,7 @@ class Test:
     record: str | None = None
     reference: tuple[tuple[str, tuple[float, ...]], ...] = ()
     channels: tuple[tuple[str, float], ...] = ()
+    uncertainty: tuple[float, ...] | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -402,6 +408,23 @@ class Test:
             object.__setattr__(self, "modes", modes)
         elif self.modes is not None:
             raise ModelError("given without frequencies", field=f"{where}.modes")
+        if self.uncertainty is not None:
+            field_name = f"{where}.uncertainty"
+            if self.frequencies is None:
+                raise ModelError("needs the test's frequencies", field=field_name)
+            given = self.uncertainty
+            values = tuple(given) if isinstance(given, (tuple, list)) else (given,) * len(self.frequencies)
+            if len(values) != len(self.frequencies):
+                raise ModelError(f"has {len(values)} values but frequencies has {len(self.frequencies)} (give one "
+                                 "number for all, or one per frequency)", field=field_name)
+            checked = []
+            for u, f in zip(values, self.frequencies):
+                u = finite_number(u, field_name)
+                if not 0 < u < f:
+                    raise ModelError(f"must be > 0 Hz and below its frequency ({f:g} Hz), got {u!r}",
+                                     field=field_name)
+                checked.append(u)
+            object.__setattr__(self, "uncertainty", tuple(checked))
         reference = tuple((str(k), tuple(v)) for k, v in self.reference)
         for label, values in reference:
             field_name = f"{where}.reference.{label}"

@@ -132,7 +132,11 @@ def printed_step(values: Sequence[float]) -> float:
 
 
 def table_measurement(test: Test) -> Measurement:
-    """A test's tabulated frequencies, with the rounding of the table as uncertainty."""
+    """A test's tabulated frequencies, with their stated uncertainty (``test.uncertainty``), else the
+    rounding of the table as uncertainty (and the source says which)."""
+    if test.uncertainty is not None:
+        return Measurement(test, np.array(test.modes), np.array(test.frequencies), np.array(test.uncertainty),
+                           "stated uncertainty")
     step = printed_step(test.frequencies)
     return Measurement(test, np.array(test.modes), np.array(test.frequencies), step / math.sqrt(12),
                        f"table rounding ({step:g} Hz / sqrt 12)")

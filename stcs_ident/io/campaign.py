@@ -40,7 +40,7 @@ _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity"
 _SETUP_KEYS = ("name", "attachment", "damper")
 _ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
 _DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass")
-_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels")
+_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels", "uncertainty")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
 
@@ -260,6 +260,10 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
     record = table.get("record")
     reference = _table(table.get("reference", {}), f"{where}.reference")
     channels = _table(table.get("channels", {}), f"{where}.channels")
+    uncertainty = table.get("uncertainty")
+    if uncertainty is not None:  # one number for all the frequencies, or one per frequency
+        uncertainty = (_numbers(uncertainty, f"{where}.uncertainty") if isinstance(uncertainty, list)
+                       else _number(uncertainty, f"{where}.uncertainty"))
     return Test(
         name=name,
         setup=_string(_required(table, "setup", where), f"{where}.setup"),
@@ -269,6 +273,7 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
         record=None if record is None else _string(record, f"{where}.record"),
         reference=tuple((k, _numbers(v, f"{where}.reference.{k}")) for k, v in reference.items()),
         channels=tuple((k, _number(v, f"{where}.channels.{k}")) for k, v in channels.items()),
+        uncertainty=uncertainty,
     )
 
 

@@ -97,6 +97,8 @@ def _test_table(test: Test) -> dict[str, Any]:
         table["reference"] = {label: [float(f) for f in values] for label, values in test.reference}
     if test.channels:
         table["channels"] = {name: float(position) for name, position in test.channels}
+    if test.uncertainty is not None:
+        table["uncertainty"] = [float(u) for u in test.uncertainty]
     return table
 
 
