@@ -305,10 +305,23 @@ def test_bad_sampling_rate_refused(tmp_path, rate):
 
 
 def test_unknown_unit_refused(tmp_path):
-    path = _write_h5(tmp_path / "rec.h5", unit="mm/s^2")
-    with pytest.raises(InputError, match="mm/s\\^2") as excinfo:
+    path = _write_h5(tmp_path / "rec.h5", unit="m/s")  # a velocity
+    with pytest.raises(InputError, match="'m/s'.*use one of m/s\\^2") as excinfo:
         read_record(path)
     _check_error(excinfo, path, "unit")
+
+
+@pytest.mark.parametrize("unit,scale", [("m/s^2", 1.0), ("m/s²", 1.0), ("m/s2", 1.0), (" m/s2 ", 1.0),
+                                        ("mm/s^2", 1e-3), ("mm/s2", 1e-3), ("g", 9.80665), ("G", 9.80665),
+                                        ("mg", 9.80665e-3)])
+def test_the_unit_spellings_of_data_loggers_are_read_with_their_scale(tmp_path, unit, scale):
+    """One table of unit spellings serves every reader: HDF5's unit and SEP005's unit_str alike."""
+    acceleration = _signals()
+    record = read_record(_write_h5(tmp_path / "rec.h5", acceleration=acceleration, unit=unit))
+    np.testing.assert_allclose(record.acceleration, acceleration * scale, rtol=1e-15)
+    channels = [{"name": n, "data": acceleration[:, j], "fs": FS, "unit_str": unit, "position": p}
+                for j, (n, p) in enumerate(zip(NAMES, POSITIONS))]
+    np.testing.assert_allclose(from_sep005(channels).acceleration, acceleration * scale, rtol=1e-15)
 
 
 @pytest.mark.parametrize("field, value", [("format", "other-record"), ("version", 2), ("start_time", "yesterday")])

@@ -73,8 +73,8 @@ def record_from_csv(
         m from end A: ``{name: position}``, or one per channel in file order.
     time_column : str
         Sample times, s: uniform within ``TIME_TOLERANCE`` (relative).
-    unit : {"m/s^2", "g"}
-        Unit of the channel columns.
+    unit : str
+        The samples' unit, a spelling of :data:`.validation.UNITS` (m/s^2, m/s2, mm/s^2, g, G, mg, ...).
 
     Raises
     ------

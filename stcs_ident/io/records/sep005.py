@@ -31,13 +31,12 @@ from .validation import (
     position_list,
     positions_by_name,
     rate_from_time,
+    unit_scale,
     validated_record,
 )
 
 __all__ = ["READER", "Sep005Reader", "from_sep005", "read_sep005", "to_sep005", "write_sep005"]
 
-# SEP005 writes the unit as free text; the contract's spelling is "m/s^2".
-_SEP005_UNITS = {"m/s^2": "m/s^2", "m/s²": "m/s^2", "m/s2": "m/s^2", "g": "g"}
 
 
 def to_sep005(record: Record) -> list[dict[str, Any]]:
@@ -188,11 +187,11 @@ def _sep005_data(channel: Mapping[str, Any], name: str) -> np.ndarray:
     quantity = channel.get("quantity", "acceleration")
     if str(quantity).lower() != "acceleration":
         raise InputError(f"channel {name!r} holds {quantity!r}, not acceleration", field="acceleration")
-    unit = _SEP005_UNITS.get(str(channel.get("unit_str")).strip())
-    if unit is None:
-        raise InputError(f"channel {name!r}: unknown unit_str {channel.get('unit_str')!r}; use 'm/s^2' or 'g'",
+    given = channel.get("unit_str")
+    if str(given).strip() not in UNITS:
+        raise InputError(f"channel {name!r}: unknown unit_str {given!r}; use one of {', '.join(UNITS)}",
                          field="unit")
-    return data * UNITS[unit]
+    return data * unit_scale(given)
 
 
 def _sep005_rate(channel: Mapping[str, Any], name: str, n_samples: int) -> float:

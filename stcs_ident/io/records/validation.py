@@ -42,11 +42,31 @@ from .screening import screen_channels
 
 __all__ = [
     "TIME_TOLERANCE", "UNITS", "Positions", "check_bandwidth", "check_duration", "check_positions",
-    "check_sampling_rate", "one_line", "position_list", "positions_by_name", "rate_from_time", "validated_record",
+    "check_sampling_rate", "one_line", "position_list", "positions_by_name", "rate_from_time", "unit_scale", "validated_record",
 ]
 
-#: Units a record may be in, with their factor to m/s².
-UNITS = {"m/s^2": 1.0, "g": STANDARD_GRAVITY}
+#: Units a record may be in, as data loggers spell them, with their factor to m/s²: the one table of every
+#: reader (HDF5's ``unit``, SEP005's ``unit_str``, the CSV reader's ``unit``).
+UNITS = {
+    "m/s^2": 1.0, "m/s²": 1.0, "m/s2": 1.0, "m s^-2": 1.0, "m s-2": 1.0,
+    "mm/s^2": 1e-3, "mm/s²": 1e-3, "mm/s2": 1e-3,
+    "g": STANDARD_GRAVITY, "G": STANDARD_GRAVITY, "mg": 1e-3 * STANDARD_GRAVITY,
+}
+
+
+def unit_scale(unit, file: str | None = None, field: str = "unit") -> float:
+    """The factor from ``unit`` (a spelling of :data:`UNITS`, surrounding blanks ignored) to m/s².
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` and listing the spellings accepted, for any other unit (a velocity or a
+        displacement is not an acceleration; ``"gal"`` or ``"ft/s^2"`` are not in use on cables here).
+    """
+    spelled = str(unit).strip() if isinstance(unit, str) else unit
+    if spelled not in UNITS:
+        raise InputError(f"unknown unit {unit!r}; use one of {', '.join(UNITS)}", field=field, file=file)
+    return UNITS[spelled]
 #: Largest relative spread of time steps accepted as uniform sampling.
 TIME_TOLERANCE = 1e-6
 
@@ -111,13 +131,12 @@ def validated_record(
     names = check_names(names, acceleration.shape[1], file)
     positions = check_position_values(positions, names, file)
     sampling_rate = check_sampling_rate(sampling_rate, file)
-    if unit not in UNITS:
-        raise InputError(f"unknown unit {unit!r}; use 'm/s^2' or 'g'", field="unit", file=file)
+    scale = unit_scale(unit, file)
     if start_time is not None:
         _check_start_time(start_time, file)
     check_finite(acceleration, names, file)
-    if UNITS[unit] != 1.0:  # in place when the array is ours already (converted to float64 above)
-        acceleration = acceleration * UNITS[unit] if acceleration is given else _scale(acceleration, UNITS[unit])
+    if scale != 1.0:  # in place when the array is ours already (converted to float64 above)
+        acceleration = acceleration * scale if acceleration is given else _scale(acceleration, scale)
     keep, dropped = screen_channels(acceleration, names, file)
     if dropped:  # (indexing copies the record: only when a channel goes)
         acceleration = acceleration[:, keep]
