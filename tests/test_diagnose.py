@@ -423,6 +423,6 @@ def test_the_diagnosis_is_the_same_in_one_process_and_in_two():
     one = diagnose(campaign, picked=picked, max_effects=1, workers=1)
     two = diagnose(campaign, picked=picked, max_effects=1, workers=2)
     assert list(one.fits) == list(two.fits)
-    strip = lambda s: {k: v for k, v in s.items() if k not in ("elapsed", "timings", "seconds")}  # noqa: E731
+    strip = lambda s: {k: v for k, v in s.items() if k not in ("elapsed", "timings", "seconds")}
     assert json.dumps(strip(one.summary()), sort_keys=True, default=str) == \
         json.dumps(strip(two.summary()), sort_keys=True, default=str)
