@@ -100,12 +100,13 @@ def npz():
 
 
 def test_the_built_in_readers_are_registered_with_their_suffixes():
-    assert [r.name for r in readers()] == ["hdf5", "csv", "sep005"]
-    assert record_suffixes() == (".h5", ".hdf5", ".csv", ".txt", ".json")
+    assert [r.name for r in readers()] == ["hdf5", "csv", "sep005", "matlab", "tdms", "uff"]
+    assert record_suffixes() == (".h5", ".hdf5", ".csv", ".txt", ".json", ".mat", ".tdms", ".uff", ".unv")
 
 
 @pytest.mark.parametrize(("name", "reader"), [("r.h5", "hdf5"), ("r.HDF5", "hdf5"), ("r.csv", "csv"),
-                                              ("r.txt", "csv"), ("r.json", "sep005")])
+                                              ("r.txt", "csv"), ("r.json", "sep005"), ("r.mat", "matlab"),
+                                              ("r.tdms", "tdms"), ("r.UFF", "uff"), ("r.unv", "uff")])
 def test_the_suffix_picks_the_reader_without_opening_the_file(tmp_path, name, reader):
     assert reader_for(tmp_path / name).name == reader  # the file does not exist: the suffix alone decided
 

@@ -18,10 +18,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from ...core.errors import InputError
 from ...core.record import Record
+from .options import check_options
+from .validation import overridden
 
 __all__ = [
     "HEAD_BYTES", "RecordReader", "file_head", "read_record", "reader_for", "readers", "record_suffixes", "register",
@@ -59,7 +62,7 @@ class RecordReader:
         """
         return False
 
-    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None) -> Record:
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
         """The record in ``path``, checked as every record is (:mod:`~stcs_ident.io.records.validation`).
 
         Parameters
@@ -68,6 +71,10 @@ class RecordReader:
             The record file.
         positions : mapping of str to float, optional
             m from end A, by channel name, for channels whose file gives no position.
+        **options
+            Reader options (:data:`~stcs_ident.io.records.options.OPTIONS`), checked already; a reader uses
+            those of its format and ignores the others. ``start_time`` and ``temperature`` are applied by
+            :func:`read_record` to every format.
 
         Raises
         ------
@@ -156,7 +163,11 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
     positions : mapping of str to float, optional
         m from end A, by channel name, for channels whose file gives no position (CSV).
     **options
-        Passed to the reader's ``read`` (the CSV reader takes ``time_column`` and ``unit``).
+        Reader options (:data:`~stcs_ident.io.records.options.OPTIONS`: ``unit``, ``sampling_rate``,
+        ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``start_time``, ``temperature``,
+        ``variable``, ``group``), a campaign's ``record_format``; None values are ignored. Each reader takes
+        those of its format; ``start_time`` and ``temperature`` replace the file's in every format, and the
+        record's ``notes`` say where a given value differs from the file's.
 
     Returns
     -------
@@ -166,9 +177,15 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
     Raises
     ------
     InputError
-        One line naming the file (and the field): unknown format, missing file, or what the reader refuses.
+        One line naming the file (and the field): unknown format, missing file, a wrong option, or what the
+        reader refuses.
     """
-    return reader_for(path).read(path, positions=positions, **options)
+    options = check_options(options, file=os.fspath(path))
+    record = reader_for(path).read(path, positions=positions, **options)
+    notes = list(record.notes)
+    changes = {key: overridden(key, getattr(record, key), options, notes) for key in ("start_time", "temperature")
+               if options.get(key) is not None}
+    return replace(record, **changes, notes=tuple(notes)) if changes else record
 
 
 def file_head(path: str | os.PathLike, size: int = HEAD_BYTES) -> bytes:

@@ -24,7 +24,7 @@ from ...core.errors import InputError
 from ...core.files import atomic_path
 from ...core.record import Record
 from .base import RecordReader, file_head
-from .validation import one_line, validated_record
+from .validation import one_line, overridden, validated_record
 
 __all__ = ["FORMAT", "READER", "VERSION", "Hdf5Reader", "read_record", "write_record"]
 
@@ -46,16 +46,19 @@ class Hdf5Reader(RecordReader):
         head = file_head(path)
         return any(head[offset:offset + len(SIGNATURE)] == SIGNATURE for offset in (0, 512, 1024))
 
-    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None) -> Record:
-        """:func:`read_record`; ``positions`` is not used (the file gives every channel's)."""
-        return read_record(path)
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
+        """:func:`read_record`; ``positions`` is not used (the file gives every channel's); of the options,
+        ``unit`` and ``sampling_rate`` replace the file's (the others do not apply)."""
+        return read_record(path, unit=options.get("unit"), sampling_rate=options.get("sampling_rate"))
 
 
 READER = Hdf5Reader()
 
 
-def read_record(path: str | os.PathLike) -> Record:
+def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_rate: float | None = None) -> Record:
     """Read an acceleration record from its HDF5 file (the contract's layout).
+
+    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``notes`` say so).
 
     Returns
     -------
@@ -70,22 +73,24 @@ def read_record(path: str | os.PathLike) -> Record:
     """
     file = str(path)
     try:
-        return _read(file)
+        return _read(file, {"unit": unit, "sampling_rate": sampling_rate})
     except InputError:
         raise
     except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # h5py on a corrupt file
         raise InputError(f"cannot read the record (a corrupt HDF5 file?): {one_line(err)}", file=file) from None
 
 
-def _read(file: str) -> Record:
+def _read(file: str, options: dict[str, Any]) -> Record:
     with _open_hdf5(file) as h5:
         if (fmt := _attr(h5.attrs, "format", str, file)) != FORMAT:
             raise InputError(f"is {fmt!r}, expected {FORMAT!r}", field="format", file=file)
         if (version := _attr(h5.attrs, "version", float, file)) != VERSION:
             raise InputError(f"unsupported version {version:g}; this toolkit reads {VERSION}", field="version",
                              file=file)
-        sampling_rate = _attr(h5.attrs, "sampling_rate", float, file)
-        unit = _attr(h5.attrs, "unit", str, file)
+        notes: list[str] = []
+        sampling_rate, unit = (overridden(key, _attr(h5.attrs, key, kind, file) if options[key] is None
+                                          or key in h5.attrs else None, options, notes)
+                               for key, kind in (("sampling_rate", float), ("unit", str)))
         start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
         temperature = _attr(h5.attrs, "temperature", float, file) if "temperature" in h5.attrs else None
         acceleration = _read_dataset(h5, "acceleration", file)
@@ -94,7 +99,7 @@ def _read(file: str) -> Record:
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
     return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
-                             source=file, temperature=temperature)
+                            source=file, temperature=temperature, notes=notes)
 
 
 def write_record(record: Record, path: str | os.PathLike, *, float32: bool = False) -> None:

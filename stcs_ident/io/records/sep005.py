@@ -128,7 +128,8 @@ class Sep005Reader(RecordReader):
     def can_open(self, path: str | os.PathLike) -> bool:
         return file_head(path).lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"["
 
-    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None) -> Record:
+    def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
+        """:func:`read_sep005`; its channel dicts carry their rate and unit (the options do not apply)."""
         return read_sep005(path, positions)
 
 

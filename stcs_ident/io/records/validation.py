@@ -42,7 +42,8 @@ from .screening import screen_channels
 
 __all__ = [
     "TIME_TOLERANCE", "UNITS", "Positions", "check_bandwidth", "check_duration", "check_positions",
-    "check_sampling_rate", "one_line", "position_list", "positions_by_name", "rate_from_time", "unit_scale", "validated_record",
+    "check_sampling_rate", "names_from_positions", "one_line", "overridden", "position_list", "positions_by_name",
+    "rate_from_time", "unit_scale", "validated_record",
 ]
 
 #: Units a record may be in, as data loggers spell them, with their factor to m/s²: the one table of every
@@ -123,8 +124,10 @@ def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: flo
 def validated_record(
     acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
     *, unit: str, start_time: str | None, source: str | None, temperature: float | None = None,
+    notes: Iterable[str] = (),
 ) -> Record:
-    """Check the parts of a record, convert to m/s², drop dead and clipped channels."""
+    """Check the parts of a record, convert to m/s², drop dead and clipped channels (``notes``: what the
+    campaign's options overrode, :func:`overridden`)."""
     file = source
     given = acceleration
     acceleration = check_shape(np.asarray(acceleration, dtype=float), file)
@@ -143,8 +146,32 @@ def validated_record(
     return Record(
         acceleration=acceleration, sampling_rate=sampling_rate,
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
-        start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature,
+        start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature, notes=tuple(notes),
     )
+
+
+def overridden(name: str, found: Any, options: Mapping[str, Any], notes: list[str]) -> Any:
+    """Option ``name``'s value where the options give it, else ``found`` (the file's; None: the file has none).
+
+    A given value that differs from the file's is noted in ``notes`` (the record says so).
+    """
+    given = options.get(name)
+    if given is None:
+        return found
+    if found is not None and found != given:
+        notes.append(f"{name} {given!r} from record_format replaces the file's {found!r}")
+    return given
+
+
+def names_from_positions(n_channels: int, positions: Mapping[str, Any] | None, file: str | None,
+                         what: str = "columns") -> list[str]:
+    """Channel names for a file that gives none: the campaign's channel table, in its order, one per column."""
+    names = list(positions or {})
+    if len(names) != n_channels:
+        raise InputError(f"the file names no channels and holds {n_channels} {what}, but the campaign's channel "
+                         f"table ([test.channels]) lists {len(names)}: list one channel per {what[:-1]}, in order",
+                         field="channel_name", file=file)
+    return names
 
 
 def check_sampling_rate(value: Any, file: str | None) -> float:

@@ -1,0 +1,92 @@
+"""Reader options: what a campaign's ``record_format`` may tell the record readers.
+
+One table, :data:`OPTIONS`, names every option and the kind of its value;
+:func:`option_problem` says what is wrong with a value (the campaign parser
+turns it into an error naming the key, :func:`check_options` into one naming
+the record file), :func:`option_value` gives the value as the readers take
+it. Each reader uses the options that apply to its format and ignores the
+others: one campaign may give options for several formats.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from datetime import date, datetime
+from typing import Any
+
+from ...core.errors import InputError
+from .validation import UNITS
+
+__all__ = ["OPTIONS", "check_options", "option_problem", "option_value"]
+
+#: Every reader option, with what its value must be.
+OPTIONS = {
+    "unit": "a unit of acceleration (" + ", ".join(UNITS) + ")",
+    "sampling_rate": "a number of Hz > 0",
+    "time_column": "a non-empty string (the time column's name)",
+    "separator": "one character (the column separator)",
+    "decimal": "one character (the decimal mark)",
+    "skip_rows": "a list of line numbers >= 1 (0-based, the header is line 0)",
+    "start_time": "an ISO 8601 date-time",
+    "temperature": "a number of degC",
+    "variable": "a non-empty string (the MATLAB variable)",
+    "group": "a non-empty string (the TDMS group)",
+}
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def option_problem(key: str, value: Any) -> str | None:
+    """What is wrong with ``value`` for option ``key`` (None: nothing); an unknown key is a problem too."""
+    if key not in OPTIONS:
+        return f"unknown key {key!r}; expected one of: {', '.join(OPTIONS)}"
+    must = f"must be {OPTIONS[key]}, got {value!r}"
+    if key in ("sampling_rate", "temperature"):
+        ok = _is_number(value) and math.isfinite(value) and (key != "sampling_rate" or value > 0)
+    elif key in ("separator", "decimal"):
+        ok = isinstance(value, str) and len(value) == 1 and value not in "\r\n\"" and (key != "decimal" or value != " ")
+    elif key == "skip_rows":
+        ok = isinstance(value, list | tuple) and all(isinstance(v, int) and not isinstance(v, bool) and v >= 1
+                                                     for v in value)
+    elif key == "start_time":
+        ok = isinstance(value, datetime) or (isinstance(value, str) and _iso(value))
+    elif key == "unit":
+        ok = isinstance(value, str) and value.strip() in UNITS
+    else:
+        ok = isinstance(value, str) and bool(value)
+    return None if ok else must
+
+
+def option_value(key: str, value: Any) -> Any:
+    """``value`` (checked) as the readers take it: rows as a tuple, a TOML date-time as ISO 8601 text."""
+    if key == "skip_rows":
+        return tuple(int(v) for v in value)
+    if key == "start_time" and isinstance(value, datetime):
+        return value.isoformat()
+    if key in ("sampling_rate", "temperature"):
+        return float(value)
+    return value
+
+
+def check_options(options: Mapping[str, Any], file: str | None = None) -> dict[str, Any]:
+    """The options as the readers take them; a wrong key or value is an InputError naming ``file`` and the key."""
+    out = {}
+    for key, value in options.items():
+        if value is None:
+            continue
+        problem = option_problem(key, value)
+        if problem is not None:
+            raise InputError(f"record_format: {problem}", field=key, file=file)
+        out[key] = option_value(key, value)
+    return out
+
+
+def _iso(text: str) -> bool:
+    try:
+        parsed = datetime.fromisoformat(text)
+    except ValueError:
+        return False
+    return isinstance(parsed, date)
