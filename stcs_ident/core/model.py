@@ -13,6 +13,7 @@ import itertools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 from .errors import ModelError
 
@@ -365,6 +366,10 @@ class Test:
         value per frequency (one number is accepted and repeated). None:
         not stated (the identification then takes the rounding of the
         table, and says so).
+    record_format : tuple of (key, value)
+        How to read the record's file (``[test.record_format]``: unit,
+        sampling_rate, separator, ...; io checks the keys and values); a
+        mapping is accepted.
     """
 
     __test__ = False  # not a pytest class
@@ -378,11 +383,13 @@ class Test:
     reference: tuple[tuple[str, tuple[float, ...]], ...] = ()
     channels: tuple[tuple[str, float], ...] = ()
     uncertainty: tuple[float, ...] | None = None
+    record_format: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="test.name")
         where = f"test[{self.name}]"
+        object.__setattr__(self, "record_format", _record_format(self.record_format, f"{where}.record_format"))
         channels = tuple(dict(self.channels).items())
         for name, _ in channels:
             if not isinstance(name, str) or not name:
@@ -489,6 +496,10 @@ class Campaign:
     #: Tolerances the campaign gives (``[tolerance]``): (key, value) pairs, sorted by key; a key not
     #: given takes its effect's default (:func:`stcs_ident.effects.tolerance`).
     tolerance: tuple[tuple[str, float], ...] = ()
+    #: How to read the records of every test (top-level ``[record_format]``; a test's own keys win), and the
+    #: channel positions of records whose files give none (top-level ``[channels]``; a test's own table wins).
+    record_format: tuple[tuple[str, Any], ...] = ()
+    channels: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -503,6 +514,9 @@ class Campaign:
                 raise ModelError(f"must be >= 0, got {value!r}", field=f"tolerance.{key}")
             given[key] = v
         object.__setattr__(self, "tolerance", tuple(sorted(given.items())))
+        object.__setattr__(self, "record_format", _record_format(self.record_format, "record_format"))
+        object.__setattr__(self, "channels", tuple(
+            (name, finite_number(position, f"channels.{name}")) for name, position in dict(self.channels).items()))
         object.__setattr__(self, "setups", tuple(self.setups))
         object.__setattr__(self, "tests", tuple(self.tests))
         _unique((s.name for s in self.setups), "setup")
@@ -525,6 +539,21 @@ class Campaign:
             if t.name == name:
                 return t
         raise KeyError(name)
+
+    def record_reading(self, test: Test) -> tuple[dict[str, float] | None, dict[str, Any]]:
+        """How to read ``test``'s record: the channel positions (the test's table, else the campaign's; None
+        if neither) and the reader options (the campaign's ``record_format`` updated with the test's)."""
+        positions = dict(test.channels or self.channels) or None
+        return positions, {**dict(self.record_format), **dict(test.record_format)}
+
+
+def _record_format(value: Any, field: str) -> tuple[tuple[str, Any], ...]:
+    """Reader options as (key, value) pairs, lists as tuples (the values are io's to check)."""
+    pairs = tuple(dict(value).items())
+    for key, _ in pairs:
+        if not isinstance(key, str) or not key:
+            raise ModelError(f"keys must be non-empty strings, got {key!r}", field=field)
+    return tuple((key, tuple(v) if isinstance(v, list) else v) for key, v in pairs)
 
 
 def _unique(names: Iterable[str], kind: str) -> None:

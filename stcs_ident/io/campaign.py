@@ -27,20 +27,23 @@ from ..core import kinds
 from ..core.errors import CampaignError, ModelError
 from ..core.model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
 from .campaign_toml import campaign_to_toml
+from .records.options import option_problem, option_value
 
 __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 
 #: Name of the campaign file inside a campaign directory.
 CAMPAIGN_FILE = "campaign.toml"
 
-_TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance")
+_TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance", "record_format", "channels")
 _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
 _SETUP_KEYS = ("name", "attachment", "damper")
 _ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
 _DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass")
-_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels", "uncertainty")
+_TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels", "uncertainty",
+              "record_format")
+_CHANNEL_KEYS = ("position", "direction")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
 
@@ -129,7 +132,9 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     tests = [_parse_test(t, i) for i, t in enumerate(_tables(data.get("test", []), "test"), 1)]
     published = [_parse_published(t, i) for i, t in enumerate(_tables(data.get("published", []), "published"), 1)]
     tolerance = _parse_tolerance(_table(data.get("tolerance", {}), "tolerance"))
-    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance)
+    return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance,
+                    record_format=_parse_record_format(data.get("record_format", {}), "record_format"),
+                    channels=_parse_channels(data.get("channels", {}), "channels"))
 
 
 def _parse_tolerance(table: dict[str, Any]) -> tuple[tuple[str, float], ...]:
@@ -259,7 +264,6 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
     modes = table.get("modes")
     record = table.get("record")
     reference = _table(table.get("reference", {}), f"{where}.reference")
-    channels = _table(table.get("channels", {}), f"{where}.channels")
     uncertainty = table.get("uncertainty")
     if uncertainty is not None:  # one number for all the frequencies, or one per frequency
         uncertainty = (_numbers(uncertainty, f"{where}.uncertainty") if isinstance(uncertainty, list)
@@ -272,9 +276,37 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
         modes=None if modes is None else _integers(modes, f"{where}.modes"),
         record=None if record is None else _string(record, f"{where}.record"),
         reference=tuple((k, _numbers(v, f"{where}.reference.{k}")) for k, v in reference.items()),
-        channels=tuple((k, _number(v, f"{where}.channels.{k}")) for k, v in channels.items()),
+        channels=_parse_channels(table.get("channels", {}), f"{where}.channels"),
         uncertainty=uncertainty,
+        record_format=_parse_record_format(table.get("record_format", {}), f"{where}.record_format"),
     )
+
+
+def _parse_channels(value: Any, field: str) -> tuple[tuple[str, float], ...]:
+    """A channel table: ``name = position`` (m from end A) or ``name = {position = .., direction = "in"}``."""
+    out = []
+    for name, entry in _table(value, field).items():
+        where = f"{field}.{name}"
+        if isinstance(entry, dict):
+            _check_keys(entry, _CHANNEL_KEYS, where)
+            direction = entry.get("direction", "in")
+            if direction != "in":
+                raise CampaignError(f"direction {_show(direction)}: out-of-plane channels are not supported yet "
+                                    '(only "in", the in-plane transverse direction)', field=f"{where}.direction")
+            entry = _required(entry, "position", where)
+        out.append((name, _number(entry, where)))
+    return tuple(out)
+
+
+def _parse_record_format(value: Any, field: str) -> tuple[tuple[str, Any], ...]:
+    """A ``record_format`` table: every key and value checked (:data:`~stcs_ident.io.records.options.OPTIONS`)."""
+    out = []
+    for key, option in _table(value, field).items():
+        problem = option_problem(key, option)
+        if problem is not None:
+            raise CampaignError(problem, field=f"{field}.{key}")
+        out.append((key, option_value(key, option)))
+    return tuple(out)
 
 
 # --------------------------------------------------------------------------

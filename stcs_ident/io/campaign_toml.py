@@ -55,7 +55,16 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
         data["published"] = [_published_table(item) for item in campaign.published]
     if campaign.tolerance:
         data["tolerance"] = {key: float(value) for key, value in campaign.tolerance}
+    if campaign.record_format:
+        data["record_format"] = _record_format_table(campaign.record_format)
+    if campaign.channels:
+        data["channels"] = {name: float(position) for name, position in campaign.channels}
     return data
+
+
+def _record_format_table(options: tuple[tuple[str, Any], ...]) -> dict[str, Any]:
+    """Reader options as TOML values: rows as a list, numbers as they were read (floats)."""
+    return {key: list(value) if isinstance(value, tuple) else value for key, value in options}
 
 
 def _cable_table(cable: Cable) -> dict[str, Any]:
@@ -99,6 +108,8 @@ def _test_table(test: Test) -> dict[str, Any]:
         table["channels"] = {name: float(position) for name, position in test.channels}
     if test.uncertainty is not None:
         table["uncertainty"] = [float(u) for u in test.uncertainty]
+    if test.record_format:
+        table["record_format"] = _record_format_table(test.record_format)
     return table
 
 

@@ -126,13 +126,15 @@ def record_path(campaign: Campaign, test: Test) -> str:
 def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
                  tension_model: str = "uniform", options: PickingOptions | None = None) -> TestSpectra:
     """Pick and number the modal frequencies of one test's record (in any format io reads; the test's
-    ``channels`` give the positions a file lacks).
+    ``channels`` give the positions a file lacks, its ``record_format`` the reader options, the campaign's
+    top-level ones where the test gives none).
 
     ``options`` tunes the picking and the numbering (default: the
     calibrated values); the result records them.
     """
     path = record_path(campaign, test)
-    record = read_record(path, positions=dict(test.channels) or None)
+    positions, reading = campaign.record_reading(test)
+    record = read_record(path, positions=positions, **reading)
     return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model,
                           options=options)
 

@@ -1,8 +1,10 @@
 """The archive of field records: its cables, their records, and a record's identity by content.
 
     ARCHIVE/<cable>/campaign.toml      the cable and its setup; its first test (if any) gives the
-                                       reference tension that numbers the modes, and the channel
-                                       positions of records whose files give none ([test.channels])
+                                       reference tension that numbers the modes; the channel positions
+                                       of records whose files give none ([channels] at the top level, else
+                                       the first test's [test.channels]) and the reader options
+                                       ([record_format], updated with the first test's)
     ARCHIVE/<cable>/records/**/*       the records, in any registered format (by suffix: *.h5, *.csv, ...;
                                        start_time required, temperature optional)
 
@@ -16,6 +18,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from ..core.errors import InputError
 from ..core.model import Campaign
@@ -28,8 +31,9 @@ __all__ = ["CableSpec", "content_id", "discover", "record_paths"]
 
 @dataclass(frozen=True)
 class CableSpec:
-    """One cable of an archive: its campaign, the setup its records are of, the reference tension, and the
-    channel positions (m from end A) of records whose files give none (its first test's ``channels``)."""
+    """One cable of an archive: its campaign, the setup its records are of, the reference tension, the
+    channel positions (m from end A) of records whose files give none (the campaign's top-level ``channels``,
+    else its first test's) and the reader options (``record_format``, the first test's over the campaign's)."""
 
     name: str
     directory: str
@@ -37,6 +41,7 @@ class CableSpec:
     setup: str
     reference_tension: float
     channels: tuple[tuple[str, float], ...] = ()
+    record_format: tuple[tuple[str, Any], ...] = ()
 
 
 def discover(archive: str | os.PathLike, cables: list[str] | None = None) -> list[CableSpec]:
@@ -60,7 +65,9 @@ def _cable(directory: Path) -> CableSpec:
         raise InputError("needs a test: its tension is the reference that numbers the modes of the records, and "
                          "its setup what is attached", field="test", file=file)
     test = campaign.tests[0]
-    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension), test.channels)
+    positions, options = campaign.record_reading(test)
+    return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension),
+                     tuple((positions or {}).items()), tuple(options.items()))
 
 
 def record_paths(spec: CableSpec) -> list[Path]:

@@ -151,11 +151,13 @@ _TIME_HINT = "name the time column with time_column, or give sampling_rate (the 
 
 def _read_csv(file: str, separator: str, skip: list[int]) -> tuple[list[str], pd.DataFrame]:
     """The header and the data rows of ``file`` as text (columns by place, so duplicates survive)."""
+    hint = ""
     try:
         with open(file, newline="", encoding="utf-8-sig") as stream:  # -sig: tolerate a BOM
             header = [name.strip() for name in next(csv.reader(stream, delimiter=separator), [])]
         if not header:
             raise InputError("empty file: no header line", file=file)
+        hint = _separator_hint(header, separator)
         table = pd.read_csv(file, sep=separator, header=None, skiprows=[0, *skip], skipinitialspace=True,
                             encoding="utf-8-sig", dtype=str, keep_default_na=False, na_values=[""])
     except FileNotFoundError:
@@ -163,7 +165,8 @@ def _read_csv(file: str, separator: str, skip: list[int]) -> tuple[list[str], pd
     except pd.errors.EmptyDataError:
         raise InputError("has no samples", field="acceleration", file=file) from None
     except (OSError, UnicodeDecodeError, pd.errors.ParserError, csv.Error) as err:
-        hint = "" if separator != "," else "; if the columns are separated otherwise, give separator"
+        hint = (f"; {hint}" if hint else "; if the columns are separated otherwise, give separator in "
+                "record_format" if separator == "," else "")
         raise InputError(f"cannot read the file as CSV: {one_line(err)}{hint}", file=file) from err
     if table.shape[1] != len(header):
         hint = (f"; {_separator_hint(header, separator)}" if _separator_hint(header, separator) else
@@ -251,11 +254,12 @@ def _time_axis(column: pd.Series, name: str, decimal: str, skip: list[int], file
     if stamps.isna().any():
         row = int(np.argmax(stamps.isna().to_numpy()))
         raise InputError(f"column {name!r}, line {_line(row, skip)}: no date-time", field="time", file=file)
-    start = stamps.iloc[0].floor("us").isoformat()
+    start = stamps.iloc[0].floor("us").to_pydatetime().isoformat()  # Python's: no fraction when it is zero
     if not need_rate:
         return None, start
     ns = (stamps - stamps.iloc[0]).to_numpy().astype("timedelta64[ns]").astype(np.int64)
-    return _rate_from_stamps(ns, column.iloc[0], name, file), start
+    digits = column.str.extract(_FRACTION, expand=False).str.len().max()  # the finest the date-times are printed to
+    return _rate_from_stamps(ns, 0 if pd.isna(digits) else int(digits), name, file), start
 
 
 def _rate_from_seconds(time: np.ndarray, name: str, file: str) -> float:
@@ -269,12 +273,12 @@ def _rate_from_seconds(time: np.ndarray, name: str, file: str) -> float:
                          "in record_format", field=err.field, file=file) from None
 
 
-def _rate_from_stamps(ns: np.ndarray, first: str, name: str, file: str) -> float:
-    """Sampling rate, Hz, of date-times ``ns`` (ns from the first), uniform within their printed resolution."""
+def _rate_from_stamps(ns: np.ndarray, digits: int, name: str, file: str) -> float:
+    """Sampling rate, Hz, of date-times ``ns`` (ns from the first) printed with ``digits`` decimals of a
+    second, uniform within that resolution."""
     if ns.size < 2:
         raise InputError("needs at least two samples to give the sampling rate", field=name, file=file)
-    digits = _FRACTION.search(first)
-    resolution = 10 ** (9 - min(len(digits.group(1)), 9)) if digits else 10**9  # ns
+    resolution = 10 ** (9 - min(digits, 9))  # ns
     span = int(ns[-1])
     steps = np.diff(ns)
     mean = span / (ns.size - 1)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
@@ -66,6 +67,8 @@ def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | N
     except (OSError, ValueError, KeyError, IndexError, TypeError, EOFError) as err:
         raise InputError(f"not a TDMS file this toolkit reads: {one_line(err)}", file=file) from None
     groups = {g.name: g for g in tdms.groups() if g.channels()}
+    if not groups:
+        raise InputError("holds no channel with data (not a TDMS record?)", field="acceleration", file=file)
     if group is None:
         if len(groups) != 1:
             raise InputError(f"cannot tell the record's group (groups with channels: {', '.join(groups) or 'none'}):"
@@ -121,5 +124,5 @@ def _agreed(channels: list, key: str, file: str) -> Any:
 
 def _iso_utc(value: Any) -> str:
     """A TDMS time stamp (UTC; numpy datetime64 as npTDMS gives it) as ISO 8601 with its offset."""
-    stamp = np.datetime64(value, "us")
-    return f"{np.datetime_as_string(stamp, unit='us')}+00:00"
+    stamp = np.datetime64(value, "us").astype(datetime)
+    return stamp.replace(tzinfo=UTC).isoformat()
