@@ -319,3 +319,44 @@ def test_channels_inline_and_every_option_round_trip(tmp_path):
     assert positions == {"acc1": 4.5, "acc3": 6.9} and merged["unit"] == "g"
     positions, merged = campaign.record_reading(campaign.test("T1"))
     assert positions == {"x": 1.0} and merged == {"unit": "mg"}
+
+
+# ---------------------------------------------------------------- track: an archive of CSV records
+
+
+def test_track_takes_an_archive_of_csv_records_with_their_start_times(tmp_path):
+    """The simulated archive's records rewritten as CSV with date-times (the channel table and the reader
+    options once, at the top level of the cable's campaign) give the rows of the HDF5 archive, start times
+    included."""
+    from stcs_ident.simulate.archive import ArchiveOptions, simulate_archive
+    from stcs_ident.track.store import processed_table
+
+    (tmp_path / "nominal").mkdir()
+    (tmp_path / "nominal" / "campaign.toml").write_text(
+        BASE_TOML.replace('record = "records/T2.h5"\n', "").format(f=_frequencies()), encoding="utf-8")
+    archive = simulate_archive({"C1": load_campaign(tmp_path / "nominal")}, tmp_path / "archive",
+                               options=ArchiveOptions(days=3 / 24, interval=3600, duration=30.0), seed=5)
+    before = processed_table(_tracked(archive, tmp_path / "h5"))
+    cable = archive / "C1"
+    paths = sorted((cable / "records").rglob("*.h5"))
+    records = [read_record(path) for path in paths]
+    for path, record in zip(paths, records):
+        _csv_datetimes(record, path.with_suffix(".csv"), start=record.start_time)
+        path.unlink()
+    campaign = load_campaign(cable)
+    campaign = replace(campaign, channels=tuple(zip(records[0].channel_names, map(float, records[0].channel_positions))),
+                       record_format=(("time_column", "timestamp"),))
+    (cable / "campaign.toml").write_text(campaign_to_toml(campaign), encoding="utf-8")
+    after = processed_table(_tracked(archive, tmp_path / "csv"))
+    assert len(after) == len(paths) == 3 and list(after["status"]) == ["ok"] * 3
+    assert list(after["start_time"]) == [pd.Timestamp(r.start_time) for r in records] == list(before["start_time"])
+    assert all(name.endswith(".csv") for name in after["record"])
+    # The same samples (to an ulp, text printed with repr): the same tension to far below its 1σ (~1e-4).
+    np.testing.assert_allclose(after["tension"], before["tension"], rtol=1e-9)
+
+
+def _tracked(archive: Path, out: Path) -> Path:
+    from stcs_ident.track.api import track
+
+    track(archive, out)
+    return out
