@@ -37,7 +37,7 @@ _EXPORTS = {
     "Attachment": "core.model", "Boundary": "core.model", "Cable": "core.model", "Campaign": "core.model",
     "Damper": "core.model", "Setup": "core.model", "Test": "core.model", "Record": "core.record",
     # files
-    "load_campaign": "io.campaign", "read_record": "io.records.hdf5", "write_record": "io.records.hdf5",
+    "load_campaign": "io.campaign", "read_record": "io.records", "write_record": "io.records.hdf5",
     # the steps
     "natural_frequencies": "forward.dsm", "batch_frequencies": "forward.dsm", "mode_shapes": "forward.shapes",
     "compare_forward": "forward.compare", "find_peaks": "spectra.peaks", "analyse_test": "spectra.pipeline",

@@ -360,3 +360,13 @@ def _tracked(archive: Path, out: Path) -> Path:
 
     track(archive, out)
     return out
+
+
+def test_spectra_says_what_the_record_format_replaced(simulated, tmp_path):
+    """A TDMS record whose start time the campaign replaces: spectra's result and JSON say so."""
+    campaign = _as_campaign(simulated, tmp_path, "tdms")
+    test = campaign.test("T2")
+    test = replace(test, record_format=(*test.record_format, ("start_time", "2026-03-05T00:00:00+00:00")))
+    spectra = analyse_test(replace(campaign, tests=(test,)), test)
+    (note,) = spectra.record_notes
+    assert note.startswith("start_time '2026-03-05T00:00:00+00:00'") and spectra.summary()["record_notes"] == [note]

@@ -51,6 +51,7 @@ class TestSpectra(PickingResult):
     nominal_frequencies : the nominal model's frequencies of modes 1, 2, ... that the peaks were numbered
         against (Hz; for plots), or None
     options : the picking and numbering options used (how the result was made)
+    record_notes : what the campaign's ``record_format`` replaced in the record's file (Record.notes)
     """
 
     __test__ = False
@@ -70,6 +71,7 @@ class TestSpectra(PickingResult):
     damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
     nominal_frequencies: np.ndarray | None = None
     options: PickingOptions = field(default_factory=PickingOptions)
+    record_notes: tuple[str, ...] = ()
 
     main_table = "modes"
 
@@ -100,7 +102,7 @@ class TestSpectra(PickingResult):
             "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
             "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
-            "options": self.options.summary(),
+            "options": self.options.summary(), "record_notes": list(self.record_notes),
         }
 
 
@@ -171,7 +173,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
-        options=options,
+        options=options, record_notes=tuple(record.notes),
     )
 
 
