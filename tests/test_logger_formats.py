@@ -370,3 +370,20 @@ def test_spectra_says_what_the_record_format_replaced(simulated, tmp_path):
     spectra = analyse_test(replace(campaign, tests=(test,)), test)
     (note,) = spectra.record_notes
     assert note.startswith("start_time '2026-03-05T00:00:00+00:00'") and spectra.summary()["record_notes"] == [note]
+
+
+def test_the_command_line_refuses_a_rounded_csv_in_one_line_naming_the_file_and_the_fix(simulated, tmp_path,
+                                                                                       capsys):
+    """`spectra` on a campaign whose CSV record has a rounded time column and no sampling_rate: exit 2, one
+    line naming the file, the field and the option, nothing written."""
+    from stcs_ident.cli.main import main
+
+    campaign = _as_campaign(simulated, tmp_path, "csv-rounded")
+    test = campaign.test("T2")
+    without = replace(test, record_format=tuple((k, v) for k, v in test.record_format if k != "sampling_rate"))
+    (tmp_path / "campaign.toml").write_text(campaign_to_toml(replace(campaign, tests=(without,))), encoding="utf-8")
+    capsys.readouterr()
+    assert main(["spectra", str(tmp_path), "--json", str(tmp_path / "out.json")]) == 2
+    (err,) = [line for line in capsys.readouterr().err.splitlines() if line.startswith("stcs-ident:")]  # progress aside
+    assert "T2.csv" in err and "field 'time'" in err, err
+    assert "give sampling_rate" in err and not (tmp_path / "out.json").exists()
