@@ -172,14 +172,15 @@ def test_every_logger_format_gives_the_frequencies_of_the_hdf5_record(simulated,
     np.testing.assert_allclose(spectra.frequencies, reference.frequencies, rtol=RTOL, atol=0)
 
 
-def test_an_option_that_replaces_the_file_s_value_is_noted_on_the_record(simulated, tmp_path):
+def test_an_option_that_replaces_the_file_s_value_is_recorded_on_the_record(simulated, tmp_path):
     campaign = _as_campaign(simulated, tmp_path, "tdms")
     path = Path(campaign.directory) / campaign.test("T2").record
     positions, options = campaign.record_reading(campaign.test("T2"))
     record = read_record(path, positions=positions, **options, start_time="2026-03-05T00:00:00+00:00",
                          temperature=4.5)
     assert record.start_time == "2026-03-05T00:00:00+00:00" and record.temperature == 4.5
-    assert any(note.startswith("start_time") and START[:19] in note for note in record.notes), record.notes
+    # The file's start time is replaced (and said so); it has no temperature: nothing replaced there.
+    assert record.replaced == (("start_time", "2026-03-05T00:00:00+00:00", START),)
 
 
 # ---------------------------------------------------------------- refusals, one line naming the file and the fix
@@ -254,7 +255,8 @@ def test_tdms_refusals(short, tmp_path):
                               ChannelObject("G", "a2", short.acceleration[:, 1], {"unit_string": "V"})])
     _refused(path, "no sampling rate.*wf_increment; give sampling_rate", "sampling_rate", positions=positions)
     _refused(path, "unknown unit 'V'", "unit", positions=positions, sampling_rate=256.0)
-    assert read_record(path, positions=positions, sampling_rate=256.0, unit="m/s^2").notes  # V replaced: noted
+    assert read_record(path, positions=positions, sampling_rate=256.0, unit="m/s^2").replaced == (
+        ("unit", "m/s^2", "V"),)
     path.write_bytes(b"TDSm" + b"\0" * 10)
     _refused(path, "not a TDMS")
 
@@ -368,8 +370,9 @@ def test_spectra_says_what_the_record_format_replaced(simulated, tmp_path):
     test = campaign.test("T2")
     test = replace(test, record_format=(*test.record_format, ("start_time", "2026-03-05T00:00:00+00:00")))
     spectra = analyse_test(replace(campaign, tests=(test,)), test)
-    (note,) = spectra.record_notes
-    assert note.startswith("start_time '2026-03-05T00:00:00+00:00'") and spectra.summary()["record_notes"] == [note]
+    assert spectra.record_replaced == (("start_time", "2026-03-05T00:00:00+00:00", START),)
+    assert spectra.summary()["record_replaced"] == [
+        {"option": "start_time", "given": "2026-03-05T00:00:00+00:00", "file": START}]
 
 
 def test_the_command_line_refuses_a_rounded_csv_in_one_line_naming_the_file_and_the_fix(simulated, tmp_path,

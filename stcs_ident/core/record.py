@@ -139,10 +139,9 @@ class Record:
     temperature : float or None
         °C during the record (of the cable or the air, as the monitoring
         system gives it), for the temperature normalisation of ``track``.
-    notes : tuple of str
-        What the reader was told rather than found in the file (a value of
-        the campaign's ``record_format`` that overrides the file's), for
-        the report.
+    replaced : tuple of (option, given, file's value)
+        The file's values that the campaign's ``record_format`` replaced
+        (``("sampling_rate", 256.0, 255.9)``), for the report to say.
     """
 
     acceleration: np.ndarray
@@ -153,11 +152,11 @@ class Record:
     source: str | None = None
     dropped: tuple[tuple[str, str], ...] = field(default_factory=tuple)
     temperature: float | None = None
-    notes: tuple[str, ...] = ()
+    replaced: tuple[tuple[str, Any, Any], ...] = ()
 
     def __post_init__(self):
         file = self.source
-        object.__setattr__(self, "notes", tuple(self.notes))
+        object.__setattr__(self, "replaced", tuple(tuple(item) for item in self.replaced))
         acc = np.asarray(self.acceleration, dtype=float)
         object.__setattr__(self, "acceleration", check_shape(acc[:, None] if acc.ndim == 1 else acc, file))
         object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=file))

@@ -86,8 +86,8 @@ def spectra_text(campaign: str, results, skipped) -> str:
         lines.append(f"Test {r.name} ({r.peaks.kind} record {os.path.basename(r.record)})")
         for name, reason in r.dropped:
             lines.append(f"  channel {name} dropped: {reason}")
-        for note in getattr(r, "record_notes", ()):
-            lines.append(f"  record: {note}")
+        for option, given, found in getattr(r, "record_replaced", ()):
+            lines.append(f"  record: {option} {given!r} from record_format replaces the file's {found!r}")
         lines.append(f"{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9}  channels")
         for k, f, u, z, ch, doubt in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels, r.doubtful):
             flag = "?" if doubt else " "

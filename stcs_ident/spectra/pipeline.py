@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -51,7 +52,8 @@ class TestSpectra(PickingResult):
     nominal_frequencies : the nominal model's frequencies of modes 1, 2, ... that the peaks were numbered
         against (Hz; for plots), or None
     options : the picking and numbering options used (how the result was made)
-    record_notes : what the campaign's ``record_format`` replaced in the record's file (Record.notes)
+    record_replaced : (option, given, file's value) the campaign's ``record_format`` replaced in the record's
+        file (:attr:`Record.replaced`)
     """
 
     __test__ = False
@@ -71,7 +73,7 @@ class TestSpectra(PickingResult):
     damping_uncertainty: np.ndarray | None = None  # 1σ of ``damping`` (NaN where not estimated)
     nominal_frequencies: np.ndarray | None = None
     options: PickingOptions = field(default_factory=PickingOptions)
-    record_notes: tuple[str, ...] = ()
+    record_replaced: tuple[tuple[str, Any, Any], ...] = ()
 
     main_table = "modes"
 
@@ -102,7 +104,8 @@ class TestSpectra(PickingResult):
             "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
             "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
-            "options": self.options.summary(), "record_notes": list(self.record_notes),
+            "options": self.options.summary(), "record_replaced": [
+                {"option": option, "given": given, "file": found} for option, given, found in self.record_replaced],
         }
 
 
@@ -173,7 +176,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
-        options=options, record_notes=tuple(record.notes),
+        options=options, record_replaced=tuple(record.replaced),
     )
 
 

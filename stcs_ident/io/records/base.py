@@ -167,7 +167,7 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
         ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``start_time``, ``temperature``,
         ``variable``, ``group``), a campaign's ``record_format``; None values are ignored. Each reader takes
         those of its format; ``start_time`` and ``temperature`` replace the file's in every format, and the
-        record's ``notes`` say where a given value differs from the file's.
+        record's ``replaced`` lists where a given value differs from the file's.
 
     Returns
     -------
@@ -182,10 +182,10 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
     """
     options = check_options(options, file=os.fspath(path))
     record = reader_for(path).read(path, positions=positions, **options)
-    notes = list(record.notes)
-    changes = {key: overridden(key, getattr(record, key), options, notes) for key in ("start_time", "temperature")
+    replaced = list(record.replaced)
+    changes = {key: overridden(key, getattr(record, key), options, replaced) for key in ("start_time", "temperature")
                if options.get(key) is not None}
-    return replace(record, **changes, notes=tuple(notes)) if changes else record
+    return replace(record, **changes, replaced=tuple(replaced)) if changes else record
 
 
 def file_head(path: str | os.PathLike, size: int = HEAD_BYTES) -> bytes:

@@ -128,14 +128,13 @@ def record_from_csv(
     names = [name for name in header if name != time_column]
     if not skip:
         _check_units_row(table, header, file)
-    rate, start_time, notes = None, None, []
+    rate, start_time, replaced = None, None, []
     if has_time:
         column = table.iloc[:, header.index(time_column)]
         rate, start_time = _time_axis(column, time_column, decimal, skip, file, need_rate=sampling_rate is None)
     if sampling_rate is not None:
         if rate is not None and abs(rate - sampling_rate) > TIME_TOLERANCE * sampling_rate:
-            notes.append(f"sampling_rate {sampling_rate!r} from record_format replaces the time column's "
-                         f"{rate:.9g} Hz")
+            replaced.append(("sampling_rate", sampling_rate, rate))
         rate = sampling_rate
     acceleration = np.column_stack(
         [_numeric_column(table, header, name, "acceleration", decimal, skip, file) for name in names]
@@ -143,7 +142,7 @@ def record_from_csv(
     )
     channel_positions = position_list(names, positions_by_name(names, positions, file), file)
     return validated_record(acceleration, rate, names, channel_positions, unit=unit, start_time=start_time,
-                            source=file, notes=notes)
+                            source=file, replaced=replaced)
 
 
 _TIME_HINT = "name the time column with time_column, or give sampling_rate (the time column is then not needed)"

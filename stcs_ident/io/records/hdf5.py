@@ -58,7 +58,7 @@ READER = Hdf5Reader()
 def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_rate: float | None = None) -> Record:
     """Read an acceleration record from its HDF5 file (the contract's layout).
 
-    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``notes`` say so).
+    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``replaced`` says so).
 
     Returns
     -------
@@ -87,9 +87,9 @@ def _read(file: str, options: dict[str, Any]) -> Record:
         if (version := _attr(h5.attrs, "version", float, file)) != VERSION:
             raise InputError(f"unsupported version {version:g}; this toolkit reads {VERSION}", field="version",
                              file=file)
-        notes: list[str] = []
+        replaced: list = []
         sampling_rate, unit = (overridden(key, _attr(h5.attrs, key, kind, file) if options[key] is None
-                                          or key in h5.attrs else None, options, notes)
+                                          or key in h5.attrs else None, options, replaced)
                                for key, kind in (("sampling_rate", float), ("unit", str)))
         start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
         temperature = _attr(h5.attrs, "temperature", float, file) if "temperature" in h5.attrs else None
@@ -99,7 +99,7 @@ def _read(file: str, options: dict[str, Any]) -> Record:
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
     return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
-                            source=file, temperature=temperature, notes=notes)
+                            source=file, temperature=temperature, replaced=replaced)
 
 
 def write_record(record: Record, path: str | os.PathLike, *, float32: bool = False) -> None:

@@ -82,12 +82,12 @@ def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | No
         raise InputError(f"no variable {variable!r} in the file (variables: {', '.join(variables) or 'none'}); "
                          "give the right one as variable in record_format", field="variable", file=file)
     acceleration = _matrix(variables[variable], variable, file)
-    notes: list[str] = []
-    rate = overridden("sampling_rate", _rate(variables, file), {"sampling_rate": sampling_rate}, notes)
+    replaced: list = []
+    rate = overridden("sampling_rate", _rate(variables, file), {"sampling_rate": sampling_rate}, replaced)
     if rate is None:
         raise InputError(f"no sampling rate: the file holds none of {', '.join(RATE_NAMES)}; give sampling_rate "
                          "in record_format", field="sampling_rate", file=file)
-    unit = overridden("unit", _text(variables, "unit", file), {"unit": unit}, notes) or "m/s^2"
+    unit = overridden("unit", _text(variables, "unit", file), {"unit": unit}, replaced) or "m/s^2"
     names = variables.get("channel_names")
     if names is None:
         names = names_from_positions(acceleration.shape[1], positions, file)
@@ -99,7 +99,7 @@ def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | No
         temperature = _one_number(temperature, "temperature", file)
     return validated_record(acceleration, rate, names, channel_positions, unit=unit,
                             start_time=_text(variables, "start_time", file), source=file,
-                            temperature=temperature, notes=notes)
+                            temperature=temperature, replaced=replaced)
 
 
 def _load(file: str) -> dict[str, Any]:

@@ -83,17 +83,17 @@ def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | N
     if len(lengths) != 1:
         raise InputError(f"the channels of group {group!r} have different lengths ({sorted(lengths)})",
                          field="acceleration", file=file)
-    notes: list[str] = []
-    rate = overridden("sampling_rate", _file_rate(channels, file), {"sampling_rate": sampling_rate}, notes)
+    replaced: list = []
+    rate = overridden("sampling_rate", _file_rate(channels, file), {"sampling_rate": sampling_rate}, replaced)
     if rate is None:
         raise InputError("no sampling rate: the channels have no wf_increment; give sampling_rate in record_format",
                          field="sampling_rate", file=file)
-    unit = overridden("unit", _agreed(channels, "unit_string", file), {"unit": unit}, notes) or "m/s^2"
+    unit = overridden("unit", _agreed(channels, "unit_string", file), {"unit": unit}, replaced) or "m/s^2"
     start = _agreed(channels, "wf_start_time", file)
     acceleration = np.column_stack([np.asarray(channel[:], dtype=float) for channel in channels])
     channel_positions = position_list(names, positions_by_name(names, positions or {}, file), file)
     return validated_record(acceleration, rate, names, channel_positions, unit=unit,
-                            start_time=None if start is None else _iso_utc(start), source=file, notes=notes)
+                            start_time=None if start is None else _iso_utc(start), source=file, replaced=replaced)
 
 
 def _file_rate(channels: list, file: str) -> float | None:

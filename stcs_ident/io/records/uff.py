@@ -76,21 +76,21 @@ def record_from_uff(path: str | os.PathLike, positions: Mapping[str, float] | No
     lengths = {len(s["data"]) for s in sets}
     if len(lengths) != 1:
         raise InputError(f"the datasets have different lengths ({sorted(lengths)})", field="acceleration", file=file)
-    notes: list[str] = []
-    rate = overridden("sampling_rate", _file_rate(sets, file), {"sampling_rate": sampling_rate}, notes)
+    replaced: list = []
+    rate = overridden("sampling_rate", _file_rate(sets, file), {"sampling_rate": sampling_rate}, replaced)
     if rate is None:
         raise InputError("a dataset has no abscissa increment (an uneven abscissa?); give sampling_rate in "
                          "record_format", field="sampling_rate", file=file)
     units = {str(s.get("ordinate_axis_units_lab", "")).strip() for s in sets} - set(_BLANK)
     if len(units) > 1:
         raise InputError(f"the datasets disagree on the unit ({', '.join(sorted(units))})", field="unit", file=file)
-    unit = overridden("unit", next(iter(units), None), {"unit": unit}, notes) or "m/s^2"
+    unit = overridden("unit", next(iter(units), None), {"unit": unit}, replaced) or "m/s^2"
     data = [np.asarray(s["data"]) for s in sets]
     if any(np.iscomplexobj(d) for d in data):
         raise InputError("the datasets hold complex values, not a time response", field="acceleration", file=file)
     channel_positions = position_list(names, positions_by_name(names, positions or {}, file), file)
     return validated_record(np.column_stack(data), rate, names, channel_positions, unit=unit, start_time=None,
-                            source=file, notes=notes)
+                            source=file, replaced=replaced)
 
 
 def _name(dataset: Mapping[str, Any]) -> str:

@@ -124,10 +124,10 @@ def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: flo
 def validated_record(
     acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
     *, unit: str, start_time: str | None, source: str | None, temperature: float | None = None,
-    notes: Iterable[str] = (),
+    replaced: Iterable[tuple[str, Any, Any]] = (),
 ) -> Record:
-    """Check the parts of a record, convert to m/s², drop dead and clipped channels (``notes``: what the
-    campaign's options overrode, :func:`overridden`)."""
+    """Check the parts of a record, convert to m/s², drop dead and clipped channels (``replaced``: the file's
+    values that the campaign's options replaced, :func:`overridden`)."""
     file = source
     given = acceleration
     acceleration = check_shape(np.asarray(acceleration, dtype=float), file)
@@ -146,20 +146,22 @@ def validated_record(
     return Record(
         acceleration=acceleration, sampling_rate=sampling_rate,
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
-        start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature, notes=tuple(notes),
+        start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature,
+        replaced=tuple(replaced),
     )
 
 
-def overridden(name: str, found: Any, options: Mapping[str, Any], notes: list[str]) -> Any:
+def overridden(name: str, found: Any, options: Mapping[str, Any], replaced: list) -> Any:
     """Option ``name``'s value where the options give it, else ``found`` (the file's; None: the file has none).
 
-    A given value that differs from the file's is noted in ``notes`` (the record says so).
+    A given value that differs from the file's is recorded in ``replaced`` as ``(name, given, found)`` (the
+    record carries it, the report says so).
     """
     given = options.get(name)
     if given is None:
         return found
     if found is not None and found != given:
-        notes.append(f"{name} {given!r} from record_format replaces the file's {found!r}")
+        replaced.append((name, given, found))
     return given
 
 
