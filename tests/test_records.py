@@ -385,3 +385,19 @@ def test_record_shorter_than_five_periods_refused(tmp_path):
     with pytest.raises(InputError, match="lasts 2 s.*at least 5 s") as excinfo:
         check_duration(record, f1=1.0)
     _check_error(excinfo, record.source, "acceleration")
+
+
+def test_hdf5_options_stand_in_for_and_replace_the_file_s_rate_and_unit(tmp_path):
+    """A campaign's record_format applies to HDF5 too: sampling_rate stands in for a missing attribute, and a
+    unit given replaces the file's (the record lists what it replaced)."""
+    from stcs_ident.io.records import read_record as read_any
+
+    path = tmp_path / "r.h5"
+    write_record(_record(), path)
+    with h5py.File(path, "r+") as h5:
+        del h5.attrs["sampling_rate"]
+    with pytest.raises(InputError, match="missing root attribute"):
+        read_any(path)
+    record = read_any(path, sampling_rate=50.0, unit="g")
+    assert record.sampling_rate == 50.0 and record.replaced == (("unit", "g", "m/s^2"),)
+    np.testing.assert_allclose(record.acceleration, _record().acceleration * STANDARD_GRAVITY, rtol=1e-15)

@@ -88,9 +88,11 @@ def _read(file: str, options: dict[str, Any]) -> Record:
             raise InputError(f"unsupported version {version:g}; this toolkit reads {VERSION}", field="version",
                              file=file)
         replaced: list = []
-        sampling_rate, unit = (overridden(key, _attr(h5.attrs, key, kind, file) if options[key] is None
-                                          or key in h5.attrs else None, options, replaced)
-                               for key, kind in (("sampling_rate", float), ("unit", str)))
+        found = {key: _attr(h5.attrs, key, kind, file)  # required unless the options give it
+                 for key, kind in (("sampling_rate", float), ("unit", str))
+                 if options[key] is None or key in h5.attrs}
+        sampling_rate = overridden("sampling_rate", found.get("sampling_rate"), options, replaced)
+        unit = overridden("unit", found.get("unit"), options, replaced)
         start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
         temperature = _attr(h5.attrs, "temperature", float, file) if "temperature" in h5.attrs else None
         acceleration = _read_dataset(h5, "acceleration", file)
