@@ -400,4 +400,5 @@ def test_hdf5_options_stand_in_for_and_replace_the_file_s_rate_and_unit(tmp_path
         read_any(path)
     record = read_any(path, sampling_rate=50.0, unit="g")
     assert record.sampling_rate == 50.0 and record.replaced == (("unit", "g", "m/s^2"),)
+    # One multiplication each way: equal to within one rounding.
     np.testing.assert_allclose(record.acceleration, _record().acceleration * STANDARD_GRAVITY, rtol=1e-15)
