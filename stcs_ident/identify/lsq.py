@@ -21,9 +21,9 @@ from scipy.optimize import least_squares
 
 from ..core.notes import Note, point
 from ..core.settings import Settings
+from .nuisance import propagate, tolerance_note
 from .problem import Problem
 from .result import IdentificationResult, TestFit
-from .nuisance import propagate, tolerance_note
 from .uncertainty import correlation, covariance, covariance_scale, identifiability, warn_identifiability
 
 #: Candidate positions of the multi-start scan, as fractions of the length.

@@ -62,8 +62,8 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto", *, tolerances: b
         ``auto``: scale by χ²/dof when χ² exceeds its 95 % quantile;
         ``birge``: whenever χ²/dof > 1; ``never``.
     tolerances : bool
-        Whether the tolerances of parameters held fixed are in the uncertainties too (said in the
-        ``no_degrees_of_freedom`` note).
+        Whether the tolerances of parameters held fixed are in the uncertainties too (said in the notes: the
+        scale then applies to the frequencies' share alone).
     """
     if rule not in SCALE_RULES:
         raise ValueError(f"scale rule must be one of {SCALE_RULES}, got {rule!r}")
@@ -76,7 +76,8 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto", *, tolerances: b
     significant = chi2 > stats.chi2.ppf(0.95, dof)
     if rule == "never" or reduced <= 1 or (rule == "auto" and not significant):
         return 1.0, None
-    return reduced, Note.make("covariance_scaled", SCALED, value=float(reduced), misfit=float(np.sqrt(reduced)),
+    template = SCALED.replace("the covariance is", "the frequencies' share of the covariance is") if tolerances else SCALED
+    return reduced, Note.make("covariance_scaled", template, value=float(reduced), misfit=float(np.sqrt(reduced)),
                               dof=int(dof))
 
 
