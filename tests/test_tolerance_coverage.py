@@ -128,3 +128,20 @@ def test_a_tolerance_of_zero_and_fitted_values_are_not_propagated():
     assert not any(n.kind == "tolerances_propagated" for n in result.notes)
     held = identify(campaign, params="tension")
     assert any(n.kind == "tolerances_propagated" and "EI 30 %" in str(n) for n in held.notes)
+
+
+def test_the_json_gives_both_shares_of_each_sigma():
+    length, mass, tension, EI = CABLES["stiff"]
+    f = batch_frequencies(Cable(length, mass, EI), (), np.array([tension]), 1)[0]
+    test = Test("T1", "bare", tension, tuple(f), uncertainty=(0.01,))
+    campaign = Campaign("stiff", Cable(length, mass, EI), (Setup("bare"),), (test,))
+    result = identify(campaign, params="tension")
+    sources = result.summary()["uncertainty_sources"]
+    assert sources["held"] == {"EI": "30 %", "length": "0.2 %"}
+    share_f = sources["frequencies"]["tension_ratio"]["T1"]
+    share_t = sources["tolerances"]["tension_ratio"]["T1"]
+    # the shares add in quadrature to the stated σ (exactly: one covariance, split in two)
+    assert math.hypot(share_f, share_t) == pytest.approx(result.get("tension_ratio[T1]")[1], rel=1e-12)
+    # a stiff cable's one mode: EI's 30 % is most of it (about 4 % of the tension against 0.3 % from 0.01 Hz)
+    assert share_t > 5 * share_f
+    assert "uncertainty_sources" not in identify(campaign, params="tension", tolerances=False).summary()

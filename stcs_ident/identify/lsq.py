@@ -150,8 +150,16 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
         uncertainty=sigma if uncertainty is None else uncertainty,
         covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
         covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
-        settings=settings,
+        settings=settings, uncertainty_sources=_sources(problem, base * scale, added),
     )
+
+
+def _sources(problem: Problem, measured: np.ndarray, added: np.ndarray) -> dict:
+    """The two shares of each standard deviation and the tolerances held (empty without nuisances)."""
+    if not problem.nuisance:
+        return {}
+    return {"frequencies": np.sqrt(np.diag(measured)), "tolerances": np.sqrt(np.maximum(np.diag(added), 0.0)),
+            "held": {n.name: n.stated for n in problem.nuisance}}
 
 
 def local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:

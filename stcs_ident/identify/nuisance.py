@@ -66,12 +66,19 @@ class Nuisance:
     unit: str = ""
 
     @property
+    def name(self) -> str:
+        """``EI``, ``position[W1]``: the parameter's name without ``_ratio``."""
+        return self.parameter.name.replace("_ratio", "")
+
+    @property
+    def stated(self) -> str:
+        """The tolerance as the campaign states it: ``30 %`` or ``0.02 m``."""
+        return f"{self.tolerance:g} {self.unit}" if self.unit else f"{100 * self.tolerance:g} %"
+
+    @property
     def label(self) -> str:
         """``EI 30 %`` or ``position[W1] 0.02 m``."""
-        name = self.parameter.name.replace("_ratio", "")
-        if self.unit:
-            return f"{name} {self.tolerance:g} {self.unit}"
-        return f"{name} {100 * self.tolerance:g} %"
+        return f"{self.name} {self.stated}"
 
 
 def nuisance_parameters(campaign: Campaign, tests: Sequence[Test], fitted: Sequence[Parameter]) -> list[Nuisance]:
