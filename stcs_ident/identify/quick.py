@@ -235,7 +235,7 @@ def _check(length, mass, frequencies, modes, EI, EA, inclination, boundary, unce
     freqs = np.array([frequency(f, "frequencies") for f in frequencies])
     if freqs.size == 0:
         raise InputError("needs at least one frequency", field="frequencies")
-    modes = np.arange(1, freqs.size + 1) if modes is None else np.array([mode_number(k, "modes") for k in modes])
+    modes = np.arange(1, freqs.size + 1) if modes is None else np.array([mode_number(int(k) if isinstance(k, np.integer) else k, "modes") for k in modes])
     if modes.size != freqs.size:
         raise InputError(f"has {modes.size} mode numbers but there are {freqs.size} frequencies", field="modes")
     if np.unique(modes).size != modes.size:
