@@ -59,7 +59,7 @@ def tension_text(result) -> str:
     lines = [(f"length {inputs['length']:g} m, mass {inputs['mass']:g} kg/m, modes "
               f"{', '.join(map(str, inputs['modes']))}, {inputs['boundary']} ends, inclination "
               f"{inputs['inclination']:g} deg"),
-             f"frequency 1σ: {sigma_text} ({inputs['uncertainty_source']})",
+             f"frequency 1σ: {sigma_text}, {inputs['uncertainty_source']}",
              "",
              f"{'method':<13} {'tension (kN)':>14} {'1σ (kN)':>10}"]
     for name, m in result.methods.items():
