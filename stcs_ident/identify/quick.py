@@ -61,6 +61,10 @@ UNSOURCED = {
     for name in ("zui1996", "mehrabi1998")
 }
 
+#: With EI given, the taut string is left out (tension None) when its leading bias from bending exceeds this:
+#: 4/ξ with clamped ends (ξ < 20), n²π²/ξ² with pinned ends.
+TAUT_MAX_BIAS = 0.2
+
 #: The clamped-end expansion is used for a mode n when ξ ≥ max(CLAMPED_MIN_XI, CLAMPED_XI_PER_MODE · n):
 #: there its tension is within 1.5 % of the exact clamped beam's (tests/test_tension.py checks it).
 CLAMPED_MIN_XI = 20.0
@@ -203,7 +207,8 @@ class QuickTensionResult(Result):
     def headline(self) -> str:
         shown = [f"{k} {m.tension / 1e3:.5g} ± {m.uncertainty / 1e3:.2g} kN" for k, m in self.methods.items()
                  if m.tension is not None and m.uncertainty is not None]
-        return f"{len(self.inputs['frequencies'])} frequencies; " + "; ".join(shown)
+        k = len(self.inputs["frequencies"])
+        return f"{k} frequenc{'ies' if k != 1 else 'y'}; " + "; ".join(shown)
 
 
 def _num(x):
@@ -274,17 +279,28 @@ def _mean(per_mode: np.ndarray, sigma: np.ndarray) -> tuple[float, float, float 
     return float(np.mean(t)), math.sqrt(prop**2 + scatter**2 / k), scatter
 
 
-def _taut(length, mass, freqs, modes, sigma, EI) -> MethodEstimate:
+def _taut(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
     per = taut_string_tension(length, mass, freqs, modes)
     t, u, scatter = _mean(per, 2 * per * sigma / freqs)
-    note = None
-    if EI:
-        xi = length * math.sqrt(t / EI)
-        note = (f"ignores bending: with the given EI, xi = l sqrt(T/EI) = {xi:.3g}; the clamped-end effect alone "
-                f"(2/xi) puts it about {200 / xi:.2g} % high")
     extra = {"formula": "T = 4 m l^2 f_n^2 / n^2"}
     if scatter is not None:
         extra["scatter"] = scatter
+    note = None
+    if EI:
+        # the leading bias in tension (T goes as f²) of the lowest mode given: 2 × 2/ξ from clamped ends,
+        # n²π²/ξ² from the bending of a pinned beam
+        xi = length * math.sqrt(t / EI)
+        n = float(modes[0])
+        bias = 4 / xi if boundary == "clamped" else n * n * math.pi**2 / xi**2
+        extra["xi"], extra["estimated_bias"] = xi, bias
+        if bias > TAUT_MAX_BIAS:
+            return MethodEstimate("taut_string", None, None,
+                                  f"bending dominates: with the given EI, xi = l sqrt(T/EI) = {xi:.3g} and the taut "
+                                  f"string would be about {100 * bias:.2g} % high (limit {100 * TAUT_MAX_BIAS:g} %)",
+                                  SOURCES["taut_string"], tuple(map(float, per)), extra)
+        cause = "4/xi, the clamped ends" if boundary == "clamped" else f"n^2 pi^2/xi^2 at mode {n:g}"
+        note = (f"ignores bending: with the given EI, xi = l sqrt(T/EI) = {xi:.3g}, and it is about "
+                f"{100 * bias:.2g} % high from bending alone ({cause})")
     return MethodEstimate("taut_string", t, u, note, SOURCES["taut_string"], tuple(map(float, per)), extra)
 
 
@@ -422,11 +438,12 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     inputs = {"length": length, "mass": mass, "frequencies": freqs.tolist(), "modes": modes.tolist(), "EI": EI,
               "EA": EA, "inclination": inclination, "boundary": boundary, "uncertainty": sigma.tolist(),
               "uncertainty_source": uncertainty_source or "stated"}
-    taut = _taut(length, mass, freqs, modes, sigma, EI)
+    taut = _taut(length, mass, freqs, modes, sigma, EI, boundary)
     methods = {
         "taut_string": taut,
         "beam": _beam(length, mass, freqs, modes, sigma, EI, boundary),
         **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
-        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, taut.tension),
+        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
+                        float(np.mean(taut.per_mode))),
     }
     return QuickTensionResult(inputs, methods)
