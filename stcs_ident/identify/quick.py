@@ -2,7 +2,8 @@
 
 :func:`quick_tension` puts side by side, each with its 1σ:
 
-- ``taut_string``: T = 4 m l² f_n² / n² (the vibrating string; ignores bending and sag);
+- ``taut_string``: T = 4 m l² f_n² / n² (the vibrating string; ignores bending and sag; with EI given,
+  left out when its bending bias exceeds :data:`TAUT_MAX_BIAS`);
 - ``beam``: the tensioned-beam formulas the exact solver is checked against
   (:mod:`stcs_ident.forward.reference`), inverted for the tension, when EI is given:
   pinned ends exactly, clamped ends by the large-ξ expansion;
