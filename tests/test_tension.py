@@ -267,8 +267,10 @@ def test_exact_sigma_covers_the_truth():
     sigma = 0.002  # Hz, ~0.1 %: the fit stays linear
     inside = 0
     for _ in range(200):
-        exact = quick_tension(length, m, f + rng.normal(0, sigma, 3), modes, EI=EI,
-                              uncertainty=sigma).methods["exact"]
+        # EI and the length are exact in these draws: their tolerances 0 (the default 30 % and 0.2 % would widen
+        # σ for errors these data do not have; tests/test_tolerance_coverage.py covers data that have them)
+        exact = quick_tension(length, m, f + rng.normal(0, sigma, 3), modes, EI=EI, uncertainty=sigma,
+                              EI_tolerance=0, length_tolerance=0).methods["exact"]
         inside += abs(exact.tension - tension) <= exact.uncertainty
     # 68.3 % expected; binomial sd over 200 draws is 3.3 %, so ±7 % is about 2 sd
     assert 0.61 <= inside / 200 <= 0.75
@@ -290,3 +292,36 @@ def test_cli_exit_1_when_the_exact_fit_fails(monkeypatch, capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["methods"]["exact"]["tension"] is None and "no convergence" in data["methods"]["exact"]["note"]
     assert data["methods"]["taut_string"]["tension"] is not None
+
+
+def test_the_exact_sigma_carries_the_tolerance_of_a_given_EI():
+    """A given EI is known only to its tolerance: with one mode of a stiff cable (ξ = 20), 30 % of EI moves
+    the tension by about 2/ξ × 30 % × 2 ≈ 3 %, far more than 0.001 Hz does; with 0 it is the frequency's alone."""
+    length, m, tension = 10.0, 5.0, 5e4
+    EI = tension * length**2 / 20.0**2
+    f = ref.beam_clamped(length, m, tension, EI, [1])
+    given = quick_tension(length, m, f, [1], EI=EI, uncertainty=0.001).methods["exact"]
+    exact_EI = quick_tension(length, m, f, [1], EI=EI, uncertainty=0.001, EI_tolerance=0,
+                             length_tolerance=0).methods["exact"]
+    assert exact_EI.uncertainty / tension < 0.002   # 2 σ_f / f ≈ 4e-4 (f ≈ 5.5 Hz)
+    assert 0.015 < given.uncertainty / tension < 0.06
+    with pytest.raises(InputError):
+        quick_tension(length, m, f, [1], EI=EI, EI_tolerance=-0.1)
+
+
+def test_the_formulas_sigma_carries_the_length_and_EI_tolerances_in_closed_form():
+    """Taut string, one mode: T = 4 m l² f², so σ_T/T = √((2σ_f/f)² + (2 t_l)²) with t_l the length's relative
+    tolerance. Pinned beam: T = 4 m l² f² − π² EI/l², so the EI tolerance t_EI adds π² EI t_EI / l²."""
+    length, m, f, sigma_f, t_l, t_EI, EI = 50.0, 40.0, 2.0, 0.004, 0.002, 0.3, 1e5
+    T = 4 * m * length**2 * f**2
+    taut = quick_tension(length, m, [f], [1], uncertainty=sigma_f, length_tolerance=t_l).methods["taut_string"]
+    # first order by a relative step of 1e-6 on a quadratic: exact to ~1e-6
+    assert taut.uncertainty / T == pytest.approx(math.hypot(2 * sigma_f / f, 2 * t_l), rel=1e-5)
+    beam = quick_tension(length, m, [f], [1], EI=EI, boundary="pinned", uncertainty=sigma_f, length_tolerance=t_l,
+                         EI_tolerance=t_EI).methods["beam"]
+    T_beam = T - math.pi**2 * EI / length**2
+    d_length = 8 * m * length**2 * f**2 + 2 * math.pi**2 * EI / length**2  # l dT/dl
+    expected = math.sqrt((8 * m * length**2 * f * sigma_f) ** 2 + (d_length * t_l) ** 2
+                         + (math.pi**2 * EI / length**2 * t_EI) ** 2)
+    assert beam.tension == pytest.approx(T_beam, rel=1e-12)
+    assert beam.uncertainty == pytest.approx(expected, rel=1e-5)

@@ -23,6 +23,9 @@ def add_parser(sub) -> None:
     parser.add_argument("--boundary", choices=("clamped", "pinned"), default="clamped", help="both ends")
     parser.add_argument("--uncertainty", metavar="HZ", help="1σ of the frequencies, Hz, one for all or one each "
                                                             "(default: their printed rounding / sqrt 12)")
+    parser.add_argument("--EI-tolerance", metavar="REL", help="relative 1σ of a given --EI, carried into the "
+                                                              "exact model's σ (default 0.3; 0: exact)")
+    parser.add_argument("--length-tolerance", metavar="REL", help="relative 1σ of --length (default 0.002)")
     add_json_option(parser)
 
 
@@ -48,7 +51,8 @@ def _numbers(text: str | None, option: str, kind=float) -> list | None:
 
 def field_options() -> dict[str, str]:
     """The library's argument names that are not the option's name."""
-    return {"mass": "--mass", "EI": "--EI", "EA": "--EA"}
+    return {"mass": "--mass", "EI": "--EI", "EA": "--EA", "EI_tolerance": "--EI-tolerance",
+            "length_tolerance": "--length-tolerance"}
 
 
 def tension_text(result) -> str:
@@ -93,7 +97,8 @@ def run(args: argparse.Namespace) -> int:
                            _numbers(args.modes, "--modes", int), EI=_number(args.EI, "--EI"),
                            EA=_number(args.EA, "--EA"), inclination=_number(args.inclination, "--inclination"),
                            boundary=args.boundary, uncertainty=uncertainty if len(uncertainty) > 1 else uncertainty[0],
-                           uncertainty_source=source)
+                           uncertainty_source=source, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
+                           length_tolerance=_number(args.length_tolerance, "--length-tolerance"))
     if args.json:
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":

@@ -29,10 +29,11 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..core import kinds
 from ..core.errors import ComputationError, InputError
 from ..core.model import finite_number, frequency, in_band, mode_number
 from ..core.notes import Note
@@ -337,6 +338,27 @@ def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
     return MethodEstimate("beam", t, u, note, SOURCES["beam"], tuple(map(float, per)), extra)
 
 
+def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, tolerance) -> MethodEstimate:
+    """A formula's estimate with the tolerances of the length and of a given EI in its σ (first order, by
+    the formula's own change for a relative step of each: docs/uncertainty.md)."""
+    estimate = method(length, mass, freqs, modes, sigma, EI, boundary)
+    if estimate.tension is None:
+        return estimate
+    step, shares = 1e-6, {}
+    for key, value in (("length", length), ("EI", EI)):
+        if not value or not tolerance[key]:
+            continue
+        moved = dict(length=length, EI=EI)
+        moved[key] = value * (1 + step)
+        other = method(moved["length"], mass, freqs, modes, sigma, moved["EI"], boundary).tension
+        if other is not None:
+            shares[key] = abs(other - estimate.tension) / step * tolerance[key]
+    if not shares:
+        return estimate
+    extra = {**estimate.extra, "uncertainty_from_tolerances": shares}
+    return replace(estimate, uncertainty=math.hypot(estimate.uncertainty, *shares.values()), extra=extra)
+
+
 def _EI_start(length, mass, freqs, modes, tension) -> float:
     """A start for EI: the slope of (f_n/n)² against n² is π² EI/(4 m l⁴) on a pinned beam; where that slope is
     not positive, EI for ξ = 100."""
@@ -346,7 +368,7 @@ def _EI_start(length, mass, freqs, modes, tension) -> float:
     return float(guess) if guess > 0 and math.isfinite(guess) else fallback
 
 
-def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start) -> MethodEstimate:
+def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance) -> MethodEstimate:
     from ..core.model import Boundary, Cable, Campaign, Setup, Test
     from .api import identify
 
@@ -356,7 +378,7 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
     cable = Cable(length, mass, EI_nominal, EA, math.radians(inclination), boundary_a=end, boundary_b=end)
     test = Test("quick", "quick", start, tuple(map(float, freqs)), tuple(map(int, modes)),
                 uncertainty=tuple(map(float, sigma)))
-    campaign = Campaign("quick-tension", cable, (Setup("quick"),), (test,))
+    campaign = Campaign("quick-tension", cable, (Setup("quick"),), (test,), tolerance=tuple(tolerance.items()))
     params = "tension,EI" if fit_EI else "tension"
     bounds = {"tension": (0.05, 2.0), **({"EI": (1e-3, 1e3)} if fit_EI else {})}
     source = SOURCES["exact"]
@@ -377,6 +399,12 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
         extra["EI"], extra["EI_source"] = EI, "given"
     else:
         extra["EI_source"] = "taken as 0 (one frequency and no --EI: a string)"
+    if result.uncertainty_sources:  # the tension's σ from the frequencies and from the tolerances held, N
+        i = next(i for i, q in enumerate(result.parameters) if q.kind == "tension")
+        q, x = result.parameters[i], float(result.estimate[i])
+        extra["uncertainty_from_frequencies"] = q.value_uncertainty(x, result.uncertainty_sources["frequencies"][i])
+        extra["uncertainty_from_tolerances"] = q.value_uncertainty(x, result.uncertainty_sources["tolerances"][i])
+        extra["tolerances_held"] = dict(result.uncertainty_sources["held"])
     extra["reduced_chi2"] = _num(result.reduced_chi2)
     extra["covariance_scale"] = float(result.covariance_scale)
     extra["fitted"] = params
@@ -386,7 +414,8 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
 def quick_tension(length: float, mass: float, frequencies: Sequence[float], modes: Sequence[int] | None = None,
                   EI: float | None = None, EA: float | None = None, inclination: float = 0.0,
                   boundary: str = "clamped", uncertainty: float | Sequence[float] | None = None, *,
-                  uncertainty_source: str | None = None) -> QuickTensionResult:
+                  uncertainty_source: str | None = None, EI_tolerance: float | None = None,
+                  length_tolerance: float | None = None) -> QuickTensionResult:
     """A cable's tension from its length, mass and measured frequencies, by several methods side by side.
 
     Parameters
@@ -414,6 +443,9 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     uncertainty_source : str, optional
         How ``uncertainty`` was obtained, recorded in ``inputs`` (the command line says "rounding of the
         printed frequencies" when it derived it from the typed text).
+    EI_tolerance, length_tolerance : float, optional
+        Relative 1σ of a given EI and of the length (default: a campaign's defaults, 30 % and 0.2 %). The
+        exact model's σ includes them where the value is held fixed (docs/uncertainty.md); 0 says exact.
 
     Returns
     -------
@@ -436,15 +468,22 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
         if np.any(sigma >= freqs):
             raise InputError("the rounding of the frequencies is as large as a frequency: give --uncertainty",
                              field="uncertainty")
+    tolerance = {}
+    for key, value in (("EI", EI_tolerance), ("length", length_tolerance)):
+        if value is not None:
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError(f"must be a finite number >= 0, got {value!r}", field=f"{key}_tolerance")
+            tolerance[key] = float(value)
     inputs = {"length": length, "mass": mass, "frequencies": freqs.tolist(), "modes": modes.tolist(), "EI": EI,
               "EA": EA, "inclination": inclination, "boundary": boundary, "uncertainty": sigma.tolist(),
-              "uncertainty_source": uncertainty_source or "stated"}
-    taut = _taut(length, mass, freqs, modes, sigma, EI, boundary)
+              "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance}
+    held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "EI")}
+    taut = _with_tolerances(_taut, length, mass, freqs, modes, sigma, EI, boundary, held)
     methods = {
         "taut_string": taut,
-        "beam": _beam(length, mass, freqs, modes, sigma, EI, boundary),
+        "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
         **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
         "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
-                        float(np.mean(taut.per_mode))),
+                        float(np.mean(taut.per_mode)), tolerance),
     }
     return QuickTensionResult(inputs, methods)
