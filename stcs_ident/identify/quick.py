@@ -348,7 +348,7 @@ def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, to
     for key, value in (("length", length), ("EI", EI)):
         if not value or not tolerance[key]:
             continue
-        moved = dict(length=length, EI=EI)
+        moved = {"length": length, "EI": EI}
         moved[key] = value * (1 + step)
         other = method(moved["length"], mass, freqs, modes, sigma, moved["EI"], boundary).tension
         if other is not None:
