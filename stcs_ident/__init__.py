@@ -42,7 +42,7 @@ _EXPORTS = {
     "natural_frequencies": "forward.dsm", "batch_frequencies": "forward.dsm", "mode_shapes": "forward.shapes",
     "compare_forward": "forward.compare", "find_peaks": "spectra.peaks", "analyse_test": "spectra.pipeline",
     "analyse_campaign": "spectra.pipeline", "simulate_campaign": "simulate.simulate_campaign",
-    "identify": "identify.api", "diagnose": "diagnose.api", "track": "track.api",
+    "identify": "identify.api", "diagnose": "diagnose.api", "track": "track.api", "quick_tension": "identify.quick",
     # their results
     "ForwardResult": "forward.compare", "PeakResult": "spectra.peak_result", "TestSpectra": "spectra.pipeline",
     "IdentificationResult": "identify.result", "Diagnosis": "diagnose.result", "TrackResult": "track.result",

@@ -28,7 +28,9 @@ def _normalised_error(trial):
     campaign, picked, params, truth = trial
     # One start at the nominal values: the noise is far too small to move the
     # estimate to the mirror image, and the 200 scans would take a minute.
-    result = identify(campaign, ["T1"], params, picked=picked, starts=[np.ones(len(truth))])
+    # The values held fixed (length, the attachment's mass) are exact in these data sets: their tolerances stay
+    # out (tests/test_tolerance_coverage.py checks the intervals with them, on data whose values held fixed are off).
+    result = identify(campaign, ["T1"], params, picked=picked, starts=[np.ones(len(truth))], tolerances=False)
     return (result.estimate - truth) / result.uncertainty
 
 

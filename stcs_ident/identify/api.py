@@ -12,6 +12,7 @@ from ..core.model import Campaign
 from ..core.notes import Note
 from ..core.parameters import parse_parameters
 from ..core.settings import Settings
+from .nuisance import nuisance_parameters
 from .problem import Problem, gather_measurements
 from .result import IdentificationResult
 
@@ -21,7 +22,7 @@ METHODS = ("lsq", "contour")
 def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str | Iterable[str] = "tension,EI", *,
              method: str = "lsq", picked: Mapping[str, object] | None = None,
              bounds: Mapping[str, tuple[float, float]] | None = None, tension_model: str = "uniform",
-             scale_rule: str = "auto", **options) -> IdentificationResult:
+             scale_rule: str = "auto", tolerances: bool = True, **options) -> IdentificationResult:
     """Correct uncertain model parameters from measured natural frequencies.
 
     Parameters
@@ -47,6 +48,12 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     tension_model : {"uniform", "per-segment", "none"}
     scale_rule : {"auto", "birge", "never"}
         When to scale the covariance by the reduced χ².
+    tolerances : bool
+        Carry the tolerances of the parameters held fixed (the campaign's ``[tolerance]``: EI, length,
+        positions, masses, damper coefficients, the tensions not fitted) into the standard deviations of
+        those fitted (:mod:`~stcs_ident.identify.nuisance`; a ``tolerances_propagated`` note lists them).
+        Off: the standard deviations rest on the frequency uncertainties alone, as if every value held
+        fixed were exact.
     **options :
         Passed to :func:`~stcs_ident.identify.lsq.fit_lsq` (``starts``,
         ``n_starts``, ``max_nfev``, ``seed``) or
@@ -75,7 +82,8 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     measurements, skipped = gather_measurements(campaign, tests, picked)
     parameters = parse_parameters(campaign, [m.test for m in measurements], params, bounds)
     settings = Settings(tension_model=tension_model, scale_rule=scale_rule)
-    problem = Problem(campaign, measurements, parameters, settings.tension_model)
+    nuisance = nuisance_parameters(campaign, [m.test for m in measurements], parameters) if tolerances else ()
+    problem = Problem(campaign, measurements, parameters, settings.tension_model, nuisance=nuisance)
     if method == "lsq":
         from .lsq import fit_lsq
 

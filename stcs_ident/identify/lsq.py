@@ -21,9 +21,10 @@ from scipy.optimize import least_squares
 
 from ..core.notes import Note, point
 from ..core.settings import Settings
+from .nuisance import propagate, tolerance_note
 from .problem import Problem
 from .result import IdentificationResult, TestFit
-from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability
+from .uncertainty import correlation, covariance, covariance_scale, identifiability, warn_identifiability
 
 #: Candidate positions of the multi-start scan, as fractions of the length.
 SCAN_FRACTIONS = np.linspace(0.025, 0.975, 20)
@@ -99,22 +100,39 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     n, p = problem.n_data, len(problem.parameters)
     dof = n - p
     notes = list(notes)
-    if scale is None:
-        scale, scale_note = covariance_scale(chi2, dof, scale_rule)
-        if scale_note:
-            notes.insert(0, scale_note)
     J = problem.jacobian(x)
     typical = problem.typical(x)
-    cov, corr = covariance(J, scale, typical)
+    # The measurements' share (JᵀJ)⁻¹, scaled by the reduced χ² when the misfit is significant, plus the share
+    # of the tolerances of what is held fixed (not scaled: a stated claim of its own; :mod:`.nuisance`).
+    base, base_corr = covariance(J, 1.0, typical)
+    tested_chi2, added = chi2, np.zeros_like(base)
+    if problem.nuisance:
+        total, tested_chi2 = propagate(J, problem.nuisance_jacobian(x), problem.residuals(x), base)
+        with np.errstate(invalid="ignore"):
+            added = np.where(np.isfinite(total - base), total - base, 0.0)
+    if scale is None:
+        scale, scale_note = covariance_scale(tested_chi2, dof, scale_rule, tolerances=bool(problem.nuisance))
+        if scale_note:
+            notes.insert(0, scale_note)
+    cov = base * scale + added
+    corr = correlation(cov) if problem.nuisance else base_corr
     sigma = np.sqrt(np.diag(cov))
+    if problem.nuisance:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(np.isfinite(sigma) & (sigma > 0), np.diag(added) / sigma**2, 0.0)
+        notes.append(tolerance_note(problem.nuisance, float(np.max(share, initial=0.0))))
+    if uncertainty is not None:  # the contour's region extent: the tolerances' share added in quadrature
+        uncertainty = np.sqrt(np.asarray(uncertainty, float) ** 2 + np.maximum(np.diag(added), 0.0))
     span = problem.upper - problem.lower
     at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
                 if min(v - lo, hi - v) <= 1e-9 * w]
     if at_bound:
         notes.append(Note.make("at_bound", "at a bound (the standard deviation there is only indicative): "
                                "{parameters}", parameters=at_bound))
-    notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper,
-                                                  typical),
+    # What the data can tell apart: from the measurements' share alone (a common error of a value held fixed,
+    # the length, say, correlates every tension without making them any less determined by the data).
+    notes += warn_identifiability(identifiability(J, problem.names, base_corr, np.sqrt(np.diag(base) * scale),
+                                                  problem.lower, problem.upper, typical),
                                   stacklevel=4)
     before = problem.predict(problem.start)
     after = problem.predict(x)
@@ -129,11 +147,19 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
                              m.source, before[sl], after[sl], reference, damping[i]))
     return IdentificationResult(
         method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
-        uncertainty=sigma if uncertainty is None else np.asarray(uncertainty, float),
+        uncertainty=sigma if uncertainty is None else uncertainty,
         covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
         covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
-        settings=settings,
+        settings=settings, uncertainty_sources=_sources(problem, base * scale, added),
     )
+
+
+def _sources(problem: Problem, measured: np.ndarray, added: np.ndarray) -> dict:
+    """The two shares of each standard deviation and the tolerances held (empty without nuisances)."""
+    if not problem.nuisance:
+        return {}
+    return {"frequencies": np.sqrt(np.diag(measured)), "tolerances": np.sqrt(np.maximum(np.diag(added), 0.0)),
+            "held": {n.name: n.stated for n in problem.nuisance}}
 
 
 def local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:

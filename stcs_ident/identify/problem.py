@@ -212,6 +212,13 @@ class Problem:
     measurements : list of Measurement
     parameters : sequence of Parameter
     tension_model : {"uniform", "per-segment", "none"}
+    use_damping : bool, optional
+        Whether measured damping ratios are data (default: with a damper in the model and a ratio measured).
+    nuisance : sequence of Nuisance, optional
+        Parameters held fixed whose tolerances go into the uncertainty of the estimate
+        (:mod:`.nuisance`); default none.
+    check : bool
+        Whether to refuse fewer data than parameters (off for the Jacobian of the nuisances).
 
     Raises
     ------
@@ -221,11 +228,14 @@ class Problem:
     """
 
     def __init__(self, campaign: Campaign, measurements: Sequence[Measurement], parameters: Sequence[Parameter],
-                 tension_model: str = "uniform", use_damping: bool | None = None):
+                 tension_model: str = "uniform", use_damping: bool | None = None, nuisance: Sequence = (),
+                 check: bool = True):
         self.campaign = campaign
         self.measurements = list(measurements)
         self.parameters = tuple(parameters)
         self.tension_model = tension_model
+        #: Parameters held fixed with their tolerances (:class:`~stcs_ident.identify.nuisance.Nuisance`).
+        self.nuisance = tuple(nuisance)
         damped = any(has_dampers(campaign.setup(m.test.setup).attachments) for m in self.measurements)
         decided = {m.damping_is_data for m in self.measurements} - {None}
         if use_damping is None and decided:
@@ -239,7 +249,7 @@ class Problem:
         n, p = self.n_data, len(self.parameters)
         if p == 0:
             raise InputError("no free parameter", field="params")
-        if n < p:
+        if check and n < p:
             names = ", ".join(q.name for q in self.parameters)
             raise InputError(f"{p} free parameters ({names}) but only {n} measured frequencies", field="params")
         for q in self.parameters:
@@ -402,6 +412,18 @@ class Problem:
                 backward = (F0 - F_down) / (x - down)[:, None]
             J = np.where(lost_up & ~lost_down, backward, np.where(lost_down & ~lost_up, forward, J))
         return J.T / self.sigma[:, None]
+
+    def nuisance_jacobian(self, x) -> np.ndarray:
+        """d residuals / d nuisance variables at the estimate ``x``, each column times the nuisance's width
+        (n_data, q); empty (n_data, 0) without nuisances."""
+        if not self.nuisance:
+            return np.zeros((self.n_data, 0))
+        extra = [n.parameter for n in self.nuisance]
+        joint = Problem(self.campaign, self.measurements, self.parameters + tuple(extra), self.tension_model,
+                        use_damping=self.use_damping, check=False)
+        x_joint = np.concatenate([np.asarray(x, float), [q.start for q in extra]])
+        J = joint.jacobian(x_joint)[:, len(self.parameters):]
+        return J * np.array([n.width for n in self.nuisance])
 
     def chi2(self, X) -> np.ndarray:
         """χ² at the rows of ``X`` (inf where the model is undefined)."""

@@ -133,6 +133,10 @@ class IdentificationResult(Result):
         The contour method's grids, surfaces and region (for figures).
     settings : Settings
         How the identification was run (tension model, scale rule).
+    uncertainty_sources : dict
+        With tolerances propagated (:mod:`~stcs_ident.identify.nuisance`): ``frequencies`` and
+        ``tolerances``, the two shares of each standard deviation (variable units; their squares add up to
+        the variance), and ``held`` ({parameter held fixed: its tolerance as stated}); else empty.
     """
 
     method: str
@@ -150,6 +154,7 @@ class IdentificationResult(Result):
     alternatives: tuple[np.ndarray, ...] = ()
     sweep: object | None = field(default=None, repr=False)
     settings: Settings = field(default_factory=Settings)
+    uncertainty_sources: dict = field(default_factory=dict)
 
     main_table = "parameters"
 
@@ -251,6 +256,8 @@ class IdentificationResult(Result):
         ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
         ``reduced_chi2``, ``covariance_scale``, ``rms_error_before``,
         ``rms_error_after`` (%), ``notes`` (as sentences), ``skipped``, ``alternatives``, ``settings``,
+        ``uncertainty_sources`` (with tolerances propagated: each σ's share from the frequencies and from the
+        tolerances of the values held fixed, in variable units, and those tolerances),
         and per test ``uncertainty``, ``uncertainty_source`` and ``reference``
         (frequencies computed by others, e.g. the paper's corrected values).
         """
@@ -284,6 +291,12 @@ class IdentificationResult(Result):
             "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
             "settings": self.settings.summary(),
         }
+        if self.uncertainty_sources:
+            out["uncertainty_sources"] = {
+                "frequencies": _nest(self.parameters, self.uncertainty_sources["frequencies"], by="key"),
+                "tolerances": _nest(self.parameters, self.uncertainty_sources["tolerances"], by="key"),
+                "held": dict(self.uncertainty_sources["held"]),
+            }
         return out
 
     @property

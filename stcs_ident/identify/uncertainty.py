@@ -48,7 +48,7 @@ class IdentifiabilityWarning(StcsWarning):
         self.parameters = tuple(parameters)
 
 
-def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, Note | None]:
+def covariance_scale(chi2: float, dof: int, rule: str = "auto", *, tolerances: bool = False) -> tuple[float, Note | None]:
     """Factor for the covariance and a note saying why it is applied.
 
     The note is ``no_degrees_of_freedom`` or ``covariance_scaled`` (its
@@ -61,17 +61,23 @@ def covariance_scale(chi2: float, dof: int, rule: str = "auto") -> tuple[float, 
     rule : {"auto", "birge", "never"}
         ``auto``: scale by χ²/dof when χ² exceeds its 95 % quantile;
         ``birge``: whenever χ²/dof > 1; ``never``.
+    tolerances : bool
+        Whether the tolerances of parameters held fixed are in the uncertainties too (said in the notes: the
+        scale then applies to the frequencies' share alone).
     """
     if rule not in SCALE_RULES:
         raise ValueError(f"scale rule must be one of {SCALE_RULES}, got {rule!r}")
     if dof <= 0:
-        return 1.0, Note.make("no_degrees_of_freedom", "no degrees of freedom left: the uncertainties rest on the "
-                                                       "stated frequency uncertainties alone")
+        rest = ("the stated frequency uncertainties and the tolerances of the parameters held fixed" if tolerances
+                else "the stated frequency uncertainties alone")
+        return 1.0, Note.make("no_degrees_of_freedom", "no degrees of freedom left: the uncertainties rest on "
+                              + rest)
     reduced = chi2 / dof
     significant = chi2 > stats.chi2.ppf(0.95, dof)
     if rule == "never" or reduced <= 1 or (rule == "auto" and not significant):
         return 1.0, None
-    return reduced, Note.make("covariance_scaled", SCALED, value=float(reduced), misfit=float(np.sqrt(reduced)),
+    template = SCALED.replace("the covariance is", "the frequencies' share of the covariance is") if tolerances else SCALED
+    return reduced, Note.make("covariance_scaled", template, value=float(reduced), misfit=float(np.sqrt(reduced)),
                               dof=int(dof))
 
 
@@ -118,6 +124,15 @@ def covariance(J: np.ndarray, scale: float = 1.0, typical: np.ndarray | None = N
         corr = cov / np.outer(d, d)
     np.fill_diagonal(corr, 1.0)
     return cov, corr
+
+
+def correlation(cov: np.ndarray) -> np.ndarray:
+    """The correlation matrix of a covariance (NaN where a variance is infinite or zero; 1 on the diagonal)."""
+    d = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(d, d)
+    np.fill_diagonal(corr, 1.0)
+    return corr
 
 
 def identifiability(J: np.ndarray, names: Sequence[str], corr: np.ndarray, sigma: np.ndarray,

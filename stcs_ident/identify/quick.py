@@ -1,0 +1,489 @@
+"""The quick answer: a cable's tension from a length, a mass and one or more frequencies, no campaign file.
+
+:func:`quick_tension` puts side by side, each with its 1σ:
+
+- ``taut_string``: T = 4 m l² f_n² / n² (the vibrating string; ignores bending and sag; with EI given,
+  left out when its bending bias exceeds :data:`TAUT_MAX_BIAS`);
+- ``beam``: the tensioned-beam formulas the exact solver is checked against
+  (:mod:`stcs_ident.forward.reference`), inverted for the tension, when EI is given:
+  pinned ends exactly, clamped ends by the large-ξ expansion;
+- ``zui1996`` and ``mehrabi1998``: the practical formulas of Zui, Shinke & Namita (1996) and of
+  Mehrabi & Tabatabai (1998). Their coefficients could not be read in any source available when this
+  module was written, and they are not reconstructed from memory: both keys say so in their ``note``
+  and give ``tension`` None (see :data:`UNSOURCED`);
+- ``exact``: the exact dynamic-stiffness model (sag-extensibility with EA, inclination, the chosen
+  ends), fitted by :func:`stcs_ident.identify.api.identify` to the frequencies: the tension alone when
+  EI is given (or with one frequency, where EI is taken as 0), the tension and EI with two modes or more
+  and no EI.
+
+Uncertainty: every formula's σ is the frequency σ propagated through dT/df (first order); with several
+modes the per-mode estimates are averaged and the σ of the mean combines that propagation with their
+scatter, σ² = σ_prop² + s²/k (s the sample standard deviation of the k estimates): a spread larger than
+the frequencies explain (a taut-string tension rising with the mode, from bending) then shows in the σ.
+The exact model's σ is the fit's covariance (scaled by the reduced χ² when the misfit is significant,
+as ``identify`` does).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..core import kinds
+from ..core.errors import ComputationError, InputError
+from ..core.model import finite_number, frequency, in_band, mode_number
+from ..core.notes import Note
+from ..core.result import Result
+from .problem import printed_step
+
+BOUNDARIES = ("clamped", "pinned")
+
+#: Where each method comes from (shown in the JSON and in docs/tension.md).
+SOURCES = {
+    "taut_string": "taut string, f_n = (n / 2l) sqrt(T/m) (the vibrating string); "
+                   "stcs_ident.forward.reference.taut_string",
+    "beam": "tensioned beam: pinned ends f_n = f_n^string sqrt(1 + n^2 pi^2 EI / (T l^2)) (exact); clamped ends "
+            "f_n = f_n^string (1 + 2/xi + (4 + n^2 pi^2 / 2) / xi^2), xi = l sqrt(T/EI) (large-xi expansion); "
+            "stcs_ident.forward.reference.beam_pinned and beam_clamped_asymptotic",
+    "zui1996": "Zui, H., Shinke, T., Namita, Y. (1996). Practical formulas for estimation of cable tension by "
+               "vibration method. J. Struct. Eng. (ASCE) 122(6), 651-656.",
+    "mehrabi1998": "Mehrabi, A. B., Tabatabai, H. (1998). Unified finite difference formulation for free vibration "
+                   "of cables. J. Struct. Eng. (ASCE) 124(11), 1313-1322.",
+    "exact": "exact dynamic stiffness of a tensioned, sagging beam (docs/model.md), fitted by identify()",
+}
+
+#: The practical formulas left out, and why (the key stays in the result, tension None, with this note).
+UNSOURCED = {
+    name: ("not implemented: the formula's coefficients could not be read in the paper or in a source quoting "
+           "it when this was written, and are not reconstructed from memory; use 'exact' (or 'beam' with EI)")
+    for name in ("zui1996", "mehrabi1998")
+}
+
+#: With EI given, the taut string is left out (tension None) when its leading bias from bending exceeds this:
+#: 4/ξ with clamped ends (ξ < 20), n²π²/ξ² with pinned ends.
+TAUT_MAX_BIAS = 0.2
+
+#: The clamped-end expansion is used for a mode n when ξ ≥ max(CLAMPED_MIN_XI, CLAMPED_XI_PER_MODE · n):
+#: there its tension is within 1.5 % of the exact clamped beam's (tests/test_tension.py checks it).
+CLAMPED_MIN_XI = 20.0
+CLAMPED_XI_PER_MODE = 6.0
+
+
+# ---- the formulas, each inverted for the tension (N); arrays broadcast ---------------------------------------
+
+def taut_string_tension(length, mass_per_length, frequencies, modes):
+    """Taut string: T = 4 m l² f_n² / n² (inverse of f_n = (n / 2l) √(T/m))."""
+    f, n = np.asarray(frequencies, float), np.asarray(modes, float)
+    return 4.0 * mass_per_length * length**2 * f**2 / n**2
+
+
+def pinned_beam_tension(length, mass_per_length, frequencies, modes, EI):
+    """Pinned–pinned tensioned beam, exact: T = 4 m l² f_n² / n² − n² π² EI / l²
+    (inverse of f_n = f_n^string √(1 + n²π² EI/(T l²)), :func:`stcs_ident.forward.reference.beam_pinned`)."""
+    n = np.asarray(modes, float)
+    return taut_string_tension(length, mass_per_length, frequencies, modes) - n**2 * math.pi**2 * EI / length**2
+
+
+def clamped_beam_frequency(length, mass_per_length, tension, EI, mode):
+    """Clamped tensioned beam for large ξ = l √(T/EI): f_n ≈ (n / 2l) √(T/m) (1 + 2/ξ + (4 + n²π²/2)/ξ²)
+    (:func:`stcs_ident.forward.reference.beam_clamped_asymptotic`, one mode, scalar)."""
+    xi = length * math.sqrt(tension / EI)
+    return mode / (2 * length) * math.sqrt(tension / mass_per_length) * (
+        1 + 2 / xi + (4 + mode * mode * math.pi**2 / 2) / xi**2)
+
+
+def clamped_beam_tension(length, mass_per_length, frequency_hz, mode, EI):
+    """Tension of a clamped tensioned beam from one frequency, by inverting :func:`clamped_beam_frequency`.
+
+    The expansion grows with T only where ξ² > 4 + n²π²/2; the root is sought there. Returns NaN when
+    the frequency is below that branch (a beam too stiff for the expansion).
+    """
+    from scipy.optimize import brentq
+
+    c = 4 + mode * mode * math.pi**2 / 2
+    lo = c * EI / length**2 * (1 + 1e-12)
+
+    def g(t):
+        return clamped_beam_frequency(length, mass_per_length, t, EI, mode) - frequency_hz
+
+    if g(lo) >= 0:
+        return math.nan
+    hi = max(2 * lo, float(taut_string_tension(length, mass_per_length, frequency_hz, mode)))
+    while g(hi) < 0:
+        hi *= 2
+    return brentq(g, lo, hi, xtol=1e-300, rtol=1e-14)
+
+
+# ---- results ------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class MethodEstimate:
+    """One method's tension.
+
+    Attributes
+    ----------
+    name : str
+        ``taut_string``, ``beam``, ``zui1996``, ``mehrabi1998`` or ``exact``.
+    tension, uncertainty : float or None
+        N and its 1σ; None when the method does not apply (``note`` says why).
+    note : str or None
+        Why the tension is None, or what to know about it.
+    source : str
+        Where the formula comes from.
+    per_mode : tuple of float
+        The formulas' estimate from each mode (N), NaN where a mode is outside the formula's range.
+    extra : dict
+        More, by method: ``EI``, ``EI_uncertainty``, ``EI_source`` (exact), ``scatter`` (N), ``formula``.
+    failed : bool
+        The computation failed (exact model); the command line then exits with status 1.
+    """
+
+    name: str
+    tension: float | None
+    uncertainty: float | None
+    note: str | None
+    source: str
+    per_mode: tuple[float, ...] = ()
+    extra: dict = field(default_factory=dict)
+    failed: bool = False
+
+    def to_dict(self) -> dict:
+        out = {"tension": _num(self.tension), "uncertainty": _num(self.uncertainty)}
+        if self.name == "exact":
+            out["EI"] = _num(self.extra.get("EI"))
+        if self.note:
+            out["note"] = self.note
+        out["source"] = self.source
+        if self.per_mode:
+            out["per_mode"] = [_num(t) for t in self.per_mode]
+        out.update({k: _num(v) if isinstance(v, float) else v for k, v in self.extra.items() if k != "EI"})
+        return out
+
+
+@dataclass(frozen=True, repr=False)
+class QuickTensionResult(Result):
+    """The tension by each method, side by side (:func:`quick_tension`).
+
+    Attributes
+    ----------
+    inputs : dict
+        What was given, in SI units (inclination in degrees), with the frequency σ used and its source.
+    methods : dict of str to MethodEstimate
+        In the order ``taut_string``, ``beam``, ``zui1996``, ``mehrabi1998``, ``exact``.
+    notes : tuple of Note
+    """
+
+    inputs: dict
+    methods: dict
+    notes: tuple[Note, ...] = ()
+
+    main_table = "methods"
+
+    @property
+    def settings(self):
+        return None
+
+    def tension(self, method: str = "exact") -> tuple[float | None, float | None]:
+        """(tension N, 1σ N) of ``method``."""
+        m = self.methods[method]
+        return m.tension, m.uncertainty
+
+    def summary(self) -> dict:
+        """``{"inputs": {...}, "methods": {name: {"tension", "uncertainty", ...}}}`` (docs/formats.md)."""
+        return {"inputs": dict(self.inputs), "methods": {k: m.to_dict() for k, m in self.methods.items()},
+                "notes": [str(n) for n in self.notes]}
+
+    to_dict = summary
+
+    def tables(self):
+        import pandas as pd
+
+        rows = [{"method": k, "tension_N": m.tension, "uncertainty_N": m.uncertainty, "note": m.note or ""}
+                for k, m in self.methods.items()]
+        return {"methods": pd.DataFrame(rows, columns=["method", "tension_N", "uncertainty_N", "note"])}
+
+    def headline(self) -> str:
+        shown = [f"{k} {m.tension / 1e3:.5g} ± {m.uncertainty / 1e3:.2g} kN" for k, m in self.methods.items()
+                 if m.tension is not None and m.uncertainty is not None]
+        k = len(self.inputs["frequencies"])
+        return f"{k} frequenc{'ies' if k != 1 else 'y'}; " + "; ".join(shown)
+
+
+def _num(x):
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+# ---- the quick answer ---------------------------------------------------------------------------------------
+
+def rounding_uncertainty(texts: Sequence[str]) -> tuple[float, str]:
+    """σ of frequencies as printed (``"1.230"`` has 3 decimals): the step / √12, and its description."""
+    decimals = 0
+    for text in texts:
+        text = text.strip().lower()
+        mantissa, _, exponent = text.partition("e")
+        digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
+        decimals = max(decimals, digits - (int(exponent) if exponent else 0))
+    step = 10.0 ** (-decimals)
+    return step / math.sqrt(12), f"rounding of the printed frequencies ({step:g} Hz / sqrt 12)"
+
+
+def _check(length, mass, frequencies, modes, EI, EA, inclination, boundary, uncertainty):
+    length = in_band(length, "length", "length")
+    mass = in_band(mass, "mass", "mass_per_length")
+    if isinstance(frequencies, (str, bytes)) or not isinstance(frequencies, Sequence | np.ndarray):
+        raise InputError(f"must be a list of frequencies (Hz), got {frequencies!r}", field="frequencies")
+    freqs = np.array([frequency(f, "frequencies") for f in frequencies])
+    if freqs.size == 0:
+        raise InputError("needs at least one frequency", field="frequencies")
+    modes = np.arange(1, freqs.size + 1) if modes is None else np.array([mode_number(int(k) if isinstance(k, np.integer) else k, "modes") for k in modes])
+    if modes.size != freqs.size:
+        raise InputError(f"has {modes.size} mode numbers but there are {freqs.size} frequencies", field="modes")
+    if np.unique(modes).size != modes.size:
+        raise InputError("mode numbers must be distinct", field="modes")
+    EI = None if EI is None else in_band(EI, "EI", "EI", zero=True)
+    EA = None if EA is None else in_band(EA, "EA", "EA")
+    inclination = finite_number(inclination, "inclination")
+    if abs(inclination) >= 90:
+        raise InputError(f"must be between -90 and 90 degrees, got {inclination:g}", field="inclination")
+    if boundary not in BOUNDARIES:
+        raise InputError(f"must be one of {', '.join(BOUNDARIES)}, got {boundary!r}", field="boundary")
+    if uncertainty is not None:
+        u = np.atleast_1d(np.array([finite_number(x, "uncertainty") for x in np.atleast_1d(uncertainty)]))
+        if u.size == 1:
+            u = np.full(freqs.size, u[0])
+        if u.size != freqs.size:
+            raise InputError(f"has {u.size} values but there are {freqs.size} frequencies (give one for all, "
+                             "or one per frequency)", field="uncertainty")
+        if np.any(u <= 0) or np.any(u >= freqs):
+            raise InputError("must be > 0 Hz and below its frequency", field="uncertainty")
+        uncertainty = u
+    order = np.argsort(modes)
+    return (length, mass, freqs[order], modes[order], EI, EA, inclination, boundary,
+            None if uncertainty is None else uncertainty[order])
+
+
+def _mean(per_mode: np.ndarray, sigma: np.ndarray) -> tuple[float, float, float | None]:
+    """Mean of the finite per-mode estimates, its σ (propagation ⊕ scatter / √k) and the scatter s."""
+    ok = np.isfinite(per_mode)
+    t, s = per_mode[ok], sigma[ok]
+    k = t.size
+    prop = math.sqrt(float(np.sum(s**2))) / k
+    if k < 2:
+        return float(t[0]), prop, None
+    scatter = float(np.std(t, ddof=1))
+    return float(np.mean(t)), math.sqrt(prop**2 + scatter**2 / k), scatter
+
+
+def _taut(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
+    per = taut_string_tension(length, mass, freqs, modes)
+    t, u, scatter = _mean(per, 2 * per * sigma / freqs)
+    extra = {"formula": "T = 4 m l^2 f_n^2 / n^2"}
+    if scatter is not None:
+        extra["scatter"] = scatter
+    note = None
+    if EI:
+        # the leading bias in tension (T goes as f²) of the lowest mode given: 2 × 2/ξ from clamped ends,
+        # n²π²/ξ² from the bending of a pinned beam
+        xi = length * math.sqrt(t / EI)
+        n = float(modes[0])
+        bias = 4 / xi if boundary == "clamped" else n * n * math.pi**2 / xi**2
+        extra["xi"], extra["estimated_bias"] = xi, bias
+        if bias > TAUT_MAX_BIAS:
+            return MethodEstimate("taut_string", None, None,
+                                  f"bending dominates: with the given EI, xi = l sqrt(T/EI) = {xi:.3g} and the taut "
+                                  f"string would be about {100 * bias:.2g} % high (limit {100 * TAUT_MAX_BIAS:g} %)",
+                                  SOURCES["taut_string"], tuple(map(float, per)), extra)
+        cause = "4/xi, the clamped ends" if boundary == "clamped" else f"n^2 pi^2/xi^2 at mode {n:g}"
+        note = (f"ignores bending: with the given EI, xi = l sqrt(T/EI) = {xi:.3g}, and it is about "
+                f"{100 * bias:.2g} % high from bending alone ({cause})")
+    return MethodEstimate("taut_string", t, u, note, SOURCES["taut_string"], tuple(map(float, per)), extra)
+
+
+def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
+    if not EI:
+        return MethodEstimate("beam", None, None, "needs the bending stiffness (--EI, > 0)", SOURCES["beam"])
+    if boundary == "pinned":
+        per = pinned_beam_tension(length, mass, freqs, modes, EI)
+        per = np.where(per > 0, per, np.nan)
+        dTdf = 8 * mass * length**2 * freqs / modes**2
+        formula, why = "T = 4 m l^2 f_n^2 / n^2 - n^2 pi^2 EI / l^2 (pinned ends, exact)", "T <= 0"
+    else:
+        per, dTdf = np.full(freqs.size, np.nan), np.full(freqs.size, np.nan)
+        for i, (f, n) in enumerate(zip(freqs, modes)):
+            t = clamped_beam_tension(length, mass, f, int(n), EI)
+            if math.isfinite(t) and length * math.sqrt(t / EI) >= max(CLAMPED_MIN_XI, CLAMPED_XI_PER_MODE * n):
+                h = 1e-6 * t
+                dfdT = (clamped_beam_frequency(length, mass, t + h, EI, int(n))
+                        - clamped_beam_frequency(length, mass, t - h, EI, int(n))) / (2 * h)
+                per[i], dTdf[i] = t, 1 / dfdT
+        formula = "inverse of f_n = (n/2l) sqrt(T/m) (1 + 2/xi + (4 + n^2 pi^2/2)/xi^2) (clamped ends, large xi)"
+        why = f"xi below max({CLAMPED_MIN_XI:g}, {CLAMPED_XI_PER_MODE:g} n)"
+    if not np.any(np.isfinite(per)):
+        return MethodEstimate("beam", None, None, f"outside the formula's range for every mode ({why})",
+                              SOURCES["beam"], tuple(map(float, per)), {"formula": formula})
+    t, u, scatter = _mean(per, np.abs(dTdf) * sigma)
+    note = None
+    if not np.all(np.isfinite(per)):
+        note = f"modes {', '.join(str(int(n)) for n in modes[~np.isfinite(per)])} left out ({why})"
+    extra = {"formula": formula, "xi": length * math.sqrt(t / EI)}
+    if scatter is not None:
+        extra["scatter"] = scatter
+    return MethodEstimate("beam", t, u, note, SOURCES["beam"], tuple(map(float, per)), extra)
+
+
+def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, tolerance) -> MethodEstimate:
+    """A formula's estimate with the tolerances of the length and of a given EI in its σ (first order, by
+    the formula's own change for a relative step of each: docs/uncertainty.md)."""
+    estimate = method(length, mass, freqs, modes, sigma, EI, boundary)
+    if estimate.tension is None:
+        return estimate
+    step, shares = 1e-6, {}
+    for key, value in (("length", length), ("EI", EI)):
+        if not value or not tolerance[key]:
+            continue
+        moved = {"length": length, "EI": EI}
+        moved[key] = value * (1 + step)
+        other = method(moved["length"], mass, freqs, modes, sigma, moved["EI"], boundary).tension
+        if other is not None:
+            shares[key] = abs(other - estimate.tension) / step * tolerance[key]
+    if not shares:
+        return estimate
+    extra = {**estimate.extra, "uncertainty_from_tolerances": shares}
+    return replace(estimate, uncertainty=math.hypot(estimate.uncertainty, *shares.values()), extra=extra)
+
+
+def _EI_start(length, mass, freqs, modes, tension) -> float:
+    """A start for EI: the slope of (f_n/n)² against n² is π² EI/(4 m l⁴) on a pinned beam; where that slope is
+    not positive, EI for ξ = 100."""
+    slope = np.polyfit(modes.astype(float) ** 2, (freqs / modes) ** 2, 1)[0]
+    guess = 4 * mass * length**4 * slope / math.pi**2
+    fallback = tension * length**2 / 100.0**2
+    return float(guess) if guess > 0 and math.isfinite(guess) else fallback
+
+
+def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance) -> MethodEstimate:
+    from ..core.model import Boundary, Cable, Campaign, Setup, Test
+    from .api import identify
+
+    fit_EI = EI is None and freqs.size >= 2
+    EI_nominal = EI if EI is not None else (_EI_start(length, mass, freqs, modes, start) if fit_EI else 0.0)
+    end = Boundary.clamped() if boundary == "clamped" else Boundary.pinned()
+    cable = Cable(length, mass, EI_nominal, EA, math.radians(inclination), boundary_a=end, boundary_b=end)
+    test = Test("quick", "quick", start, tuple(map(float, freqs)), tuple(map(int, modes)),
+                uncertainty=tuple(map(float, sigma)))
+    campaign = Campaign("quick-tension", cable, (Setup("quick"),), (test,), tolerance=tuple(tolerance.items()))
+    params = "tension,EI" if fit_EI else "tension"
+    bounds = {"tension": (0.05, 2.0), **({"EI": (1e-3, 1e3)} if fit_EI else {})}
+    source = SOURCES["exact"]
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = identify(campaign, params=params, bounds=bounds)
+        t, u = result.value("tension")
+    except (ComputationError, InputError, FloatingPointError, ArithmeticError) as err:
+        return MethodEstimate("exact", None, None, f"the exact model's fit failed: {err}", source,
+                              failed=isinstance(err, (ComputationError, FloatingPointError, ArithmeticError)))
+    said = [str(n) for n in result.notes] + [str(w.message) for w in caught]
+    extra: dict = {"EI": None, "EI_uncertainty": None}
+    if fit_EI:
+        extra["EI"], extra["EI_uncertainty"] = result.value("EI")
+        extra["EI_source"] = "fitted with the tension (two modes or more, no --EI)"
+    elif EI is not None:
+        extra["EI"], extra["EI_source"] = EI, "given"
+    else:
+        extra["EI_source"] = "taken as 0 (one frequency and no --EI: a string)"
+    if result.uncertainty_sources:  # the tension's σ from the frequencies and from the tolerances held, N
+        i = next(i for i, q in enumerate(result.parameters) if q.kind == "tension")
+        q, x = result.parameters[i], float(result.estimate[i])
+        extra["uncertainty_from_frequencies"] = q.value_uncertainty(x, result.uncertainty_sources["frequencies"][i])
+        extra["uncertainty_from_tolerances"] = q.value_uncertainty(x, result.uncertainty_sources["tolerances"][i])
+        extra["tolerances_held"] = dict(result.uncertainty_sources["held"])
+    extra["reduced_chi2"] = _num(result.reduced_chi2)
+    extra["covariance_scale"] = float(result.covariance_scale)
+    extra["fitted"] = params
+    return MethodEstimate("exact", t, u, "; ".join(dict.fromkeys(said)) or None, source, (), extra)
+
+
+def quick_tension(length: float, mass: float, frequencies: Sequence[float], modes: Sequence[int] | None = None,
+                  EI: float | None = None, EA: float | None = None, inclination: float = 0.0,
+                  boundary: str = "clamped", uncertainty: float | Sequence[float] | None = None, *,
+                  uncertainty_source: str | None = None, EI_tolerance: float | None = None,
+                  length_tolerance: float | None = None) -> QuickTensionResult:
+    """A cable's tension from its length, mass and measured frequencies, by several methods side by side.
+
+    Parameters
+    ----------
+    length : float
+        Chord length between the anchorages, m.
+    mass : float
+        Mass per unit length, kg/m.
+    frequencies : sequence of float
+        Measured natural frequencies, Hz.
+    modes : sequence of int, optional
+        Their mode numbers (default 1, 2, ...).
+    EI : float, optional
+        Bending stiffness, N m². Given: the exact model fits the tension alone. Not given: with one
+        frequency EI is taken as 0; with two modes or more it is fitted with the tension.
+    EA : float, optional
+        Axial stiffness, N (sag-extensibility in the exact model); None ignores it.
+    inclination : float
+        Chord angle from horizontal, degrees.
+    boundary : {"clamped", "pinned"}
+        Both anchorages.
+    uncertainty : float or sequence of float, optional
+        1σ of the frequencies, Hz (one for all or one each). Default: the rounding of the frequencies as
+        printed (step / √12).
+    uncertainty_source : str, optional
+        How ``uncertainty`` was obtained, recorded in ``inputs`` (the command line says "rounding of the
+        printed frequencies" when it derived it from the typed text).
+    EI_tolerance, length_tolerance : float, optional
+        Relative 1σ of a given EI and of the length (default: a campaign's defaults, 30 % and 0.2 %). The
+        exact model's σ includes them where the value is held fixed (docs/uncertainty.md); 0 says exact.
+
+    Returns
+    -------
+    QuickTensionResult
+        ``.methods[name].tension`` / ``.uncertainty`` (N), ``.summary()`` (= ``.to_dict()``) the JSON of
+        ``stcs-ident tension``.
+
+    Raises
+    ------
+    InputError
+        Naming the argument (``length``, ``mass``, ``frequencies``, ``modes``, ``EI``, ``EA``,
+        ``inclination``, ``boundary``, ``uncertainty``).
+    """
+    length, mass, freqs, modes, EI, EA, inclination, boundary, sigma = _check(
+        length, mass, frequencies, modes, EI, EA, inclination, boundary, uncertainty)
+    if sigma is None:
+        step = printed_step(freqs)
+        sigma = np.full(freqs.size, step / math.sqrt(12))
+        uncertainty_source = uncertainty_source or f"rounding of the frequencies as printed ({step:g} Hz / sqrt 12)"
+        if np.any(sigma >= freqs):
+            raise InputError("the rounding of the frequencies is as large as a frequency: give --uncertainty",
+                             field="uncertainty")
+    tolerance = {}
+    for key, value in (("EI", EI_tolerance), ("length", length_tolerance)):
+        if value is not None:
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError(f"must be a finite number >= 0, got {value!r}", field=f"{key}_tolerance")
+            tolerance[key] = float(value)
+    inputs = {"length": length, "mass": mass, "frequencies": freqs.tolist(), "modes": modes.tolist(), "EI": EI,
+              "EA": EA, "inclination": inclination, "boundary": boundary, "uncertainty": sigma.tolist(),
+              "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance}
+    held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "EI")}
+    taut = _with_tolerances(_taut, length, mass, freqs, modes, sigma, EI, boundary, held)
+    methods = {
+        "taut_string": taut,
+        "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
+        **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
+        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
+                        float(np.mean(taut.per_mode)), tolerance),
+    }
+    return QuickTensionResult(inputs, methods)
