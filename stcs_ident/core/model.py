@@ -489,10 +489,15 @@ class Campaign:
     #: Tolerances the campaign gives (``[tolerance]``): (key, value) pairs, sorted by key; a key not
     #: given takes its effect's default (:func:`stcs_ident.effects.tolerance`).
     tolerance: tuple[tuple[str, float], ...] = ()
+    #: Default bounds of the identification's variables (``[bounds]``): (kind, (lower, upper)) pairs, sorted
+    #: by kind, in the variable's units (a ratio to nominal; the kind's SI unit when the nominal value is 0;
+    #: the fixity of an end). A kind not given keeps its registered bounds (:mod:`stcs_ident.core.kinds`).
+    bounds: tuple[tuple[str, tuple[float, float]], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="campaign.name")
+        object.__setattr__(self, "bounds", _checked_bounds(self.bounds))
         object.__setattr__(self, "published", tuple(self.published))
         given = dict(self.tolerance)
         if len(given) != len(tuple(self.tolerance)):
@@ -525,6 +530,25 @@ class Campaign:
             if t.name == name:
                 return t
         raise KeyError(name)
+
+
+def _checked_bounds(bounds) -> tuple[tuple[str, tuple[float, float]], ...]:
+    """``Campaign.bounds`` as sorted (kind, (lower, upper)) pairs of finite increasing numbers."""
+    pairs = list(bounds.items()) if isinstance(bounds, dict) else list(bounds)
+    out: dict[str, tuple[float, float]] = {}
+    for key, given in pairs:
+        field = f"bounds.{key}"
+        if key in out:
+            raise ModelError("a key is given twice", field="bounds")
+        if isinstance(given, (str, bytes)) or not hasattr(given, "__len__") or len(given) != 2:
+            raise ModelError(f"must be two numbers [lower, upper], got {given!r}", field=field)
+        lo, hi = (finite_number(v, field) for v in given)
+        if not lo < hi:
+            raise ModelError(f"must satisfy lower < upper, got [{lo:g}, {hi:g}]", field=field)
+        if lo < 0:
+            raise ModelError(f"the lower bound must be >= 0, got {lo:g}", field=field)
+        out[key] = (lo, hi)
+    return tuple(sorted(out.items()))
 
 
 def _unique(names: Iterable[str], kind: str) -> None:

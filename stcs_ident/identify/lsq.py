@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 
 from ..core.notes import Note, point
 from ..core.settings import Settings
+from .bounds import bound_failure
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import covariance, covariance_scale, identifiability, warn_identifiability
@@ -107,12 +108,10 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     typical = problem.typical(x)
     cov, corr = covariance(J, scale, typical)
     sigma = np.sqrt(np.diag(cov))
-    span = problem.upper - problem.lower
-    at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
-                if min(v - lo, hi - v) <= 1e-9 * w]
-    if at_bound:
-        notes.append(Note.make("at_bound", "at a bound (the standard deviation there is only indicative): "
-                               "{parameters}", parameters=at_bound))
+    failure, at_limit = bound_failure(problem.parameters, x, problem.lower, problem.upper)
+    if at_limit:
+        notes.append(Note.make("at_bound", "at a physical limit (the standard deviation there is only "
+                               "indicative): {parameters}", parameters=at_limit))
     notes += warn_identifiability(identifiability(J, problem.names, corr, sigma, problem.lower, problem.upper,
                                                   typical),
                                   stacklevel=4)
@@ -127,13 +126,14 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
                      for label, values in m.test.reference}
         tests.append(TestFit(m.name, m.test.setup, tuple(int(v) for v in m.modes), m.frequencies, m.uncertainty,
                              m.source, before[sl], after[sl], reference, damping[i]))
-    return IdentificationResult(
+    result = IdentificationResult(
         method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
         uncertainty=sigma if uncertainty is None else np.asarray(uncertainty, float),
         covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
         covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
         settings=settings,
     )
+    return result if failure is None else result.failed(failure)
 
 
 def local_fit(problem: Problem, x0: np.ndarray, max_nfev: int, tol: float = 1e-14) -> tuple[np.ndarray, float]:

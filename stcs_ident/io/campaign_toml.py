@@ -55,6 +55,8 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
         data["published"] = [_published_table(item) for item in campaign.published]
     if campaign.tolerance:
         data["tolerance"] = {key: float(value) for key, value in campaign.tolerance}
+    if campaign.bounds:
+        data["bounds"] = {key: [float(lo), float(hi)] for key, (lo, hi) in campaign.bounds}
     return data
 
 
