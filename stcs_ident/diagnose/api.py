@@ -117,8 +117,6 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     given = dict(picked or {})
     picked, excluded = _without_doubtful(campaign, given)
     measurements, skipped = gather_measurements(campaign, tests, picked)
-    if check_plausibility:
-        plausible(campaign, measurements, settings.tension_model)
     measured_tests = [m.test for m in measurements]
     notes: list[Note] = list(excluded)
     usable = []
@@ -130,6 +128,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             raise InputError(why, field="effects")
         else:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
+    if check_plausibility:  # after the options' checks (an unknown or inapplicable effect is named first)
+        plausible(campaign, measurements, settings.tension_model)
     # The damping ratios are data, for the nominal model and every hypothesis alike, where a damper is in
     # question: a recorded damper, or a missing one asked for.
     with_damping = (any(has_dampers(campaign.setup(m.test.setup).attachments) for m in measurements)

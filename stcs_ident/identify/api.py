@@ -91,15 +91,15 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
     measurements, skipped = gather_measurements(campaign, tests, picked)
-    if check_plausibility:
-        from .plausibility import check_plausibility as check
-
-        check(campaign, measurements, tension_model)
     held = None
     if params is None:
         params, held = default_params(measurements)
     parameters = parse_parameters(campaign, [m.test for m in measurements], params, bounds)
     settings = Settings(tension_model=tension_model, scale_rule=scale_rule)
+    if check_plausibility:  # after the options' checks: a bad --params is named before the data are judged
+        from .plausibility import check_plausibility as check
+
+        check(campaign, measurements, settings.tension_model)
     problem = Problem(campaign, measurements, parameters, settings.tension_model)
     if method == "lsq":
         from .lsq import fit_lsq

@@ -26,6 +26,8 @@ from ..core.parameters import Parameter
 
 #: An estimate within this fraction of the bounds' span from a bound is at it.
 AT_BOUND = 1e-9
+#: How a failed fit's reason starts (the diagnosis tells bound failures from errors by it).
+FAILURE_HEAD = "the fit stopped at a bound, so it is no result"
 
 
 def hits(parameters: Sequence[Parameter], x, lower, upper) -> list[tuple[Parameter, str, float, float]]:
@@ -55,10 +57,13 @@ def bound_failure(parameters: Sequence[Parameter], x, lower, upper) -> tuple[Not
         if physical_limit(p, side, bound):
             limits.append(p.name)
         elif failure is None:
+            if p.is_ratio:
+                what = f"ratio to nominal, {float(p.to_value(bound)):.4g} {p.unit}"
+            else:
+                what = "fixity" if p.is_fixity else p.unit
             failure = Note.make(
-                "fit_at_bound", "the fit stopped at a bound, so it is no result: {parameter} = {bound:.6g} is its "
-                "{side} bound ({unit_word}); widen the bounds (a [bounds] table in the campaign) if the value "
+                "fit_at_bound", FAILURE_HEAD + ": {parameter} = {bound:.6g} is its "
+                "{side} bound ({what}); widen the bounds (a [bounds] table in the campaign) if the value "
                 "is plausible, or check the nominal values", parameters=[p.name], value=bound, side=side,
-                bound=bound, unit_word="ratio to nominal" if p.is_ratio else
-                ("fixity" if p.is_fixity else p.unit))
+                bound=bound, what=what)
     return failure, limits

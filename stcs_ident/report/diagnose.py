@@ -71,9 +71,10 @@ def baseline_label(diagnosis) -> str:
     base = diagnosis.baseline
     if base is None:
         return "none"
-    words = {"tension": "tension",
-             "bending_stiffness": "EI absolute" if diagnosis.campaign.cable.EI <= 0 else "EI"}
-    return ", ".join(words.get(e, e) for e in base.effects)
+    from ..effects import registry
+
+    words = {"tension": "tension", "EI": "EI absolute" if diagnosis.campaign.cable.EI <= 0 else "EI"}
+    return ", ".join(words.get(registry.get(e).parameter_kind, e) for e in base.effects)
 
 
 def _file_stem(name: str) -> str:
