@@ -223,3 +223,30 @@ def test_bare_cable_diagnose_says_EI_is_absolute():
     assert any(n.kind == "EI_absolute" for n in d.notes)
     text = diagnosis_text(d)
     assert "absolute" in text and "baseline (tension, EI)" not in text
+
+
+@pytest.mark.parametrize("method", ["lsq", "contour"])
+def test_both_methods_fail_at_a_campaign_bound(method):
+    import warnings
+
+    # han2020's case1-L4 wants EI about 0.5 × nominal: campaign bounds [0.9, 1.1] exclude it
+    campaign = replace(load_campaign(HAN), bounds=(("EI", (0.9, 1.1)),))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the fit at the bound also warns that EI is not identifiable there
+        with pytest.raises(BoundError) as info:
+            identify(campaign, ["case1-L4"], "tension,EI", method=method)
+    failure = info.value.result.failure
+    assert failure.parameters == ("EI_ratio",) and dict(failure.data)["side"] == "lower"
+    assert "EI_ratio = 0.9 is its lower bound" in str(info.value)
+
+
+def test_a_diagnosis_hypothesis_at_a_bound_failed_and_is_not_the_cause():
+    from stcs_ident.diagnose.fitting import fit_hypothesis
+    from stcs_ident.identify.bounds import FAILURE_HEAD
+
+    campaign = replace(load_campaign(HAN), bounds=(("EI", (0.9, 1.1)),))
+    measurements, _ = gather_measurements(campaign, ["case1-L4"])
+    fit = fit_hypothesis(campaign, measurements, ("bending_stiffness",))
+    assert fit.failure is not None and fit.failure.startswith(FAILURE_HEAD)
+    assert "EI" in fit.failure and "lower bound" in fit.failure
+    assert fit.result is None and fit.aicc == float("inf")  # ranked last, never chosen (selection.select)
