@@ -326,7 +326,8 @@ def test_joint_excess_generalises_the_one_parameter_test_and_sees_a_spread_depar
 
 
 def test_an_unmodeled_effect_must_have_a_significant_size(monkeypatch):
-    """Step 2: an amplitude without a finite σ, or within 2 σ of zero, is not a cause; one at its bound is."""
+    """Step 2: an amplitude without a finite σ, or within 2 σ of zero, is not a cause (one at its upper bound
+    never gets here: that fit failed, fitting.fit_hypothesis)."""
     from types import SimpleNamespace
 
     from stcs_ident.diagnose import selection
@@ -341,7 +342,8 @@ def test_an_unmodeled_effect_must_have_a_significant_size(monkeypatch):
     assert selection.insignificant(support(452.0, float("nan"))) == ("unmodeled_support",)
     assert selection.insignificant(support(452.0, 300.0)) == ("unmodeled_support",)
     assert selection.insignificant(support(452.0, 133.0)) == ()
-    assert selection.insignificant(support(1e6, float("nan"))) == ()  # pushed to its bound
+    # pushed to its bound without a σ: no longer counted as sized (such a final fit is a failed hypothesis)
+    assert selection.insignificant(support(1e6, float("nan"))) == ("unmodeled_support",)
 
 
 def test_an_unmodeled_effect_whose_gain_rests_on_one_frequency_is_not_chosen(monkeypatch):
