@@ -132,5 +132,4 @@ def default_params(measurements) -> tuple[str, Note | None]:
     if any(m.modes.size >= 2 for m in measurements):
         return "tension,EI", None
     return "tension", Note.make("EI_held", "EI is held at its nominal value: every test has one measured mode, "
-                                "so the data cannot carry EI beside the tensions (give --params tension,EI "
-                                "with more modes)")
+                                "as many frequencies as tensions, so the data cannot carry EI as well")
