@@ -118,7 +118,7 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if held is not None:
         result = replace(result, notes=result.notes + (held,))
     if result.failure is not None:
-        raise BoundError(f"identify failed: {result.failure}", result)
+        raise BoundError(str(result.failure), result)
     return result
 
 
