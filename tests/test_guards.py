@@ -250,3 +250,16 @@ def test_a_diagnosis_hypothesis_at_a_bound_failed_and_is_not_the_cause():
     assert fit.failure is not None and fit.failure.startswith(FAILURE_HEAD)
     assert "EI" in fit.failure and "lower bound" in fit.failure
     assert fit.result is None and fit.aicc == float("inf")  # ranked last, never chosen (selection.select)
+
+
+def test_campaign_bounds_built_in_python_are_checked_too():
+    campaign = load_campaign(HAN)
+    with pytest.raises(InputError) as info:  # a kind no parameter has
+        identify(replace(campaign, bounds=(("tensoin", (0.2, 5.0)),)), ["case1-L4"], "tension,EI")
+    assert info.value.field == "bounds.tensoin"
+    with pytest.raises(InputError) as info:  # bounds that exclude the nominal value
+        identify(replace(campaign, bounds=(("EI", (2.0, 5.0)),)), ["case1-L4"], "tension,EI")
+    assert info.value.field == "bounds.EI_ratio"
+    with pytest.raises(InputError) as info:  # not increasing: refused when the campaign is built
+        replace(campaign, bounds=(("EI", (5.0, 2.0)),))
+    assert info.value.field == "bounds.EI"

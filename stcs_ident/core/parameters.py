@@ -266,6 +266,10 @@ def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iter
         ends = {p.member for p in params if p.kind == kind}
         if "AB" in ends and len(ends) > 1:
             raise InputError(f"{kind} for both ends and for one end at once", field="params")
+    for key in dict(campaign.bounds):
+        if key not in kinds.names():
+            raise InputError(f"unknown parameter kind {key!r}; known: {', '.join(kinds.names())}",
+                             field=f"bounds.{key}")
     given = {**dict(campaign.bounds), **dict(bounds or {})}  # the keyword wins over the campaign's [bounds]
     return tuple(_with_bounds(p, given, cable.length) for p in params)
 
