@@ -48,7 +48,7 @@ _EXPORTS = {
     "IdentificationResult": "identify.result", "Diagnosis": "diagnose.result", "TrackResult": "track.result",
     # errors and warnings
     "InputError": "core.errors", "CampaignError": "core.errors", "ModelError": "core.errors",
-    "ComputationError": "core.errors", "StcsWarning": "core.errors", "RecordWarning": "core.errors",
+    "ComputationError": "core.errors", "BoundError": "core.errors", "StcsWarning": "core.errors", "RecordWarning": "core.errors",
     "NumberingWarning": "core.errors", "IdentifiabilityWarning": "identify.uncertainty",
 }
 

@@ -52,6 +52,14 @@ def add_tension_model_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tension-model", choices=TENSION_MODELS, default="uniform", help=TENSION_MODEL_HELP)
 
 
+def add_plausibility_option(parser: argparse.ArgumentParser) -> None:
+    """``--no-plausibility-check``: fit even when the nominal model is implausibly far from the measurement."""
+    parser.add_argument("--no-plausibility-check", dest="plausibility_check", action="store_false",
+                        help="fit even when the nominal frequency of a test's lowest measured mode is more than "
+                             "1.3 times off the measured one (refused by default: a unit slip, such as a tension "
+                             "in kN or a mass per length in g/m)")
+
+
 def worker_count(text: str) -> int:
     """``--workers``: a number of processes 1 … 1024 (argparse reports a refusal as a bad option)."""
     try:

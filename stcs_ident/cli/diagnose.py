@@ -11,6 +11,7 @@ from ..core.errors import InputError
 from .common import (
     add_campaign_argument,
     add_json_option,
+    add_plausibility_option,
     add_tension_model_option,
     command_parser,
     picked_spectra,
@@ -36,6 +37,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--all-hypotheses", action="store_true",
                         help="fit every pair of effects even when the nominal model explains the data")
     add_tension_model_option(parser)
+    add_plausibility_option(parser)
     parser.add_argument("--workers", type=worker_count, metavar="N",
                         help="processes fitting hypotheses in parallel (default: the processors this process may "
                              f"use, at most {DEFAULT_MAX_WORKERS}; 1 fits them in this process)")
@@ -57,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = diagnose(campaign, tests, effects=args.effects, picked=picked, max_effects=args.max_effects,
                           tension_model=args.tension_model, all_hypotheses=args.all_hypotheses,
-                          workers=args.workers, progress=step_progress("diagnose", "hypothesis"))
+                          workers=args.workers, progress=step_progress("diagnose", "hypothesis"),
+                          check_plausibility=args.plausibility_check)
     except InputError as err:
         raise InputError(err.message, field=err.field, file=err.file or file) from None
     if args.json:

@@ -48,4 +48,27 @@ def run(args: argparse.Namespace) -> int:
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":
         sys.stdout.write(text)
+    warning = plausibility_warning(campaign, tests, picked, args.tension_model)
+    if warning:
+        print(f"stcs-ident: warning: {warning}", file=sys.stderr)
     return 0
+
+
+def plausibility_warning(campaign, tests, picked, tension_model: str) -> str | None:
+    """What ``identify`` and ``diagnose`` would refuse the campaign for (a unit slip, most likely), or None:
+    ``forward`` only says it."""
+    import numpy as np
+
+    from ..identify.plausibility import assess
+    from ..identify.problem import Measurement
+
+    measurements = []
+    for t in campaign.tests:
+        if tests and t.name not in tests:
+            continue
+        modes, freqs = picked.get(t.name, (t.modes, t.frequencies))
+        if freqs is not None and len(freqs):
+            measurements.append(Measurement(t, np.asarray(modes, int), np.asarray(freqs, float),
+                                            np.ones(len(freqs)), "measured"))
+    found = assess(campaign, measurements, tension_model) if measurements else None
+    return None if found is None else f"field '{found[0]}': {found[1]} (identify and diagnose refuse it)"

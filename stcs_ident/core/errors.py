@@ -72,3 +72,19 @@ class RecordWarning(StcsWarning):
 
 class NumberingWarning(StcsWarning):
     """A mode-number assignment is doubtful."""
+
+
+class BoundError(ComputationError):
+    """A fit that stopped at a bound of a parameter: not a result.
+
+    Attributes
+    ----------
+    result : object
+        The failed result (an :class:`~stcs_ident.identify.result.IdentificationResult` whose ``failure``
+        names the parameter and the bound): its before/after frequencies stay printable, its parameters have
+        no uncertainty.
+    """
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result

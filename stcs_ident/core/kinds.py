@@ -270,10 +270,18 @@ def _stiff_support(campaign: Campaign) -> float:
     return 100.0 * mean_tension(campaign) / campaign.cable.length
 
 
+def bare_EI_upper(campaign: Campaign) -> float:
+    """Largest EI worth a search on a bare cable (N m²): T_max l² / 4, at which ξ = l √(T/EI) drops to 2
+    for the campaign's largest tension. Below ξ ≈ 2 bending, not tension, sets even the first mode: the
+    member is a beam, and a campaign that calls it a cable with EI = 0 is wrong in more than its EI."""
+    tension = max((t.tension for t in campaign.tests), default=1.0)
+    return tension * campaign.cable.length**2 / 4.0
+
+
 for _kind in (
     Kind("tension", "N", "H", "test", "tension", bounds=(0.5, 2.0), grid=(0.9, 1.1),
          tolerance=Tolerance("tension", 0.02), noted_in_si=False),
-    Kind("EI", "N m^2", "EI", "cable", "EI", bounds=(0.01, 100.0), grid=(0.5, 1.5),
+    Kind("EI", "N m^2", "EI", "cable", "EI", bounds=(0.01, 100.0), grid=(0.5, 1.5), zero_upper=bare_EI_upper,
          tolerance=Tolerance("EI", 0.3), aliases=("ei",)),
     Kind("length", "m", "l", "cable", "length", bounds=(0.8, 1.2), grid=(0.97, 1.03),
          tolerance=Tolerance("length", 0.002)),

@@ -12,8 +12,10 @@ override of :func:`stcs_ident.forward.batch_frequencies`.
 The variable is the ratio to the nominal value (H̃/H, ẼI/EI, l̃_k/l_k), as
 in the source paper, except
 
-- an attachment's mass, spring or dashpot whose nominal value is zero: the
-  variable is then the value itself in the kind's unit (kg, N/m, N s/m);
+- an attachment's mass, spring or dashpot, or the cable's EI (a bare
+  cable), whose nominal value is zero: the variable is then the value
+  itself in the kind's unit (kg, N/m, N s/m, N m²), bounded by
+  ``[0, zero_upper(campaign)]`` of its kind;
 - an end's rotational stiffness k: the variable is the *fixity*
   φ = k / (k + √(EI·H)), 0 for a pinned end and 1 for a clamped one. √(EI·H)
   is the stiffness at which the end's boundary layer (length √(EI/H)) is
@@ -232,9 +234,11 @@ def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iter
         accepted (``EI_ratio``).
     bounds : mapping, optional
         ``{name: (lower, upper)}`` in variable units (ratios; the kind's unit
-        for a zero-nominal mass, spring or dashpot; fixity in [0, 1]), keyed by a kind
+        for a zero-nominal mass, spring, dashpot or EI; fixity in [0, 1]), keyed by a kind
         (``"EI"``, ``"position"``) or a display name
-        (``"position_ratio[W1]"``, ``"position[W1]"``).
+        (``"position_ratio[W1]"``, ``"position[W1]"``). They replace the
+        campaign's ``[bounds]`` (``campaign.bounds``), which replace the
+        kinds' default bounds.
 
     Returns
     -------
@@ -262,7 +266,12 @@ def parse_parameters(campaign: Campaign, tests: Sequence[Test], spec: str | Iter
         ends = {p.member for p in params if p.kind == kind}
         if "AB" in ends and len(ends) > 1:
             raise InputError(f"{kind} for both ends and for one end at once", field="params")
-    return tuple(_with_bounds(p, bounds or {}, cable.length) for p in params)
+    for key in dict(campaign.bounds):
+        if key not in kinds.names():
+            raise InputError(f"unknown parameter kind {key!r}; known: {', '.join(kinds.names())}",
+                             field=f"bounds.{key}")
+    given = {**dict(campaign.bounds), **dict(bounds or {})}  # the keyword wins over the campaign's [bounds]
+    return tuple(_with_bounds(p, given, cable.length) for p in params)
 
 
 def _expand(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | None, name: str,
@@ -282,7 +291,10 @@ def _expand(campaign: Campaign, tests: Sequence[Test], kind: str, member: str | 
             raise InputError(f"{name}: {kind} is a cable property and takes no [member]", field="params")
         nominal = float(getattr(cable, spec.attribute))
         if nominal <= 0:
-            raise InputError(f"{name}: the nominal {kind} is 0, so it has no ratio", field="params")
+            if spec.zero_upper is None:
+                raise InputError(f"{name}: the nominal {kind} is 0, so it has no ratio", field="params")
+            # Zero nominal (a bare cable's EI): the variable is the value itself, in the kind's unit.
+            return [Parameter(kind, None, 0.0, 1.0, 0.0, spec.zero_upper(campaign))]
         return [Parameter(kind, None, nominal, nominal, lo, hi)]
     if spec.belongs_to == "end":
         ends = {"A": cable.boundary_a, "B": cable.boundary_b}

@@ -19,12 +19,14 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..core import kinds
 from ..core.errors import InputError
 from ..core.model import Campaign, has_dampers
 from ..core.notes import Note
 from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
+from ..identify.plausibility import check_plausibility as plausible
 from ..identify.problem import Measurement, gather_measurements
 from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
@@ -51,7 +53,7 @@ MAX_WORKERS = 8
 def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects: str | Sequence[str] | None = None,
              picked: Mapping[str, object] | None = None, max_effects: int = 2, tension_model: str = "uniform",
              progress: Progress | None = None, workers: int | None = None,
-             all_hypotheses: bool = False) -> Diagnosis:
+             all_hypotheses: bool = False, check_plausibility: bool = True) -> Diagnosis:
     """Diagnose the nominal model of ``campaign`` against its measured frequencies.
 
     Parameters
@@ -79,6 +81,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         Fit every pair even when the nominal model explains the data (by
         default only the single effects and the baseline are then fitted:
         no pair can change an empty cause).
+    check_plausibility : bool
+        Refuse, before any fit, a campaign whose nominal model is
+        implausibly far from the measured frequencies (a unit slip:
+        :func:`~stcs_ident.identify.plausibility.check_plausibility`).
 
     Returns
     -------
@@ -94,7 +100,15 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
         to act on in the measured tests (an attachment effect when no
         measured test's setup has an attachment); ``field="frequencies"``
         when there are fewer measured frequencies than the smallest
-        hypothesis needs; ``field="test"`` for unknown tests or no data.
+        hypothesis needs; ``field="test"`` for unknown tests or no data;
+        the implausible field (``test[<name>].tension``,
+        ``cable.mass_per_length``) when the nominal model is far from the
+        measurement.
+
+    A hypothesis whose final fit stops at a bound of the search is a failed
+    hypothesis (``failure`` names the parameter and the bound), ranked last
+    and never the cause. On a bare cable (nominal EI = 0) ``bending_stiffness``
+    fits EI as an absolute value in N m² (a note says so).
     """
     started = time.perf_counter()
     requested = effects is not None
@@ -114,6 +128,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             raise InputError(why, field="effects")
         else:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
+    if check_plausibility:  # after the options' checks (an unknown or inapplicable effect is named first)
+        plausible(campaign, measurements, settings.tension_model)
     # The damping ratios are data, for the nominal model and every hypothesis alike, where a damper is in
     # question: a recorded damper, or a missing one asked for.
     with_damping = (any(has_dampers(campaign.setup(m.test.setup).attachments) for m in measurements)
@@ -136,6 +152,10 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
                                "{n} frequencies allow", value=dropped, n=n))
     if baseline and baseline not in sets and sum(sizes[e] for e in baseline) + 2 <= n:
         sets.append(baseline)
+    if campaign.cable.EI <= 0 and any(registry.get(e).parameter_kind == "EI" for s in sets for e in s):
+        notes.append(Note.make("EI_absolute", "the nominal EI is 0 (a bare cable): bending_stiffness fits EI as "
+                               "an absolute value, from 0 to {value:.4g} {unit} (where xi = l sqrt(T/EI) falls to 2 "
+                               "at the largest tension)", value=kinds.get("EI").zero_upper(campaign), unit="N m^2"))
     symmetric = mirror_symmetric(campaign, measurements, settings.tension_model)
     fits: dict[tuple[str, ...], HypothesisFit] = {}
     timings: dict[tuple[str, ...], float] = {}

@@ -72,7 +72,10 @@ class HypothesisFit:
     profile : list of (position m, χ²), optional
         The profile scan of an unmodeled attachment's position.
     failure : str or None
-        Why the fit failed (it then ranks last: χ² and AICc infinite).
+        Why the fit failed (it then ranks last: χ² and AICc infinite): an
+        exception, or the final fit stopped at a bound of the search (the
+        :mod:`stcs_ident.identify.bounds` rule, which names the parameter and
+        the bound).
     penalty : float
         How implausible the departures are (:func:`prior_penalty`: −2 log of
         the priors that the tolerances of the nominal values give, and the
@@ -409,6 +412,13 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             result = other
     notes += [n for n in result.notes if n not in notes]
     notes = [in_si_units(note, problem.parameters) for note in notes]
+    if result.failure is not None:
+        # The final fit stopped at a bound of the search: no estimate, so the hypothesis failed (ranked last,
+        # never a cause). The profile scan's points may touch bounds; only this fit counts.
+        failed = failed_fit(campaign, measurements, effects, str(in_si_units(result.failure, problem.parameters)),
+                            tension_model)
+        failed.notes, failed.profile, failed.minima = notes, sorted(profile), minima
+        return failed
     n = problem.n_data
     predicted = problem.predict(result.estimate)
     terms = ((predicted - problem.measured) / problem.sigma) ** 2

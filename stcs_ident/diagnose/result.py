@@ -192,6 +192,7 @@ class Diagnosis(Result):
                 "cv_rms_error_nominal": nominal.cv_rms_error,
                 "cv_rms_error_corrected": _finite_or_none(corrected.cv_rms_error)}
         if baseline is not None:
+            gain["baseline_effects"] = list(baseline.effects)
             gain["rms_error_baseline"] = baseline.rms_error
             gain["cv_rms_error_baseline"] = _finite_or_none(baseline.cv_rms_error)
         for label, value in self.test_cv.items():

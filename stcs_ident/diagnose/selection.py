@@ -21,7 +21,9 @@
    that of the likelihood with it, one more parameter each. A
    hypothesis with an effect without a tolerance whose size the data do
    not establish (:func:`insignificant`), or whose gain rests on a single
-   frequency (:func:`single_frequency`), is not ranked.
+   frequency (:func:`single_frequency`), is not ranked; nor is one whose
+   final fit stopped at a bound of the search (a failed hypothesis: the
+   report says which parameter and which bound).
 3. **Parsimony**: a hypothesis with fewer parameters than the best one
    that is within :data:`AMBIGUITY` of it in AICc explains the data as well
    more simply and is preferred (Burnham & Anderson: an added parameter
@@ -252,8 +254,9 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
 def insignificant(fit: HypothesisFit) -> tuple[str, ...]:
     """Effects of ``fit`` without a tolerance (an unmodeled mass or support, an end restraint) whose size the
     data do not establish: no amplitude (a parameter of a kind with ``amplitude`` set, :mod:`stcs_ident.core.kinds`)
-    departs from its nominal value by more than :data:`BEYOND` σ (an
-    amplitude pushed to its bound counts as established). Such a hypothesis is never chosen (step 2).
+    departs from its nominal value by more than :data:`BEYOND` σ. A fit whose amplitude stopped at the
+    upper bound of its search is a failed hypothesis (:mod:`stcs_ident.identify.bounds`), never ranked.
+    Such a hypothesis is never chosen (step 2).
 
     A support of 452 N/m found at mid-span of a 4 MN stay, its stiffness and position without a finite σ,
     had absorbed one mode's misfit and was named beside an EI change (validate_diagnosis stay seed 1501).
@@ -267,8 +270,8 @@ def insignificant(fit: HypothesisFit) -> tuple[str, ...]:
                                          widths):
         if width is not None or not kinds.get(p.kind).amplitude:
             continue
-        at_bound = float(x) >= float(p.upper) * (1 - 1e-6)
-        sized = at_bound or (math.isfinite(sigma) and sigma > 0 and abs(float(x) - p.start) > BEYOND * sigma)
+        # (An amplitude pushed to its upper bound no longer reaches here: that fit failed, fitting.fit_hypothesis.)
+        sized = math.isfinite(sigma) and sigma > 0 and abs(float(x) - p.start) > BEYOND * sigma
         shown[owner] = shown.get(owner, False) or sized
     return tuple(e for e, sized in shown.items() if not sized)
 

@@ -3,7 +3,9 @@
 A strand's or a bundle's bending stiffness lies between that of its wires
 bending alone and that of a solid section, depending on interwire friction
 and hence on tension; the nominal value is often a guess within tens of per
-cent. One value for all tests. Part of the source paper's correction.
+cent. One value for all tests. Part of the source paper's correction. On a
+bare cable (nominal EI = 0) the parameter is EI itself, in N m², from 0 to
+the EI at which ξ = l √(T/EI) falls to 2 (:func:`stcs_ident.core.kinds.bare_EI_upper`).
 """
 
 from __future__ import annotations
@@ -23,13 +25,13 @@ class BendingStiffness(Effect):
     option = Option("--EI-ratio", "R", "true / nominal bending stiffness")
 
     def applicable(self, campaign, tests):
-        if campaign.cable.EI <= 0:
-            return "bending_stiffness has no ratio: the nominal EI is 0"
-        return None
+        return None  # on a bare cable (EI = 0) EI is an absolute value in N m² (core.kinds.bare_EI_upper)
 
     def describe(self, values, sigmas, cable):
-        return (f"an effective bending stiffness EI = {pm(values['EI'] / 1e3, scaled(sigmas.get('EI'), 1e3))} "
-                f"kN m² ({values['EI'] / cable.EI:.3g} × nominal)")
+        shown = f"EI = {pm(values['EI'] / 1e3, scaled(sigmas.get('EI'), 1e3))} kN m²"
+        if cable.EI <= 0:
+            return f"a bending stiffness {shown} (an absolute value: the nominal EI is 0, a bare cable)"
+        return f"an effective bending stiffness {shown} ({values['EI'] / cable.EI:.3g} × nominal)"
 
     def check_truth(self, value, field):
         return positive_ratio(value, field)

@@ -7,7 +7,7 @@ from collections.abc import Iterable, Mapping, Sequence
 # Imported for its registrations: the effects' names (bending_stiffness, ...) become aliases of their
 # parameter kinds, which parse_parameters accepts.
 from .. import effects  # noqa: F401
-from ..core.errors import InputError
+from ..core.errors import BoundError, InputError
 from ..core.model import Campaign
 from ..core.notes import Note
 from ..core.parameters import parse_parameters
@@ -19,10 +19,11 @@ from .result import IdentificationResult
 METHODS = ("lsq", "contour")
 
 
-def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str | Iterable[str] = "tension,EI", *,
+def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str | Iterable[str] | None = None, *,
              method: str = "lsq", picked: Mapping[str, object] | None = None,
              bounds: Mapping[str, tuple[float, float]] | None = None, tension_model: str = "uniform",
-             scale_rule: str = "auto", tolerances: bool = True, **options) -> IdentificationResult:
+             scale_rule: str = "auto", tolerances: bool = True, check_plausibility: bool = True,
+             **options) -> IdentificationResult:
     """Correct uncertain model parameters from measured natural frequencies.
 
     Parameters
@@ -33,10 +34,14 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         frequencies or a record; the others are skipped and listed in
         ``result.skipped``). A tension is one parameter per test; EI,
         length, end stiffness and the attachments of a setup are shared.
-    params : str or iterable of str
+    params : str or iterable of str, optional
         Free parameters, e.g. ``"tension,EI"``, ``"position[W1]"``,
         ``"tension,EI,position"`` (see
-        :func:`~stcs_ident.core.parameters.parse_parameters`).
+        :func:`~stcs_ident.core.parameters.parse_parameters`). Default
+        (:func:`default_params`): ``"tension,EI"`` when the data carry EI (a
+        test with two or more measured modes), else ``"tension"`` with a
+        note that EI is held at its nominal value. On a bare cable (EI = 0)
+        EI is freed as an absolute value in N m².
     method : {"lsq", "contour"}
         Weighted least squares (any number of parameters), or the source
         paper's contour intersection (exactly two parameters).
@@ -44,7 +49,8 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         {test: spectra or :class:`~stcs_ident.identify.problem.Measurement`}
         replacing a test's table (its uncertainties become the weights).
     bounds : mapping, optional
-        {parameter: (lower, upper)} in variable units.
+        {parameter: (lower, upper)} in variable units; they win over the
+        campaign's ``[bounds]``, which win over the kinds' defaults.
     tension_model : {"uniform", "per-segment", "none"}
     scale_rule : {"auto", "birge", "never"}
         When to scale the covariance by the reduced χ².
@@ -54,6 +60,11 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         those fitted (:mod:`~stcs_ident.identify.nuisance`; a ``tolerances_propagated`` note lists them).
         Off: the standard deviations rest on the frequency uncertainties alone, as if every value held
         fixed were exact.
+    check_plausibility : bool
+        Refuse, before any fit, a campaign whose nominal model is
+        implausibly far from the measured frequencies (a unit slip:
+        :func:`~stcs_ident.identify.plausibility.check_plausibility`).
+        False for a user who means it.
     **options :
         Passed to :func:`~stcs_ident.identify.lsq.fit_lsq` (``starts``,
         ``n_starts``, ``max_nfev``, ``seed``) or
@@ -70,7 +81,15 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         Naming the field: ``method``, ``tension_model``, ``scale_rule``, ``test``,
         ``test[<name>].frequencies`` (a selected test with neither
         frequencies nor a record), ``params`` (unknown name, fewer measured
-        frequencies than free parameters), ``bounds.<parameter>``.
+        frequencies than free parameters), ``bounds.<parameter>``; the
+        implausible field (``test[<name>].tension``, ``cable.mass_per_length``)
+        when the nominal model is far from the measurement.
+    BoundError
+        When the fit stopped at a bound of the search (a
+        :class:`~stcs_ident.core.errors.ComputationError`): no result. Its
+        ``result`` is the failed :class:`IdentificationResult` (``failure``
+        names the parameter and the bound; before/after frequencies kept, no
+        uncertainties).
 
     Warns
     -----
@@ -80,8 +99,15 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
     measurements, skipped = gather_measurements(campaign, tests, picked)
+    held = None
+    if params is None:
+        params, held = default_params(measurements)
     parameters = parse_parameters(campaign, [m.test for m in measurements], params, bounds)
     settings = Settings(tension_model=tension_model, scale_rule=scale_rule)
+    if check_plausibility:  # after the options' checks: a bad --params is named before the data are judged
+        from .plausibility import check_plausibility as check
+
+        check(campaign, measurements, settings.tension_model)
     nuisance = nuisance_parameters(campaign, [m.test for m in measurements], parameters) if tolerances else ()
     problem = Problem(campaign, measurements, parameters, settings.tension_model, nuisance=nuisance)
     if method == "lsq":
@@ -92,10 +118,27 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         from .contour import fit_contour
 
         result = fit_contour(problem, settings=settings, **options)
-    if skipped:
-        from dataclasses import replace
+    from dataclasses import replace
 
+    if skipped:
         note = Note.make("skipped", "skipped (nothing to identify from): {tests}",
                          tests=", ".join(f"{n} ({r})" for n, r in skipped))
         result = replace(result, skipped=tuple(skipped), notes=result.notes + (note,))
+    if held is not None:
+        result = replace(result, notes=result.notes + (held,))
+    if result.failure is not None:
+        raise BoundError(str(result.failure), result)
     return result
+
+
+def default_params(measurements) -> tuple[str, Note | None]:
+    """The default free parameters: ``"tension,EI"`` when the data carry EI, else ``"tension"`` and a note.
+
+    A tension per test and one EI are one parameter more than the tests: the data carry EI only when some
+    test has two or more measured modes (one mode per test gives as many frequencies as tensions, each
+    matched exactly whatever EI is).
+    """
+    if any(m.modes.size >= 2 for m in measurements):
+        return "tension,EI", None
+    return "tension", Note.make("EI_held", "EI is held at its nominal value: every test has one measured mode, "
+                                "as many frequencies as tensions, so the data cannot carry EI as well")

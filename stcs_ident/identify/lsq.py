@@ -22,6 +22,7 @@ from scipy.optimize import least_squares
 from ..core.notes import Note, point
 from ..core.settings import Settings
 from .nuisance import propagate, tolerance_note
+from .bounds import bound_failure
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import correlation, covariance, covariance_scale, identifiability, warn_identifiability
@@ -123,12 +124,10 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
         notes.append(tolerance_note(problem.nuisance, float(np.max(share, initial=0.0))))
     if uncertainty is not None:  # the contour's region extent: the tolerances' share added in quadrature
         uncertainty = np.sqrt(np.asarray(uncertainty, float) ** 2 + np.maximum(np.diag(added), 0.0))
-    span = problem.upper - problem.lower
-    at_bound = [q.name for q, v, lo, hi, w in zip(problem.parameters, x, problem.lower, problem.upper, span)
-                if min(v - lo, hi - v) <= 1e-9 * w]
-    if at_bound:
-        notes.append(Note.make("at_bound", "at a bound (the standard deviation there is only indicative): "
-                               "{parameters}", parameters=at_bound))
+    failure, at_limit = bound_failure(problem.parameters, x, problem.lower, problem.upper)
+    if at_limit:
+        notes.append(Note.make("at_bound", "at a physical limit (the standard deviation there is only "
+                               "indicative): {parameters}", parameters=at_limit))
     # What the data can tell apart: from the measurements' share alone (a common error of a value held fixed,
     # the length, say, correlates every tension without making them any less determined by the data).
     notes += warn_identifiability(identifiability(J, problem.names, base_corr, np.sqrt(np.diag(base) * scale),
@@ -145,13 +144,14 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
                      for label, values in m.test.reference}
         tests.append(TestFit(m.name, m.test.setup, tuple(int(v) for v in m.modes), m.frequencies, m.uncertainty,
                              m.source, before[sl], after[sl], reference, damping[i]))
-    return IdentificationResult(
+    result = IdentificationResult(
         method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
         uncertainty=sigma if uncertainty is None else uncertainty,
         covariance=cov, correlation=corr, tests=tuple(tests), chi2=float(chi2), dof=dof,
         covariance_scale=scale, notes=tuple(notes), alternatives=tuple(alternatives), sweep=sweep,
         settings=settings, uncertainty_sources=_sources(problem, base * scale, added),
     )
+    return result if failure is None else result.failed(failure)
 
 
 def _sources(problem: Problem, measured: np.ndarray, added: np.ndarray) -> dict:

@@ -137,6 +137,13 @@ class IdentificationResult(Result):
         With tolerances propagated (:mod:`~stcs_ident.identify.nuisance`): ``frequencies`` and
         ``tolerances``, the two shares of each standard deviation (variable units; their squares add up to
         the variance), and ``held`` ({parameter held fixed: its tolerance as stated}); else empty.
+    failure : Note or None
+        Why the fit is no result (``kind="fit_at_bound"``: it stopped at a
+        bound of the search, naming the parameter and the bound), or None.
+        A failed result keeps ``estimate`` (where the fit stopped) and the
+        before/after frequencies, but its ``uncertainty`` is NaN: no value
+        with a standard deviation is reported. :func:`~stcs_ident.identify.identify`
+        raises :class:`~stcs_ident.core.errors.BoundError` carrying it.
     """
 
     method: str
@@ -155,8 +162,27 @@ class IdentificationResult(Result):
     sweep: object | None = field(default=None, repr=False)
     settings: Settings = field(default_factory=Settings)
     uncertainty_sources: dict = field(default_factory=dict)
+    failure: Note | None = None
 
     main_table = "parameters"
+
+    @property
+    def ok(self) -> bool:
+        """True unless the fit failed (:attr:`failure`)."""
+        return self.failure is None
+
+    @property
+    def status(self) -> str:
+        """``"ok"`` or ``"failed"``."""
+        return "ok" if self.failure is None else "failed"
+
+    def failed(self, failure: Note) -> IdentificationResult:
+        """This result marked as failed for ``failure``: the uncertainties become NaN (a fit stopped at a
+        bound has no standard deviation worth reporting), the rest stays for the before/after tables."""
+        from dataclasses import replace
+
+        return replace(self, failure=failure, uncertainty=np.full(len(self.parameters), np.nan),
+                       notes=(failure, *self.notes))
 
     @property
     def names(self) -> list[str]:
@@ -211,6 +237,8 @@ class IdentificationResult(Result):
                  for p, v, vs in zip(self.parameters, self.values, self.value_uncertainty)]
         more = f", … ({len(shown)} parameters)" if len(shown) > 3 else ""
         n = sum(len(t.modes) for t in self.tests)
+        if self.failure is not None:
+            return f"{self.method} failed: {self.failure}"
         return (f"{self.method}, {', '.join(shown[:3])}{more}; rms error {self.rms_before:.3g} % → "
                 f"{self.rms_after:.3g} % over {n} frequencies of {len(self.tests)} "
                 f"test{'s' if len(self.tests) != 1 else ''}")
@@ -252,7 +280,9 @@ class IdentificationResult(Result):
     def summary(self) -> dict:
         """Plain data for JSON: the ``identify`` object, with extra keys.
 
-        Extra keys: ``values`` and ``value_uncertainty`` (SI units),
+        Extra keys: ``status`` (``"ok"`` or ``"failed"``), ``failure`` (null, or ``reason``,
+        ``parameter``, ``side`` and ``bound`` of a fit stopped at a bound; the uncertainties are then
+        null), ``values`` and ``value_uncertainty`` (SI units),
         ``uncertainty_kind``, ``correlation``, ``chi2``, ``dof``,
         ``reduced_chi2``, ``covariance_scale``, ``rms_error_before``,
         ``rms_error_after`` (%), ``notes`` (as sentences), ``skipped``, ``alternatives``, ``settings``,
@@ -263,6 +293,10 @@ class IdentificationResult(Result):
         """
         out = {
             "method": self.method,
+            "status": self.status,
+            "failure": None if self.failure is None else {
+                "reason": str(self.failure), "parameter": self.failure.parameters[0],
+                **{k: v for k, v in self.failure.data if k in ("side", "bound")}},
             "parameters": _nest(self.parameters, self.estimate, by="key"),
             "uncertainty": _nest(self.parameters, self.uncertainty, by="key"),
             "uncertainty_kind": "one standard deviation" if self.method == "lsq"

@@ -34,7 +34,8 @@ __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 #: Name of the campaign file inside a campaign directory.
 CAMPAIGN_FILE = "campaign.toml"
 
-_TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance", "record_format", "channels")
+_TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance", "record_format", "channels",
+             "bounds")
 _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
@@ -132,9 +133,26 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     tests = [_parse_test(t, i) for i, t in enumerate(_tables(data.get("test", []), "test"), 1)]
     published = [_parse_published(t, i) for i, t in enumerate(_tables(data.get("published", []), "published"), 1)]
     tolerance = _parse_tolerance(_table(data.get("tolerance", {}), "tolerance"))
+    bounds = _parse_bounds(_table(data.get("bounds", {}), "bounds"))
     return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance,
-                    record_format=_parse_record_format(data.get("record_format", {}), "record_format"),
+                    bounds=bounds, record_format=_parse_record_format(data.get("record_format", {}), "record_format"),
                     channels=_parse_channels(data.get("channels", {}), "channels"))
+
+
+def _parse_bounds(table: dict[str, Any]) -> tuple[tuple[str, tuple[float, float]], ...]:
+    """``[bounds]``: default bounds of the identification's variables, by parameter kind (``tension =
+    [0.2, 5.0]``, ratios to nominal; see docs/formats.md)."""
+    _check_keys(table, kinds.names(), "bounds")
+    out = []
+    for key, value in table.items():
+        field = f"bounds.{key}"
+        if not isinstance(value, list) or len(value) != 2:
+            raise CampaignError(f"must be two numbers [lower, upper], got {_show(value)}", field=field)
+        lo, hi = (_number(v, field) for v in value)
+        if not (math.isfinite(lo) and math.isfinite(hi)) or not 0 <= lo < hi:
+            raise CampaignError(f"must satisfy 0 <= lower < upper (finite), got {_show(value)}", field=field)
+        out.append((key, (float(lo), float(hi))))
+    return tuple(out)
 
 
 def _parse_tolerance(table: dict[str, Any]) -> tuple[tuple[str, float], ...]:

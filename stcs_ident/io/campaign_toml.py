@@ -59,6 +59,8 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
         data["record_format"] = _record_format_table(campaign.record_format)
     if campaign.channels:
         data["channels"] = {name: float(position) for name, position in campaign.channels}
+    if campaign.bounds:
+        data["bounds"] = {key: [float(lo), float(hi)] for key, (lo, hi) in campaign.bounds}
     return data
 
 

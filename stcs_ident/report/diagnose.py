@@ -52,7 +52,7 @@ def diagnosis_text(diagnosis) -> str:
     s = d.summary()["gain"]
     baseline, cv_baseline, cv_corrected = (number(s.get(k), finite_only=True) for k in (
         "rms_error_baseline", "cv_rms_error_baseline", "cv_rms_error_corrected"))
-    lines.append(f"Gain: rms error nominal {s['rms_error_nominal']:.3f} %, baseline (tension, EI) {baseline} %, "
+    lines.append(f"Gain: rms error nominal {s['rms_error_nominal']:.3f} %, baseline ({baseline_label(d)}) {baseline} %, "
                  f"corrected {s['rms_error_corrected']:.3f} %; cross-validated (leave one mode out) baseline "
                  f"{cv_baseline} %, corrected {cv_corrected} %.")
     if d.test_cv:
@@ -63,6 +63,18 @@ def diagnosis_text(diagnosis) -> str:
     for name, reason in d.skipped:
         lines.append(f"Skipped {name}: {reason}")
     return "\n".join(lines) + "\n"
+
+
+def baseline_label(diagnosis) -> str:
+    """What the baseline re-estimated: ``tension, EI`` (the source paper's correction), ``tension, EI absolute``
+    on a bare cable, or the part of it that was fitted (``tension``); ``none`` when nothing was."""
+    base = diagnosis.baseline
+    if base is None:
+        return "none"
+    from ..effects import registry
+
+    words = {"tension": "tension", "EI": "EI absolute" if diagnosis.campaign.cable.EI <= 0 else "EI"}
+    return ", ".join(words.get(registry.get(e).parameter_kind, e) for e in base.effects)
 
 
 def _file_stem(name: str) -> str:
@@ -225,7 +237,7 @@ def _gain_section(d, gain: pd.DataFrame) -> list[str]:
     sentence = (f"The rms error against the measured frequencies is {percent(g['rms_error_nominal'])} with the nominal "
                 f"model")
     if "rms_error_baseline" in g:
-        sentence += f", {percent(g['rms_error_baseline'])} with tension and EI re-estimated (baseline)"
+        sentence += f", {percent(g['rms_error_baseline'])} with {baseline_label(d).replace(', ', ' and ')} re-estimated (baseline)"
     sentence += (f" and {percent(g['rms_error_corrected'])} with the corrected model ({effects_label(d.corrected.effects)}); "
                  f"cross-validated, nominal {percent(g['cv_rms_error_nominal'])}")
     if "rms_error_baseline" in g:
