@@ -21,8 +21,8 @@ from scipy.optimize import least_squares
 
 from ..core.notes import Note, point
 from ..core.settings import Settings
-from .nuisance import propagate, tolerance_note
 from .bounds import bound_failure
+from .nuisance import propagate, tolerance_note
 from .problem import Problem
 from .result import IdentificationResult, TestFit
 from .uncertainty import correlation, covariance, covariance_scale, identifiability, warn_identifiability
