@@ -120,9 +120,10 @@ def test_the_effects_names_are_aliases_of_their_kinds():
 
 
 def test_every_tolerance_an_effect_declared_is_a_kind_s_and_accepted_by_a_campaign():
-    """The keys and defaults the effect modules declared before the kinds held them."""
+    """The keys and defaults the effect modules declared before the kinds held them (and the mass per length's,
+    which no effect changes: identify carries it into σ)."""
     declared = {"tension": (0.02, True), "EI": (0.3, True), "position": (0.02, False), "mass": (0.02, True),
-                "length": (0.002, True), "coefficient": (0.2, True)}
+                "length": (0.002, True), "coefficient": (0.2, True), "mass_per_length": (0.01, True)}
     assert set(kinds.tolerance_keys()) == set(declared) == set(effects.tolerance_keys())
     for e in effects.effects():
         if e.tolerance is not None:

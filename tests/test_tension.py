@@ -267,10 +267,10 @@ def test_exact_sigma_covers_the_truth():
     sigma = 0.002  # Hz, ~0.1 %: the fit stays linear
     inside = 0
     for _ in range(200):
-        # EI and the length are exact in these draws: their tolerances 0 (the default 30 % and 0.2 % would widen
+        # EI, the length and the mass are exact in these draws: their tolerances 0 (the default 30 % and 0.2 % would widen
         # σ for errors these data do not have; tests/test_tolerance_coverage.py covers data that have them)
         exact = quick_tension(length, m, f + rng.normal(0, sigma, 3), modes, EI=EI, uncertainty=sigma,
-                              EI_tolerance=0, length_tolerance=0).methods["exact"]
+                              EI_tolerance=0, length_tolerance=0, mass_tolerance=0).methods["exact"]
         inside += abs(exact.tension - tension) <= exact.uncertainty
     # 68.3 % expected; binomial sd over 200 draws is 3.3 %, so ±7 % is about 2 sd
     assert 0.61 <= inside / 200 <= 0.75
@@ -302,7 +302,7 @@ def test_the_exact_sigma_carries_the_tolerance_of_a_given_EI():
     f = ref.beam_clamped(length, m, tension, EI, [1])
     given = quick_tension(length, m, f, [1], EI=EI, uncertainty=0.001).methods["exact"]
     exact_EI = quick_tension(length, m, f, [1], EI=EI, uncertainty=0.001, EI_tolerance=0,
-                             length_tolerance=0).methods["exact"]
+                             length_tolerance=0, mass_tolerance=0).methods["exact"]
     assert exact_EI.uncertainty / tension < 0.002   # 2 σ_f / f ≈ 4e-4 (f ≈ 5.5 Hz)
     assert 0.015 < given.uncertainty / tension < 0.06
     with pytest.raises(InputError):
@@ -314,11 +314,17 @@ def test_the_formulas_sigma_carries_the_length_and_EI_tolerances_in_closed_form(
     tolerance. Pinned beam: T = 4 m l² f² − π² EI/l², so the EI tolerance t_EI adds π² EI t_EI / l²."""
     length, m, f, sigma_f, t_l, t_EI, EI = 50.0, 40.0, 2.0, 0.004, 0.002, 0.3, 1e5
     T = 4 * m * length**2 * f**2
-    taut = quick_tension(length, m, [f], [1], uncertainty=sigma_f, length_tolerance=t_l).methods["taut_string"]
+    taut = quick_tension(length, m, [f], [1], uncertainty=sigma_f, length_tolerance=t_l,
+                         mass_tolerance=0).methods["taut_string"]
     # first order by a relative step of 1e-6 on a quadratic: exact to ~1e-6
     assert taut.uncertainty / T == pytest.approx(math.hypot(2 * sigma_f / f, 2 * t_l), rel=1e-5)
+    # and T ∝ m: the mass per length's relative tolerance adds itself
+    with_mass = quick_tension(length, m, [f], [1], uncertainty=sigma_f, length_tolerance=t_l,
+                              mass_tolerance=0.01).methods["taut_string"]
+    assert with_mass.uncertainty / T == pytest.approx(math.sqrt((2 * sigma_f / f) ** 2 + (2 * t_l) ** 2 + 0.01**2),
+                                                      rel=1e-5)
     beam = quick_tension(length, m, [f], [1], EI=EI, boundary="pinned", uncertainty=sigma_f, length_tolerance=t_l,
-                         EI_tolerance=t_EI).methods["beam"]
+                         EI_tolerance=t_EI, mass_tolerance=0).methods["beam"]
     T_beam = T - math.pi**2 * EI / length**2
     d_length = 8 * m * length**2 * f**2 + 2 * math.pi**2 * EI / length**2  # l dT/dl
     expected = math.sqrt((8 * m * length**2 * f * sigma_f) ** 2 + (d_length * t_l) ** 2

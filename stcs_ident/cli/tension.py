@@ -26,6 +26,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--EI-tolerance", metavar="REL", help="relative 1σ of a given --EI, carried into the "
                                                               "exact model's σ (default 0.3; 0: exact)")
     parser.add_argument("--length-tolerance", metavar="REL", help="relative 1σ of --length (default 0.002)")
+    parser.add_argument("--mass-tolerance", metavar="REL", help="relative 1σ of --mass (default 0.01)")
     add_json_option(parser)
 
 
@@ -52,7 +53,8 @@ def _numbers(text: str | None, option: str, kind=float) -> list | None:
 def field_options() -> dict[str, str]:
     """The library's argument names that are not the option's name."""
     return {"mass": "--mass", "EI": "--EI", "EA": "--EA", "EI_tolerance": "--EI-tolerance",
-            "length_tolerance": "--length-tolerance"}
+            "length_tolerance": "--length-tolerance", "mass_tolerance": "--mass-tolerance",
+            "mass_per_length_tolerance": "--mass-tolerance"}
 
 
 def tension_text(result) -> str:
@@ -98,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
                            EA=_number(args.EA, "--EA"), inclination=_number(args.inclination, "--inclination"),
                            boundary=args.boundary, uncertainty=uncertainty if len(uncertainty) > 1 else uncertainty[0],
                            uncertainty_source=source, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
-                           length_tolerance=_number(args.length_tolerance, "--length-tolerance"))
+                           length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
+                           mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"))
     if args.json:
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":

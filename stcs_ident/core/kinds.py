@@ -285,7 +285,10 @@ for _kind in (
          tolerance=Tolerance("EI", 0.3), aliases=("ei",)),
     Kind("length", "m", "l", "cable", "length", bounds=(0.8, 1.2), grid=(0.97, 1.03),
          tolerance=Tolerance("length", 0.002)),
-    Kind("mass_per_length", "kg/m", "m", "cable", "mass_per_length", bounds=(0.5, 2.0), grid=(0.9, 1.1)),
+    # A cable's mass per length comes from its strand count and sheath, from tables: the filler, grease and
+    # sheath thickness make it uncertain by about a percent, and the tension goes with it one to one.
+    Kind("mass_per_length", "kg/m", "m", "cable", "mass_per_length", bounds=(0.5, 2.0), grid=(0.9, 1.1),
+         tolerance=Tolerance("mass_per_length", 0.01)),
     # A position's bounds keep it a margin away from the anchorages (core.parameters), whatever these say.
     Kind("position", "m", "x", "attachment", "positions", bounds=(0.0, 1.0), grid=(0.9, 1.1),
          tolerance=Tolerance("position", 0.02, relative=False, unit="m")),

@@ -339,18 +339,18 @@ def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
 
 
 def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, tolerance) -> MethodEstimate:
-    """A formula's estimate with the tolerances of the length and of a given EI in its σ (first order, by
+    """A formula's estimate with the tolerances of the length, the mass and a given EI in its σ (first order, by
     the formula's own change for a relative step of each: docs/uncertainty.md)."""
     estimate = method(length, mass, freqs, modes, sigma, EI, boundary)
     if estimate.tension is None:
         return estimate
     step, shares = 1e-6, {}
-    for key, value in (("length", length), ("EI", EI)):
+    for key, value in (("length", length), ("mass_per_length", mass), ("EI", EI)):
         if not value or not tolerance[key]:
             continue
-        moved = {"length": length, "EI": EI}
+        moved = {"length": length, "mass_per_length": mass, "EI": EI}
         moved[key] = value * (1 + step)
-        other = method(moved["length"], mass, freqs, modes, sigma, moved["EI"], boundary).tension
+        other = method(moved["length"], moved["mass_per_length"], freqs, modes, sigma, moved["EI"], boundary).tension
         if other is not None:
             shares[key] = abs(other - estimate.tension) / step * tolerance[key]
     if not shares:
@@ -415,7 +415,7 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
                   EI: float | None = None, EA: float | None = None, inclination: float = 0.0,
                   boundary: str = "clamped", uncertainty: float | Sequence[float] | None = None, *,
                   uncertainty_source: str | None = None, EI_tolerance: float | None = None,
-                  length_tolerance: float | None = None) -> QuickTensionResult:
+                  length_tolerance: float | None = None, mass_tolerance: float | None = None) -> QuickTensionResult:
     """A cable's tension from its length, mass and measured frequencies, by several methods side by side.
 
     Parameters
@@ -443,9 +443,10 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     uncertainty_source : str, optional
         How ``uncertainty`` was obtained, recorded in ``inputs`` (the command line says "rounding of the
         printed frequencies" when it derived it from the typed text).
-    EI_tolerance, length_tolerance : float, optional
-        Relative 1σ of a given EI and of the length (default: a campaign's defaults, 30 % and 0.2 %). The
-        exact model's σ includes them where the value is held fixed (docs/uncertainty.md); 0 says exact.
+    EI_tolerance, length_tolerance, mass_tolerance : float, optional
+        Relative 1σ of a given EI, of the length and of the mass per length (default: a campaign's defaults,
+        30 %, 0.2 % and 1 %). Every method's σ includes them where the value is held fixed
+        (docs/uncertainty.md); 0 says exact.
 
     Returns
     -------
@@ -469,7 +470,7 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
             raise InputError("the rounding of the frequencies is as large as a frequency: give --uncertainty",
                              field="uncertainty")
     tolerance = {}
-    for key, value in (("EI", EI_tolerance), ("length", length_tolerance)):
+    for key, value in (("EI", EI_tolerance), ("length", length_tolerance), ("mass_per_length", mass_tolerance)):
         if value is not None:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise InputError(f"must be a finite number >= 0, got {value!r}", field=f"{key}_tolerance")
@@ -477,7 +478,7 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     inputs = {"length": length, "mass": mass, "frequencies": freqs.tolist(), "modes": modes.tolist(), "EI": EI,
               "EA": EA, "inclination": inclination, "boundary": boundary, "uncertainty": sigma.tolist(),
               "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance}
-    held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "EI")}
+    held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "mass_per_length", "EI")}
     taut = _with_tolerances(_taut, length, mass, freqs, modes, sigma, EI, boundary, held)
     methods = {
         "taut_string": taut,
