@@ -7,33 +7,53 @@ Model
     of tension per °C (a cable's thermal strain against its anchorages),
     θ_i the record's temperature (b = 0 when records carry none) and e_i
     the record-to-record scatter (traffic and wind: the mean tension over
-    ten minutes is not the same twice) plus the identification's own error.
-    The normalised tension is T_ref (1 + y_i − b (θ_i − θ̄)): what it would
-    have been at the mean temperature θ̄.
+    ten minutes is not the same twice), the identification's own error and
+    what the linear temperature model misses (a cable lagging the air, a
+    weather drift it does not follow: slow, correlated from record to
+    record). The normalised tension is T_ref (1 + y_i − b (θ_i − θ̄)): what
+    it would have been at the mean temperature θ̄.
 
 Detection: Page's two-sided CUSUM (Page 1954; Montgomery, *Introduction to
 Statistical Quality Control*, ch. 9) run as a monitor would have run it,
 record after record:
 
-1. The first ``TRAINING`` records (a day of 10-minute records) give the
-   level μ, the thermal coefficient b (least squares) and the scatter s
-   (1.4826 × the median absolute residual: robust to an outlier).
-2. Each later record's standardised residual z = (y − μ − b (θ − θ̄)) / s,
-   clipped to ±``CLIP`` (a single wild record adds at most CLIP − k: a
-   change must last to be seen), feeds S⁺ = max(0, S⁺ + z − k) and
-   S⁻ = max(0, S⁻ − z − k); an alarm when either exceeds h. Between
-   alarms μ follows the residuals slowly (an exponential average with a
-   day's memory, ``ADAPT``): a slow drift (a season, a temperature the
-   linear model does not follow) is not a lasting change, a step is
-   found within a few records, long before the average moves.
-3. The change started where the alarming sum last left zero (the maximum
-   likelihood change point of a step under the CUSUM). Its size is the
-   difference of the levels before (since the last change) and after (the
-   next ``TRAINING`` records, or all that remain), relative to the level
-   before, with 1σ √(s_b² f_b / n_b + s_a² f_a / n_a): each window's
-   robust scatter, its size, and f = (1 + ρ)/(1 − ρ) for residuals
-   correlated from record to record (ρ their lag-1 correlation); the
-   monitor restarts at the new level after those records.
+1. Training. The records of the first day (``TRAINING_SPAN``, by the
+   records' times; without times, the first ``TRAINING`` records, a day of
+   10-minute records), and at least ``MIN_TRAINING`` records, give the
+   level μ, the thermal coefficient b (least squares over a whole daily
+   cycle) and the scatter. A history that does not reach past its training
+   window by ``MIN_MONITORED`` records has **not enough history yet**
+   (:attr:`History.state`): no change can be reported, whatever the records
+   show. The training window was once cut to half the history when the
+   history was short: a 1-day archive then fitted b on half a day's cycle
+   and reported its other half's misfit as a lasting change (+0.37 %).
+2. The scatter in which residuals are counted is the long-run one,
+   s √((1 + ρ)/(1 − ρ)): s robust (1.4826 × the median absolute residual),
+   ρ the lag-1 correlation of the training residuals. What the temperature
+   model misses is slow; counted against the record-to-record s alone it
+   added up in the sums like a change. Each later record's standardised
+   residual z = (y − μ − b (θ − θ̄)) / s_run, clipped to ±``CLIP`` (a single
+   wild record adds at most CLIP − k: a change must last to be seen), feeds
+   S⁺ = max(0, S⁺ + z − k) and S⁻ = max(0, S⁻ − z − k); an alarm when either
+   exceeds h. Between alarms μ follows the residuals slowly (an exponential
+   average with a day's memory, ``ADAPT`` per day of records): a slow drift
+   is not a lasting change, a step is found within a few records, long
+   before the average moves.
+3. Where and how large. The CUSUM's own change point (where the alarming
+   sum last left zero) is only a start: a step under a daily thermal swing
+   of comparable size is seen late, and the level has begun to follow it.
+   The change is placed and sized by least squares on the raw relative
+   tensions around it (a day before, a day after, since the last change),
+   y = μ + Δ H(i − τ) + b (θ − θ̄), b fitted jointly with the step and τ the
+   record that minimises the residual sum of squares among those from a
+   day before the alarm to the alarm. Held fixed, b would absorb the part
+   of the step that its window's temperatures correlate with, and the
+   followed level would take some more: the 1.5 % loss under a thermal
+   swing half its size was found 6 records late and sized −1.24 %. The 1σ
+   of Δ is the regression's, from the robust scatter of its residuals, times
+   √((1 + ρ)/(1 − ρ)) for residuals correlated from record to record. The
+   change is Δ / (1 + μ) (after / before − 1); the monitor restarts at the
+   new level after a new training window.
 
 Then b is fitted again on the whole history with one level per segment
 between the changes found, and the detection is run once more with it
@@ -42,11 +62,11 @@ between the changes found, and the detection is run once more with it
 Choice of k and h: k = 1 (a change of 2 s is detected fastest) and h = 8.
 For independent Gaussian residuals the average run between false alarms
 (Siegmund's approximation, two-sided) is then beyond 10⁷ records; the
-residuals of a real history are neither (a thermal lag the linear model
-misses, weather), which is why h is high: the false-alarm rate on healthy
-simulated histories with daily cycles and scatter is measured in
-``benchmarks/track.py``. With CLIP = 4, a change of 5 s or more is found
-after 3 records.
+residuals of a real history are neither, which is why h is high: the
+false-alarm rate on healthy simulated histories with daily cycles and
+scatter is measured in ``benchmarks/track.py`` and in
+``tests/test_track_events.py``. With CLIP = 4, a change of 5 s_run or more
+raises the alarm after 3 records.
 """
 
 from __future__ import annotations
@@ -55,14 +75,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CLIP", "THRESHOLD", "TRAINING", "Event", "History", "analyse_history"]
+from ..core.errors import InputError
 
-TRAINING = 144  # records that set a level: a day of 10-minute records
+__all__ = ["CLIP", "MIN_MONITORED", "MIN_TRAINING", "NOT_ENOUGH_HISTORY", "THRESHOLD", "TRAINING", "TRAINING_SPAN",
+           "Event", "History", "analyse_history"]
+
+TRAINING = 144  # records that set a level when the records carry no times: a day of 10-minute records
+TRAINING_SPAN = 86400.0  # s: with times, the records of the first day set the level (a whole daily cycle)
 SLACK = 1.0  # k, in units of the scatter
 THRESHOLD = 8.0  # h, in units of the scatter
 CLIP = 4.0  # standardised residuals are clipped to ± this before the sums
 MIN_TRAINING = 12  # fewer records than this cannot set a level
-ADAPT = 1.0 / TRAINING  # the monitored level follows the residuals with this weight per record
+MIN_MONITORED = 3  # records after the training window before a change can be seen (one must last 3 records)
+ADAPT = 1.0  # the monitored level follows the residuals with this weight per training window of records
+MONITORING = "monitoring"
+NOT_ENOUGH_HISTORY = "not enough history yet"
 
 
 @dataclass(frozen=True)
@@ -77,7 +104,13 @@ class Event:
 
 @dataclass(frozen=True)
 class History:
-    """A cable's analysed history: per record the normalised tension, and the events."""
+    """A cable's analysed history: per record the normalised tension, and the events.
+
+    ``state`` is ``"monitoring"`` once the history reaches ``MIN_MONITORED``
+    records past its training window (``monitored_from``, the first record
+    a change could be seen at), else ``"not enough history yet"`` (no event
+    can be reported; ``monitored_from`` is then the history's length).
+    """
 
     normalised: np.ndarray  # N, at the mean temperature
     level: np.ndarray  # relative level μ of each record's segment
@@ -85,22 +118,45 @@ class History:
     mean_temperature: float
     scatter: float  # s, relative
     events: tuple[Event, ...]
+    state: str = MONITORING
+    monitored_from: int = 0
 
 
 def analyse_history(tension: np.ndarray, temperature: np.ndarray, reference: float, *,
-                    training: int = TRAINING) -> History:
-    """Normalise a cable's tension history (records in time order) and find its lasting changes."""
+                    training: int = TRAINING, times: np.ndarray | None = None) -> History:
+    """Normalise a cable's tension history (records in time order) and find its lasting changes.
+
+    Parameters
+    ----------
+    tension, temperature : ndarray (N,)
+        Per record, in time order; temperatures NaN (or constant) when the
+        records carry none.
+    reference : float
+        The reference tension T_ref (N).
+    training : int
+        Records that set a level when ``times`` is not given.
+    times : ndarray (N,), optional
+        The records' start times, seconds from any origin or datetime64:
+        the training window is then the first day of records
+        (``TRAINING_SPAN``), whatever the interval between records.
+
+    Returns
+    -------
+    History
+        See the module docstring for the method.
+    """
     tension = np.asarray(tension, dtype=float)
     theta = np.asarray(temperature, dtype=float)
     use_temperature = theta.size > 0 and np.all(np.isfinite(theta)) and np.ptp(theta) > 0
     mean_theta = float(np.mean(theta)) if use_temperature else float("nan")
     x = theta - mean_theta if use_temperature else np.zeros_like(tension)
     y = tension / reference - 1.0
-    training = max(MIN_TRAINING, min(training, y.size // 2))
-    if y.size < 2 * MIN_TRAINING:
-        b = _thermal(y, x, np.zeros(y.size, dtype=int)) if use_temperature else 0.0
+    training = _training_length(y.size, training, times)
+    if y.size < training + MIN_MONITORED:
+        b = _thermal(y, x, np.zeros(y.size, dtype=int)) if use_temperature and y.size > 2 else 0.0
         levels = np.full(y.size, np.median(y - b * x)) if y.size else y
-        return History(reference * (1 + y - b * x), levels, b, mean_theta, _scale(y - b * x - levels), ())
+        return History(reference * (1 + y - b * x), levels, float(b), mean_theta, _scale(y - b * x - levels), (),
+                       NOT_ENOUGH_HISTORY, int(y.size))
     b = _thermal(y[:training], x[:training], np.zeros(training, dtype=int)) if use_temperature else 0.0
     events = _detect(y, x, b, training)
     if use_temperature:  # b again, from the whole history with a level per segment
@@ -109,18 +165,33 @@ def analyse_history(tension: np.ndarray, temperature: np.ndarray, reference: flo
     segments = _segments(y.size, events)
     levels = np.array([np.mean((y - b * x)[segments == j]) for j in range(len(events) + 1)])[segments]
     return History(reference * (1 + y - b * x), levels, float(b), mean_theta, _scale(y - b * x - levels),
-                   tuple(events))
+                   tuple(events), MONITORING, int(training))
+
+
+def _training_length(n: int, training: int, times) -> int:
+    """Records in the training window: the first day's by ``times`` if given (and usable), else ``training``."""
+    if times is not None:
+        t = np.asarray(times)
+        if np.issubdtype(t.dtype, np.datetime64):
+            t = (t - t[0]) / np.timedelta64(1, "s") if t.size else t.astype(float)
+        t = np.asarray(t, dtype=float)
+        if t.size != n:
+            raise InputError(f"has {t.size} values for {n} tensions", field="times")
+        if n and np.all(np.isfinite(t)):
+            return max(MIN_TRAINING, int(np.sum(t < t[0] + TRAINING_SPAN - 0.5)))  # ½ s: rounding
+    return max(MIN_TRAINING, int(training))
 
 
 def _detect(y: np.ndarray, x: np.ndarray, b: float, training: int) -> list[Event]:
-    """The sequential CUSUM of the module docstring, with the thermal coefficient ``b`` held."""
+    """The sequential CUSUM of the module docstring, with the thermal coefficient ``b`` held while monitoring."""
     r = y - b * x
     events: list[Event] = []
     start = 0  # first record of the current level's training window
+    adapt = ADAPT / training
     while start + training < r.size:
         base = r[start:start + training]
         level = np.median(base)
-        scale = _scale(base - level)
+        scale = _scale(base - level) * np.sqrt(_correlation_factor(base - np.mean(base)))
         up = down = 0.0
         last_zero_up = last_zero_down = start + training
         alarm = None
@@ -134,28 +205,52 @@ def _detect(y: np.ndarray, x: np.ndarray, b: float, training: int) -> list[Event
             if up > THRESHOLD or down > THRESHOLD:
                 alarm = i
                 break
-            level += ADAPT * np.clip(r[i] - level, -CLIP * scale, CLIP * scale)  # follows a slow drift
+            level += adapt * np.clip(r[i] - level, -CLIP * scale, CLIP * scale)  # follows a slow drift
         if alarm is None:
             break
-        change_at = last_zero_up if up > THRESHOLD else last_zero_down
-        before = r[max(events[-1].index if events else 0, change_at - training):change_at]
-        after = r[change_at:change_at + training]
-        mean_before, mean_after = float(np.mean(before)), float(np.mean(after))
-        uncertainty = np.sqrt(_mean_variance(before) + _mean_variance(after)) / (1 + mean_before)
-        events.append(Event(int(change_at), (1 + mean_after) / (1 + mean_before) - 1, float(uncertainty),
-                            int(alarm)))
-        start = change_at
+        guess = last_zero_up if up > THRESHOLD else last_zero_down
+        first = events[-1].index if events else 0
+        event = _fit_step(y, x, first, guess, alarm, training, start + training)
+        events.append(event)
+        start = event.index
     return events
 
 
-def _mean_variance(values: np.ndarray) -> float:
-    """Variance of the mean of ``values``, residuals correlated from record to record as AR(1): s²/n ×
-    (1 + ρ) / (1 − ρ), s robust and ρ the lag-1 correlation (0 … 0.95). Without the factor, the 1σ of a
-    change was a third too small under a slow drift the temperature model does not follow."""
-    r = values - np.mean(values)
-    rho = float(np.sum(r[1:] * r[:-1]) / np.sum(r * r)) if values.size > 2 and np.any(r) else 0.0
+def _fit_step(y: np.ndarray, x: np.ndarray, first: int, guess: int, alarm: int, training: int,
+              earliest: int) -> Event:
+    """The change's record and size: least squares of y = μ + Δ H(i − τ) + b x around it (b fitted jointly),
+    τ among the records from a day before the alarm (not before ``earliest``) to the alarm."""
+    lo = max(first, guess - training)
+    hi = min(y.size, max(guess, alarm) + training)
+    candidates = range(max(earliest, alarm - training + 1, lo + 2), alarm + 1)
+    use_x = bool(np.any(x[lo:hi]))
+    best = None
+    for tau in candidates:
+        design = _step_design(x[lo:hi], tau - lo, use_x)
+        coefficients, *_ = np.linalg.lstsq(design, y[lo:hi], rcond=None)
+        rss = float(np.sum((y[lo:hi] - design @ coefficients) ** 2))
+        if best is None or rss < best[0]:
+            best = (rss, tau, coefficients, design)
+    _, tau, coefficients, design = best
+    residuals = y[lo:hi] - design @ coefficients
+    covariance = np.linalg.pinv(design.T @ design)
+    variance = _scale(residuals) ** 2 * covariance[1, 1] * _correlation_factor(residuals)
+    mu, delta = float(coefficients[0]), float(coefficients[1])
+    return Event(int(tau), delta / (1 + mu), float(np.sqrt(variance)) / (1 + mu), int(alarm))
+
+
+def _step_design(x: np.ndarray, at: int, use_x: bool) -> np.ndarray:
+    columns = [np.ones(x.size), (np.arange(x.size) >= at).astype(float)] + ([x] if use_x else [])
+    return np.column_stack(columns)
+
+
+def _correlation_factor(residuals: np.ndarray) -> float:
+    """(1 + ρ)/(1 − ρ), ρ the lag-1 correlation of ``residuals`` (0 … 0.95): the variance of a mean of
+    residuals correlated from record to record as AR(1), relative to independent ones."""
+    r = residuals - np.mean(residuals) if residuals.size else residuals
+    rho = float(np.sum(r[1:] * r[:-1]) / np.sum(r * r)) if r.size > 2 and np.any(r) else 0.0
     rho = min(max(rho, 0.0), 0.95)
-    return _scale(r) ** 2 / values.size * (1 + rho) / (1 - rho)
+    return (1 + rho) / (1 - rho)
 
 
 def _segments(n: int, events: list[Event]) -> np.ndarray:
