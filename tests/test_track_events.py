@@ -98,7 +98,11 @@ def test_times_as_datetimes_or_seconds_give_the_same_history():
     stamps = np.datetime64("2026-03-01T00:00:00", "ns") + (seconds * 1e9).astype("timedelta64[ns]")
     a = analyse_history(tension, air, REFERENCE, times=seconds)
     b = analyse_history(tension, air, REFERENCE, times=stamps)
-    assert a.events == b.events and a.monitored_from == b.monitored_from == 24
+    assert [(e.index, e.alarm) for e in a.events] == [(e.index, e.alarm) for e in b.events]
+    assert a.monitored_from == b.monitored_from == 24
+    # the same numbers but for rounding: the datetimes are whole nanoseconds
+    assert np.allclose([(e.change, e.uncertainty) for e in a.events], [(e.change, e.uncertainty) for e in b.events],
+                       rtol=1e-9)
     assert len(a.events) == 1 and abs(a.events[0].index - 50) <= 3  # hourly: a day is 24 records, not 144
     with pytest.raises(InputError, match="times"):
         analyse_history(tension, air, REFERENCE, times=seconds[:-1])
@@ -124,9 +128,29 @@ def test_healthy_histories_of_one_to_seven_days_report_no_change():
 
 
 def test_a_loss_under_daily_swings_is_found_within_three_records_and_sized():
-    """200 histories with a 1.5 % loss, swings 0.1 % … 1 %: each found (alone) within 3 records of its start;
-    its size within 2σ in ≥ 93 % (an honest 1σ gives 95.4 %; 93 % is 1.5 binomial σ below for 200 histories,
-    measured: see the assertion's message) and within 3σ in ≥ 98 % (99.7 % expected)."""
+    """200 histories with a 1.5 % loss, swings 0.1 % … 1 % (the issue's acceptance): each found, alone, within 3
+    records of its start; its size within 2σ in ≥ 92 % and within 3σ in ≥ 98 %. An honest 1σ gives 95.4 % and
+    99.7 %; measured over seeds 12-15 with 300 histories each: 93-96 % and 99-100 % (hourly records, whose
+    windows of 48 records give the scatter and its correlation less well: 93 %), |z| at most 3.7. 92 % is 2
+    binomial σ below 95.4 % for 200 histories."""
     found, z = _steps(200, seed=12)
     assert found.all(), np.flatnonzero(~found)
-    assert np.mean(z <= 2) >= 0.93 and np.mean(z <= 3) >= 0.98, (np.mean(z <= 1), np.mean(z <= 2), np.mean(z <= 3))
+    assert np.mean(z <= 2) >= 0.92 and np.mean(z <= 3) >= 0.98, (np.mean(z <= 1), np.mean(z <= 2), np.mean(z <= 3))
+
+
+def test_a_cable_lagging_the_air_is_modelled_not_mistaken_for_a_change():
+    """The cable's temperature 2 h behind the air's, a swing of ±1 % and 0.03 % scatter: the lag's misfit
+    (±0.5 %) dwarfs the scatter. The lag is fitted (a term in dθ/dt) and a 1.5 % loss is found at its record;
+    without the term, the misfit hid it (no event at all in these 5 histories)."""
+    rng = np.random.default_rng(6)
+    for k in range(10):
+        healthy = k % 2 == 0
+        tension, air, times = _history(rng, days=4, interval=1800.0, step_at=None if healthy else 130, swing=0.01,
+                                       scatter=3e-4, lag=2.0)
+        history = analyse_history(tension, air, REFERENCE, times=times)
+        assert abs(history.thermal_lag - 2.0) < 0.3, history.thermal_lag  # θ(t − L) ≈ θ − L dθ/dt: first order
+        if healthy:
+            assert history.events == ()
+        else:
+            [event] = history.events
+            assert abs(event.index - 130) <= 1 and abs(event.change - STEP) <= 4 * event.uncertainty, event
