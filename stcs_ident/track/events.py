@@ -129,7 +129,9 @@ class History:
     events: tuple[Event, ...]
     state: str = MONITORING
     monitored_from: int = 0
-    thermal_lag: float = 0.0  # L, h: the cable's temperature behind the records' (0 without temperatures)
+    # L, h (records when the history has no times): the cable's temperature behind the records'; 0 without
+    # temperatures, and meaningless where b is (no thermal effect to lag)
+    thermal_lag: float = 0.0
 
 
 def analyse_history(tension: np.ndarray, temperature: np.ndarray, reference: float, *,
