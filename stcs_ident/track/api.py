@@ -225,8 +225,10 @@ def _histories(specs: list[CableSpec], table: pd.DataFrame):
     for spec in specs:
         rows = table.index[(table["cable"] == spec.name) & (table["status"] == "ok")]
         rows = table.loc[rows].sort_values("start_time", kind="stable").index
+        starts = table.loc[rows, "start_time"]
         history = analyse_history(table.loc[rows, "tension"].to_numpy(), table.loc[rows, "temperature"].to_numpy(),
-                                  spec.reference_tension)
+                                  spec.reference_tension,
+                                  times=(starts - starts.min()).dt.total_seconds().to_numpy(dtype=float))
         table.loc[rows, "tension_normalised"] = history.normalised
         table.loc[rows, "level"] = spec.reference_tension * (1 + history.level)
         histories[spec.name] = (rows, history)

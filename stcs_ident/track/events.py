@@ -1,52 +1,80 @@
 """A cable's tension history: normalised for temperature, and its lasting changes found (CUSUM).
 
 Model
-    y_i = T_i / T_ref − 1 = μ_j + b (θ_i − θ̄) + e_i
+    y_i = T_i / T_ref − 1 = μ_j + b (θ_i − θ̄) + c θ̇_i + e_i
 
     with μ_j the level between two lasting changes, b the relative change
     of tension per °C (a cable's thermal strain against its anchorages),
-    θ_i the record's temperature (b = 0 when records carry none) and e_i
-    the record-to-record scatter (traffic and wind: the mean tension over
-    ten minutes is not the same twice) plus the identification's own error.
-    The normalised tension is T_ref (1 + y_i − b (θ_i − θ̄)): what it would
-    have been at the mean temperature θ̄.
+    θ_i the record's temperature (b = c = 0 when records carry none), θ̇_i
+    its rate (°C/h, from the records' times; per record without them) and
+    c = −b L for a cable whose own temperature lags the recorded one by L
+    (θ(t − L) ≈ θ − L θ̇: the sun heats the air before the steel), e_i the
+    record-to-record scatter (traffic and wind: the mean tension over ten
+    minutes is not the same twice), the identification's own error and
+    what the temperature model still misses (a weather drift the cable does
+    not follow: slow, correlated from record to record). The normalised
+    tension is T_ref (1 + y_i − b (θ_i − θ̄) − c θ̇_i): what it would have
+    been at the mean temperature θ̄.
 
 Detection: Page's two-sided CUSUM (Page 1954; Montgomery, *Introduction to
 Statistical Quality Control*, ch. 9) run as a monitor would have run it,
 record after record:
 
-1. The first ``TRAINING`` records (a day of 10-minute records) give the
-   level μ, the thermal coefficient b (least squares) and the scatter s
-   (1.4826 × the median absolute residual: robust to an outlier).
-2. Each later record's standardised residual z = (y − μ − b (θ − θ̄)) / s,
-   clipped to ±``CLIP`` (a single wild record adds at most CLIP − k: a
-   change must last to be seen), feeds S⁺ = max(0, S⁺ + z − k) and
-   S⁻ = max(0, S⁻ − z − k); an alarm when either exceeds h. Between
-   alarms μ follows the residuals slowly (an exponential average with a
-   day's memory, ``ADAPT``): a slow drift (a season, a temperature the
-   linear model does not follow) is not a lasting change, a step is
-   found within a few records, long before the average moves.
-3. The change started where the alarming sum last left zero (the maximum
-   likelihood change point of a step under the CUSUM). Its size is the
-   difference of the levels before (since the last change) and after (the
-   next ``TRAINING`` records, or all that remain), relative to the level
-   before, with 1σ √(s_b² f_b / n_b + s_a² f_a / n_a): each window's
-   robust scatter, its size, and f = (1 + ρ)/(1 − ρ) for residuals
-   correlated from record to record (ρ their lag-1 correlation); the
-   monitor restarts at the new level after those records.
+1. Training. The records of the first day (``TRAINING_SPAN``, by the
+   records' times; without times, the first ``TRAINING`` records, a day of
+   10-minute records), and at least ``MIN_TRAINING`` records, give the
+   level μ, b and c (least squares over a whole daily cycle) and the
+   scatter. A history that does not reach ``MIN_MONITORED`` records past
+   its training window has **not enough history yet**
+   (:attr:`History.state`): no change is reported, whatever the records
+   show. The training window was once cut to half the history when the
+   history was short: a 1-day archive then fitted b on half a day's cycle
+   and reported its other half's misfit as a lasting change (+0.37 %).
+2. The residuals are counted in their long-run scatter s √((1 + ρ)/(1 − ρ)):
+   s robust (1.4826 × the median absolute residual), ρ the lag-1
+   correlation of the training residuals (with its small-sample bias,
+   (1 + 3ρ)/n, added back). What the temperature model misses is slow;
+   counted against the record-to-record s alone it added up in the sums
+   like a change. Each later record's standardised residual z, clipped to
+   ±``CLIP`` (a single wild record adds at most CLIP − k: a change must
+   last to be seen), feeds S⁺ = max(0, S⁺ + z − k) and
+   S⁻ = max(0, S⁻ − z − k); an alarm when either exceeds h. Between alarms
+   μ follows the residuals slowly (an exponential average with the
+   training window's memory, ``ADAPT``): a slow drift is not a lasting
+   change, a step is found within a few records, long before the average
+   moves.
+3. Where and how large. The CUSUM's own change point (where the alarming
+   sum last left zero) is only a start: a step under a daily thermal swing
+   of comparable size is seen late, and the level has begun to follow it.
+   The change is placed and sized by least squares on the relative
+   tensions around it (a day before, a day after, since the last change),
+   y = μ + Δ H(i − τ) + b (θ − θ̄) + c θ̇, the temperature terms fitted
+   jointly with the step and τ the record that minimises the residual sum
+   of squares among those from a day before the alarm to the alarm. Held
+   fixed, b would absorb the part of the step that its window's
+   temperatures correlate with, and the followed level would take some
+   more: a 1.5 % loss under a thermal swing half its size was found 6
+   records late and sized −1.24 %. The 1σ of Δ is the regression's, from
+   the robust scatter of its residuals (× n / (n − p) for the p fitted
+   terms), times (1 + ρ)/(1 − ρ) in variance for residuals correlated from
+   record to record. An alarm whose step is less than ``CONFIRM`` σ is no
+   change (a slow misfit the sums caught): the sums restart from zero at
+   the level of the last day's records. Else the change is Δ / (1 + μ)
+   (after / before − 1) and the monitor restarts at the new level after a
+   new training window.
 
-Then b is fitted again on the whole history with one level per segment
-between the changes found, and the detection is run once more with it
-(a day's cycle alone fits b less well than weeks of them).
+Then b and c are fitted again on the whole history with one level per
+segment between the changes found, and the detection is run once more
+with them (a day's cycle alone fits them less well than weeks of them).
 
 Choice of k and h: k = 1 (a change of 2 s is detected fastest) and h = 8.
 For independent Gaussian residuals the average run between false alarms
 (Siegmund's approximation, two-sided) is then beyond 10⁷ records; the
-residuals of a real history are neither (a thermal lag the linear model
-misses, weather), which is why h is high: the false-alarm rate on healthy
-simulated histories with daily cycles and scatter is measured in
-``benchmarks/track.py``. With CLIP = 4, a change of 5 s or more is found
-after 3 records.
+residuals of a real history are neither, which is why h is high: the
+false-alarm rate on healthy simulated histories with daily cycles and
+scatter is measured in ``benchmarks/track.py`` and in
+``tests/test_track_events.py``. With CLIP = 4, a change of 5 long-run s
+or more raises the alarm after 3 records.
 """
 
 from __future__ import annotations
@@ -55,14 +83,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CLIP", "THRESHOLD", "TRAINING", "Event", "History", "analyse_history"]
+from ..core.errors import InputError
 
-TRAINING = 144  # records that set a level: a day of 10-minute records
+__all__ = ["CLIP", "MIN_MONITORED", "MIN_TRAINING", "NOT_ENOUGH_HISTORY", "THRESHOLD", "TRAINING", "TRAINING_SPAN",
+           "Event", "History", "analyse_history"]
+
+TRAINING = 144  # records that set a level when the records carry no times: a day of 10-minute records
+TRAINING_SPAN = 86400.0  # s: with times, the records of the first day set the level (a whole daily cycle)
 SLACK = 1.0  # k, in units of the scatter
 THRESHOLD = 8.0  # h, in units of the scatter
 CLIP = 4.0  # standardised residuals are clipped to ± this before the sums
 MIN_TRAINING = 12  # fewer records than this cannot set a level
-ADAPT = 1.0 / TRAINING  # the monitored level follows the residuals with this weight per record
+MIN_MONITORED = 3  # records after the training window before a change can be seen (one must last 3 records)
+CONFIRM = 4.0  # an alarm is a change only if the step fitted around it is this many of its 1σ
+ADAPT = 1.0  # the monitored level follows the residuals with this weight per training window of records
+MONITORING = "monitoring"
+NOT_ENOUGH_HISTORY = "not enough history yet"
 
 
 @dataclass(frozen=True)
@@ -77,7 +113,13 @@ class Event:
 
 @dataclass(frozen=True)
 class History:
-    """A cable's analysed history: per record the normalised tension, and the events."""
+    """A cable's analysed history: per record the normalised tension, and the events.
+
+    ``state`` is ``"monitoring"`` once the history reaches ``MIN_MONITORED``
+    records past its training window (``monitored_from``, the first record
+    a change could be seen at), else ``"not enough history yet"`` (no event
+    can be reported; ``monitored_from`` is then the history's length).
+    """
 
     normalised: np.ndarray  # N, at the mean temperature
     level: np.ndarray  # relative level μ of each record's segment
@@ -85,45 +127,112 @@ class History:
     mean_temperature: float
     scatter: float  # s, relative
     events: tuple[Event, ...]
+    state: str = MONITORING
+    monitored_from: int = 0
+    # L, h (records when the history has no times): the cable's temperature behind the records'; 0 without
+    # temperatures, and meaningless where b is (no thermal effect to lag)
+    thermal_lag: float = 0.0
 
 
 def analyse_history(tension: np.ndarray, temperature: np.ndarray, reference: float, *,
-                    training: int = TRAINING) -> History:
-    """Normalise a cable's tension history (records in time order) and find its lasting changes."""
+                    training: int = TRAINING, times: np.ndarray | None = None) -> History:
+    """Normalise a cable's tension history (records in time order) and find its lasting changes.
+
+    Parameters
+    ----------
+    tension, temperature : ndarray (N,)
+        Per record, in time order; temperatures NaN (or constant) when the
+        records carry none.
+    reference : float
+        The reference tension T_ref (N).
+    training : int
+        Records that set a level when ``times`` is not given.
+    times : ndarray (N,), optional
+        The records' start times, seconds from any origin or datetime64:
+        the training window is then the first day of records
+        (``TRAINING_SPAN``), whatever the interval between records.
+
+    Returns
+    -------
+    History
+        See the module docstring for the method.
+    """
     tension = np.asarray(tension, dtype=float)
     theta = np.asarray(temperature, dtype=float)
+    seconds = _seconds(times, tension.size)
     use_temperature = theta.size > 0 and np.all(np.isfinite(theta)) and np.ptp(theta) > 0
     mean_theta = float(np.mean(theta)) if use_temperature else float("nan")
-    x = theta - mean_theta if use_temperature else np.zeros_like(tension)
+    x = _thermal_terms(theta - mean_theta, seconds) if use_temperature else np.zeros((tension.size, 0))
     y = tension / reference - 1.0
-    training = max(MIN_TRAINING, min(training, y.size // 2))
-    if y.size < 2 * MIN_TRAINING:
-        b = _thermal(y, x, np.zeros(y.size, dtype=int)) if use_temperature else 0.0
-        levels = np.full(y.size, np.median(y - b * x)) if y.size else y
-        return History(reference * (1 + y - b * x), levels, b, mean_theta, _scale(y - b * x - levels), ())
-    b = _thermal(y[:training], x[:training], np.zeros(training, dtype=int)) if use_temperature else 0.0
-    events = _detect(y, x, b, training)
+    training = _training_length(seconds, training)
+    if y.size < training + MIN_MONITORED:
+        beta = _thermal(y, x, np.zeros(y.size, dtype=int)) if y.size > x.shape[1] + 1 else np.zeros(x.shape[1])
+        r = y - x @ beta
+        levels = np.full(y.size, np.median(r)) if y.size else y
+        b, lag = _coefficients(beta)
+        return History(reference * (1 + r), levels, b, mean_theta, _scale(r - levels), (), NOT_ENOUGH_HISTORY,
+                       int(y.size), lag)
+    beta = _thermal(y[:training], x[:training], np.zeros(training, dtype=int))
+    events = _detect(y, x, beta, training)
     if use_temperature:  # b again, from the whole history with a level per segment
-        b = _thermal(y, x, _segments(y.size, events))
-        events = _detect(y, x, b, training)
+        beta = _thermal(y, x, _segments(y.size, events))
+        events = _detect(y, x, beta, training)
     segments = _segments(y.size, events)
-    levels = np.array([np.mean((y - b * x)[segments == j]) for j in range(len(events) + 1)])[segments]
-    return History(reference * (1 + y - b * x), levels, float(b), mean_theta, _scale(y - b * x - levels),
-                   tuple(events))
+    r = y - x @ beta
+    levels = np.array([np.mean(r[segments == j]) for j in range(len(events) + 1)])[segments]
+    b, lag = _coefficients(beta)
+    return History(reference * (1 + r), levels, b, mean_theta, _scale(r - levels), tuple(events), MONITORING,
+                   int(training), lag)
 
 
-def _detect(y: np.ndarray, x: np.ndarray, b: float, training: int) -> list[Event]:
-    """The sequential CUSUM of the module docstring, with the thermal coefficient ``b`` held."""
-    r = y - b * x
+def _seconds(times, n: int) -> np.ndarray | None:
+    """The records' times in seconds from the first, or None (not given, or not all finite)."""
+    if times is None:
+        return None
+    t = np.asarray(times)
+    if np.issubdtype(t.dtype, np.datetime64):
+        t = (t - t[0]) / np.timedelta64(1, "s") if t.size else t.astype(float)
+    t = np.asarray(t, dtype=float)
+    if t.size != n:
+        raise InputError(f"has {t.size} values for {n} tensions", field="times")
+    return t - t[0] if n and np.all(np.isfinite(t)) else None
+
+
+def _training_length(seconds: np.ndarray | None, training: int) -> int:
+    """Records in the training window: the first day's by their times if known, else ``training``."""
+    if seconds is not None:
+        return max(MIN_TRAINING, int(np.sum(seconds < TRAINING_SPAN - 0.5)))  # ½ s: rounding
+    return max(MIN_TRAINING, int(training))
+
+
+def _thermal_terms(x: np.ndarray, seconds: np.ndarray | None) -> np.ndarray:
+    """The temperature regressors: θ − θ̄ and its rate dθ/dt (°C/h; per record without usable times)."""
+    hours = seconds / 3600.0 if seconds is not None and np.all(np.diff(seconds) > 0) else np.arange(x.size, dtype=float)
+    rate = np.gradient(x, hours) if x.size > 1 else np.zeros_like(x)
+    return np.column_stack([x, rate])
+
+
+def _coefficients(beta: np.ndarray) -> tuple[float, float]:
+    """b (per °C) and the lag of the cable's temperature behind the records' (h, from y ≈ b θ(t − L))."""
+    if beta.size == 0:
+        return 0.0, 0.0
+    b = float(beta[0])
+    return b, float(-beta[1] / b) if b != 0 else 0.0
+
+
+def _detect(y: np.ndarray, x: np.ndarray, beta: np.ndarray, training: int) -> list[Event]:
+    """The sequential CUSUM of the module docstring, the temperature terms ``beta`` held while monitoring."""
+    r = y - x @ beta
     events: list[Event] = []
     start = 0  # first record of the current level's training window
+    adapt = ADAPT / training
     while start + training < r.size:
         base = r[start:start + training]
         level = np.median(base)
-        scale = _scale(base - level)
+        scale = _scale(base - level) * np.sqrt(_correlation_factor(base - np.mean(base)))
         up = down = 0.0
         last_zero_up = last_zero_down = start + training
-        alarm = None
+        event = None
         for i in range(start + training, r.size):
             z = np.clip((r[i] - level) / scale, -CLIP, CLIP)
             up, down = max(0.0, up + z - SLACK), max(0.0, down - z - SLACK)
@@ -132,30 +241,58 @@ def _detect(y: np.ndarray, x: np.ndarray, b: float, training: int) -> list[Event
             if down == 0.0:
                 last_zero_down = i + 1
             if up > THRESHOLD or down > THRESHOLD:
-                alarm = i
-                break
-            level += ADAPT * np.clip(r[i] - level, -CLIP * scale, CLIP * scale)  # follows a slow drift
-        if alarm is None:
+                guess = last_zero_up if up > THRESHOLD else last_zero_down
+                event = _fit_step(y, x, events[-1].index if events else 0, guess, i, training, start + training)
+                if abs(event.change) >= CONFIRM * event.uncertainty:
+                    break
+                # not a step: what the temperature model misses, slow and correlated; the level catches up
+                event, up, down = None, 0.0, 0.0
+                last_zero_up = last_zero_down = i + 1
+                level = np.median(r[max(start, i + 1 - training):i + 1])
+                continue
+            level += adapt * np.clip(r[i] - level, -CLIP * scale, CLIP * scale)  # follows a slow drift
+        if event is None:
             break
-        change_at = last_zero_up if up > THRESHOLD else last_zero_down
-        before = r[max(events[-1].index if events else 0, change_at - training):change_at]
-        after = r[change_at:change_at + training]
-        mean_before, mean_after = float(np.mean(before)), float(np.mean(after))
-        uncertainty = np.sqrt(_mean_variance(before) + _mean_variance(after)) / (1 + mean_before)
-        events.append(Event(int(change_at), (1 + mean_after) / (1 + mean_before) - 1, float(uncertainty),
-                            int(alarm)))
-        start = change_at
+        events.append(event)
+        start = event.index
     return events
 
 
-def _mean_variance(values: np.ndarray) -> float:
-    """Variance of the mean of ``values``, residuals correlated from record to record as AR(1): s²/n ×
-    (1 + ρ) / (1 − ρ), s robust and ρ the lag-1 correlation (0 … 0.95). Without the factor, the 1σ of a
-    change was a third too small under a slow drift the temperature model does not follow."""
-    r = values - np.mean(values)
-    rho = float(np.sum(r[1:] * r[:-1]) / np.sum(r * r)) if values.size > 2 and np.any(r) else 0.0
-    rho = min(max(rho, 0.0), 0.95)
-    return _scale(r) ** 2 / values.size * (1 + rho) / (1 - rho)
+def _fit_step(y: np.ndarray, x: np.ndarray, first: int, guess: int, alarm: int, training: int,
+              earliest: int) -> Event:
+    """The change's record and size: least squares of y = μ + Δ H(i − τ) + b x around it (b fitted jointly),
+    τ among the records from a day before the alarm (not before ``earliest``) to the alarm."""
+    lo = max(first, guess - training)
+    hi = min(y.size, max(guess, alarm) + training)
+    candidates = range(max(earliest, alarm - training + 1, lo + 2), alarm + 1)
+    best = None
+    for tau in candidates:
+        design = _step_design(x[lo:hi], tau - lo)
+        coefficients, *_ = np.linalg.lstsq(design, y[lo:hi], rcond=None)
+        rss = float(np.sum((y[lo:hi] - design @ coefficients) ** 2))
+        if best is None or rss < best[0]:
+            best = (rss, tau, coefficients, design)
+    _, tau, coefficients, design = best
+    residuals = y[lo:hi] - design @ coefficients
+    covariance = np.linalg.pinv(design.T @ design)
+    dof = residuals.size / max(residuals.size - design.shape[1], 1)  # residuals are smaller than the errors
+    variance = _scale(residuals) ** 2 * dof * covariance[1, 1] * _correlation_factor(residuals)
+    mu, delta = float(coefficients[0]), float(coefficients[1])
+    return Event(int(tau), delta / (1 + mu), float(np.sqrt(variance)) / (1 + mu), int(alarm))
+
+
+def _step_design(x: np.ndarray, at: int) -> np.ndarray:
+    n = x.shape[0]
+    return np.column_stack([np.ones(n), (np.arange(n) >= at).astype(float), x])
+
+
+def _correlation_factor(residuals: np.ndarray) -> float:
+    """(1 + ρ)/(1 − ρ), ρ the lag-1 correlation of ``residuals`` (0 … 0.95): the variance of a mean of
+    residuals correlated from record to record as AR(1), relative to independent ones."""
+    r = residuals - np.mean(residuals) if residuals.size else residuals
+    rho = float(np.sum(r[1:] * r[:-1]) / np.sum(r * r)) if r.size > 2 and np.any(r) else 0.0
+    rho = min(max(rho + (1 + 3 * rho) / max(r.size, 1), 0.0), 0.95)  # + its bias over n records (Kendall 1954)
+    return (1 + rho) / (1 - rho)
 
 
 def _segments(n: int, events: list[Event]) -> np.ndarray:
@@ -165,11 +302,13 @@ def _segments(n: int, events: list[Event]) -> np.ndarray:
     return segment
 
 
-def _thermal(y: np.ndarray, x: np.ndarray, segment: np.ndarray) -> float:
-    """b of y = μ_segment + b x, least squares."""
-    columns = [x] + [(segment == j).astype(float) for j in range(int(segment.max()) + 1)]
-    coefficients, *_ = np.linalg.lstsq(np.column_stack(columns), y, rcond=None)
-    return float(coefficients[0])
+def _thermal(y: np.ndarray, x: np.ndarray, segment: np.ndarray) -> np.ndarray:
+    """The coefficients of the temperature terms ``x`` (N, p) in y = μ_segment + x β, least squares."""
+    if x.shape[1] == 0:
+        return np.zeros(0)
+    levels = [(segment == j).astype(float) for j in range(int(segment.max()) + 1)]
+    coefficients, *_ = np.linalg.lstsq(np.column_stack([x, *levels]), y, rcond=None)
+    return coefficients[:x.shape[1]]
 
 
 def _scale(residuals: np.ndarray) -> float:
