@@ -8,6 +8,7 @@ now is gives (:func:`_clean`), and what the run says it did (``counts``).
 
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
 import warnings
@@ -228,3 +229,106 @@ def test_a_dangling_link_and_a_folder_named_like_a_record_are_not_records(archiv
     result = track(archive, tmp_path / "out")
     assert result.summary()["cables"]["C1"]["records"] == 4
     assert "records/folder.h5/inside.h5" in set(result.table["record"])
+
+
+# Reruns as a property: whatever happens to the archive and the output between runs, the rerun's table is that
+# of a first run on the archive as it then is.
+
+hypothesis = pytest.importorskip("hypothesis")
+st = hypothesis.strategies
+
+#: An operation on the archive or the output: (kind, cable, which record / value).
+OPERATIONS = st.tuples(st.sampled_from(["add", "remove", "modify", "copy", "campaign", "corrupt", "kill"]),
+                       st.sampled_from(["C1", "C2"]), st.integers(0, 7))
+
+
+class Killed(BaseException):
+    """The run stopped dead after writing a part (kill -9 between a part and the table)."""
+
+
+@pytest.fixture(scope="module")
+def pool(tmp_path_factory):
+    """Records of distinct contents to add to the archive."""
+    root = tmp_path_factory.mktemp("pool")
+    options = ArchiveOptions(days=4 / 48, interval=1800, duration=10, sampling_rate=50, sensors=(0.3,))
+    arch = simulate_archive({"P": _campaign(root / "campaign")}, root / "archive", options=options, seed=23)
+    return records(arch, "P")
+
+
+def _apply(operation, archive: Path, out: Path, pool: list[Path], step: int) -> None:
+    kind, cable, k = operation
+    mine = records(archive, cable)
+    other = records(archive, "C2" if cable == "C1" else "C1")
+    if kind == "add":
+        shutil.copy(pool[k % len(pool)], archive / cable / "records" / f"added-{step}.h5")
+    elif kind == "remove" and mine:
+        mine[k % len(mine)].unlink()
+    elif kind == "modify" and mine:
+        with h5py.File(mine[k % len(mine)], "r+") as h5:
+            h5.attrs["temperature"] = 10.0 + k + 0.5 * step  # another content each time
+    elif kind == "copy" and other:
+        shutil.copy(other[k % len(other)], archive / cable / "records" / f"copied-{step}.h5")
+    elif kind == "campaign":
+        toml = archive / cable / "campaign.toml"
+        text = toml.read_text()
+        toml.write_text(text.replace("mass_per_length = 30.0", "mass_per_length = 31.5") if "= 30.0" in text
+                        else text.replace("mass_per_length = 31.5", "mass_per_length = 30.0"))
+    elif kind == "corrupt":
+        parts = sorted((out / "parts").glob("*.parquet")) if out.exists() else []
+        if parts:
+            part = parts[k % len(parts)]
+            part.write_bytes(part.read_bytes()[: 50 * k])  # truncated, or empty for k = 0
+    elif kind == "kill":
+        api = importlib.import_module("stcs_ident.track.api")  # the module (stcs_ident.track is also a function)
+
+        def killed(out_, rows):
+            append_part(out_, rows)
+            raise Killed
+        with h5py.File(mine[0], "r+") if mine else _nothing() as h5:  # something to do for the killed run
+            if h5 is not None:
+                h5.attrs["temperature"] = 40.0 + step
+        original = api.append_part
+        api.append_part = killed
+        try:
+            track(archive, out, batch=1)
+        except Killed:
+            pass
+        finally:
+            api.append_part = original
+
+
+class _nothing:
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc):
+        return False
+
+
+@pytest.mark.slow
+def test_reruns_after_any_sequence_of_changes_give_the_table_of_a_first_run(pristine, pool, tmp_path_factory):
+    """Random sequences of archive operations (add, remove, modify, copy into another cable, edit a campaign,
+    corrupt a part, kill a run after a part), each followed by a rerun: the last table is that of a first run
+    on the final archive (every column that says what a row is)."""
+
+    @hypothesis.settings(max_examples=15, deadline=None, database=None, derandomize=True,
+                         suppress_health_check=[hypothesis.HealthCheck.too_slow])
+    @hypothesis.given(st.lists(OPERATIONS, min_size=1, max_size=5))
+    def check(operations):
+        root = tmp_path_factory.mktemp("run")
+        archive = Path(shutil.copytree(pristine, root / "archive"))
+        out = root / "out"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TrackWarning)  # the corrupted parts: reported, and rebuilt
+            track(archive, out)
+            for step, operation in enumerate(operations):
+                _apply(operation, archive, out, pool, step)
+                rerun = track(archive, out, batch=2)
+            assert rerun.counts["unchanged"] + rerun.counts["new"] + rerun.counts["changed"] + \
+                rerun.counts["stale"] + rerun.counts["retried"] == len(rerun.table)
+            assert not rerun.table.duplicated(["cable", "record"]).any()
+            assert_same_table(rerun.table, track(archive, root / "clean").table)
+            assert track(archive, out).counts["unchanged"] == len(rerun.table)  # and the next rerun has nothing to do
+        shutil.rmtree(root)
+
+    check()
