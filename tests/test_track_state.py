@@ -332,3 +332,24 @@ def test_reruns_after_any_sequence_of_changes_give_the_table_of_a_first_run(pris
         shutil.rmtree(root)
 
     check()
+
+
+def test_every_cable_is_in_the_report_whatever_its_state(archive, tmp_path, capsys):
+    """One good record (C1), all failed (C2), no record yet (C3): each its row in cables.csv, its line in
+    report.md, its figure."""
+    for path in records(archive, "C1")[1:]:
+        path.unlink()
+    for i, path in enumerate(records(archive, "C2")):
+        path.write_text(f"not a record {i}\n")
+    shutil.copytree(archive / "C2", archive / "C3", ignore=shutil.ignore_patterns("records"))
+    out = tmp_path / "out"
+    assert main(["track", str(archive), "--out", str(out)]) == 0
+    cables = pd.read_csv(out / "cables.csv").set_index("cable")
+    assert list(cables.index) == ["C1", "C2", "C3"]
+    assert cables[["records", "processed", "failed"]].to_dict("index") == {
+        "C1": {"records": 1, "processed": 1, "failed": 0}, "C2": {"records": 3, "processed": 0, "failed": 3},
+        "C3": {"records": 0, "processed": 0, "failed": 0}}
+    report = (out / "report.md").read_text()
+    for line in ("| C1 | 1 | 1 | 0 |", "| C2 | 3 | 0 | 3 |", "| C3 | 0 | 0 | 0 |", "[C3](C3.png)"):
+        assert line in report
+    assert {"C1.png", "C2.png", "C3.png"} <= {p.name for p in out.iterdir()}

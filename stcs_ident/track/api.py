@@ -1,16 +1,19 @@
 """``track``: an archive of field records into tension histories, on local processes or a Dask cluster.
 
-1. The cables and their records (:mod:`.archive`); a record already in the
-   output's table (known by content, with its path, size and modification
-   time as a shortcut that spares hashing it again) is skipped.
+1. The cables and their records (:mod:`.archive`), against the rows of the
+   output's parts: per record's path, unchanged, new, changed, stale (another
+   campaign, settings or toolkit: :func:`cable_version`) or retried (it
+   failed), and the paths gone (:mod:`.state`).
 2. The new records, in batches, each into a row (:mod:`.process`), on
    ``workers`` local processes or on the Dask cluster at ``scheduler``: the
    same function on the same inputs, so the same rows. Each finished batch
    is written as a part of the table (:mod:`.store`) before the next is
    awaited: memory holds a batch, never the archive, and a killed run keeps
    what it finished.
-3. Per cable, the history of the records that gave a tension: normalised for
-   temperature and its lasting changes found (:mod:`.events`).
+3. Per cable, its rows (one per record of the archive) into one part when
+   they changed, and the history of the records that gave a tension:
+   normalised for temperature and its lasting changes found
+   (:mod:`.events`). With ``cables``, the other cables keep their rows.
 4. The table (``records.parquet``) and a :class:`~.result.TrackResult`
    (the summary of the interface's JSON, the tables); the report is drawn
    from it by :func:`stcs_ident.report.track.write_report`.
