@@ -23,7 +23,7 @@ from stcs_ident.core.errors import TrackWarning
 from stcs_ident.simulate.archive import ArchiveOptions, simulate_archive
 from stcs_ident.track.api import track
 from stcs_ident.track.archive import discover
-from stcs_ident.track.store import ROW_COLUMNS, append_part
+from stcs_ident.track.store import ROW_COLUMNS, append_part, cable_key
 from tests.test_track import _campaign
 
 #: Tiny records: 10 s at 50 Hz on one channel give the hanger's first modes and a tension in about 0.1 s.
@@ -353,3 +353,18 @@ def test_every_cable_is_in_the_report_whatever_its_state(archive, tmp_path, caps
     for line in ("| C1 | 1 | 1 | 0 |", "| C2 | 3 | 0 | 3 |", "| C3 | 0 | 0 | 0 |", "[C3](C3.png)"):
         assert line in report
     assert {"C1.png", "C2.png", "C3.png"} <= {p.name for p in out.iterdir()}
+
+
+def test_the_cli_says_what_a_rerun_did_and_warns_once_of_a_damaged_part(archive, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["track", str(archive), "--out", str(out)]) == 0
+    assert "track: 6 new, 0 changed, 0 stale, 0 removed, 0 retried, 0 unchanged" in capsys.readouterr().err
+    next((out / "parts").glob(cable_key("C1") + "-*")).write_bytes(b"PAR1")  # C1's rows lost
+    records(archive, "C2")[0].unlink()
+    assert main(["track", str(archive), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("stcs-ident: warning:") == 1 and "cannot be read" in err and "Traceback" not in err
+    assert "track: 3 new, 0 changed, 0 stale, 1 removed, 0 retried, 2 unchanged" in err
+    assert main(["track", str(archive), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "warning" not in err and "track: 0 new, 0 changed, 0 stale, 0 removed, 0 retried, 5 unchanged" in err
