@@ -174,6 +174,18 @@ def test_a_relative_archive_path_reaches_the_workers_whole(archive, tmp_path, mo
     assert Path(spec.directory).is_absolute() and Path(spec.directory) == archive / "C1"
 
 
+def test_a_relative_archive_path_on_dask_workers_started_elsewhere(archive, tmp_path, monkeypatch):
+    """The issue's case: workers whose working directory is not the caller's got relative paths (every row
+    "failed: file not found"), and the failed rows were never retried."""
+    distributed = pytest.importorskip("distributed")
+    first = track(archive, tmp_path / "local").table
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        monkeypatch.chdir(archive.parent)  # after the workers started: their directory is another
+        result = track("archive", tmp_path / "dask", scheduler=cluster.scheduler_address)
+    assert (result.table["status"] == "ok").all()
+    assert_same_table(result.table, first)
+
+
 @pytest.mark.parametrize("damage", ["truncated", "zero-byte", "other columns"])
 def test_a_damaged_part_is_reported_and_its_records_processed_again(archive, tmp_path, damage):
     out = tmp_path / "out"
