@@ -134,10 +134,11 @@ def test_a_rerun_processes_only_new_records_known_by_content(small, tmp_path):
     records = small / "C1" / "records"
     day = next(records.iterdir())
     first = min(day.glob("*.h5"))
-    shutil.copy(first, records / "renamed-copy.h5")  # the same content under another name: not new
+    shutil.copy(first, records / "renamed-copy.h5")  # the same content under another name: a row, not processed
     calls.clear()
-    summary = track(small, out, progress=lambda done, total: calls.append(total)).summary()
-    assert calls == [] and summary["cables"]["C1"]["records"] == 24
+    result = track(small, out, progress=lambda done, total: calls.append(total))
+    assert calls == [] and result.summary()["cables"]["C1"]["records"] == 25
+    assert result.counts == {"new": 1, "changed": 0, "stale": 0, "removed": 0, "retried": 0, "unchanged": 24}
     (records / "renamed-copy.h5").unlink()
 
 

@@ -18,9 +18,10 @@ __all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parse
 def add_parser(sub) -> None:
     """The ``track`` subcommand and its options."""
     trk = command_parser(sub, "track",
-                         description="Processes the records of ARCHIVE/<cable>/records/ not processed before "
-                                     "(known by content): modes, tension with 1σ, temperature normalisation, "
-                                     "lasting changes. Writes OUT/records.parquet (and the same table as "
+                         description="Brings the table of ARCHIVE/<cable>/records/ up to date (a record new, "
+                                     "changed, processed under another campaign or failed before is processed; "
+                                     "a record gone leaves the table): modes, tension with 1σ, temperature "
+                                     "normalisation, lasting changes. Writes OUT/records.parquet (and the same table as "
                                      "OUT/records.csv), OUT/report.md, OUT/<cable>.png, OUT/events.csv and "
                                      "OUT/cables.csv.")
     trk.add_argument("archive", help="archive directory: one folder per cable with campaign.toml and records/")
@@ -51,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
     check_outputs([("--out", out, True), ("--json", args.json, False)], inputs)
     result = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
                    progress=True if sys.stderr.isatty() else _lines())
+    print(result.run_line(), file=sys.stderr)
     write_report(result)
     summary = result.summary()
     if args.json:

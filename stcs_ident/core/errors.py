@@ -74,6 +74,10 @@ class NumberingWarning(StcsWarning):
     """A mode-number assignment is doubtful."""
 
 
+class TrackWarning(StcsWarning):
+    """Something in the state of ``track``'s output was handled (an unreadable part rebuilt from the records)."""
+
+
 class BoundError(ComputationError):
     """A fit that stopped at a bound of a parameter: not a result.
 

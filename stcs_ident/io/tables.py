@@ -16,7 +16,7 @@ import pandas as pd
 
 from ..core.files import atomic_path
 
-__all__ = ["parquet_parts", "write_parquet"]
+__all__ = ["parquet_parts", "read_parquet_files", "write_parquet"]
 
 
 def write_parquet(frame: pd.DataFrame, path: str | os.PathLike) -> None:
@@ -42,3 +42,18 @@ def parquet_parts(directory: str | os.PathLike) -> pd.DataFrame | None:
     if not parts:
         return None
     return pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+
+
+def read_parquet_files(paths) -> tuple[list[tuple[Path, pd.DataFrame]], list[tuple[Path, str]]]:
+    """Read each Parquet file of ``paths``: ([(path, frame)] of those read, [(path, why)] of those that cannot be).
+
+    A file that cannot be read (truncated, empty, not Parquet, gone since listed) is returned with the
+    reason in one line instead of raising: the caller decides what it means.
+    """
+    read, unreadable = [], []
+    for path in paths:
+        try:
+            read.append((Path(path), pd.read_parquet(path)))
+        except Exception as err:  # noqa: BLE001 (pyarrow raises its own types: ArrowInvalid, OSError, ...)
+            unreadable.append((Path(path), " ".join(f"{type(err).__name__}: {err}".split())))
+    return read, unreadable

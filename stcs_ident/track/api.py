@@ -1,16 +1,19 @@
 """``track``: an archive of field records into tension histories, on local processes or a Dask cluster.
 
-1. The cables and their records (:mod:`.archive`); a record already in the
-   output's table (known by content, with its path, size and modification
-   time as a shortcut that spares hashing it again) is skipped.
+1. The cables and their records (:mod:`.archive`), against the rows of the
+   output's parts: per record's path, unchanged, new, changed, stale (another
+   campaign, settings or toolkit: :func:`cable_version`) or retried (it
+   failed), and the paths gone (:mod:`.state`).
 2. The new records, in batches, each into a row (:mod:`.process`), on
    ``workers`` local processes or on the Dask cluster at ``scheduler``: the
    same function on the same inputs, so the same rows. Each finished batch
    is written as a part of the table (:mod:`.store`) before the next is
    awaited: memory holds a batch, never the archive, and a killed run keeps
    what it finished.
-3. Per cable, the history of the records that gave a tension: normalised for
-   temperature and its lasting changes found (:mod:`.events`).
+3. Per cable, its rows (one per record of the archive) into one part when
+   they changed, and the history of the records that gave a tension:
+   normalised for temperature and its lasting changes found
+   (:mod:`.events`). With ``cables``, the other cables keep their rows.
 4. The table (``records.parquet``) and a :class:`~.result.TrackResult`
    (the summary of the interface's JSON, the tables); the report is drawn
    from it by :func:`stcs_ident.report.track.write_report`.
@@ -18,21 +21,26 @@
 
 from __future__ import annotations
 
+import hashlib
 import os
 import sys
+import warnings
 from collections.abc import Callable, Iterable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..core.errors import InputError
+from ..core.errors import InputError, TrackWarning
 from ..core.files import remove_stale
-from .archive import CableSpec, content_id, discover, record_paths
+from ..core.version import __version__
+from .archive import CableSpec, cable_names, content_id, discover
 from .events import analyse_history
-from .process import process_record
+from .process import MAX_MODES, process_record
 from .result import TrackResult
-from .store import append_part, processed_table, write_table
+from .state import COUNTS, current_rows, plan_cable
+from .store import append_part, cable_key, read_parts, replace_parts, sort_rows, write_table
 
 __all__ = ["BATCH", "default_out", "track"]
 
@@ -50,15 +58,23 @@ def process_batch(spec: CableSpec, items: list[tuple[str, str, int, int]]) -> li
     rows = []
     for path, record_id, size, mtime in items:
         row = process_record(spec, path, record_id or content_id(path))
-        row.update(size=size, mtime_ns=mtime)
+        row.update(version=spec.version, size=size, mtime_ns=mtime)
         rows.append(row)
     return rows
+
+
+def cable_version(spec: CableSpec) -> str:
+    """The version of what shapes a cable's rows: its campaign as parsed (not where it lies), the reference
+    test's setup and tension, the reader options, the modes picked per record and the toolkit's version."""
+    shaping = (replace(spec.campaign, directory=None), spec.setup, spec.reference_tension, spec.channels,
+               spec.record_format, MAX_MODES, __version__)
+    return hashlib.sha256(repr(shaping).encode("utf-8")).hexdigest()[:16]
 
 
 def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, cables: list[str] | None = None,
           workers: int = 1, scheduler: str | None = None, batch: int = BATCH,
           progress: bool | Callable = False) -> TrackResult:
-    """Process an archive's new records and analyse every cable's history (see the module docstring).
+    """Bring the table of an archive up to date and analyse every cable's history (see the module docstring).
 
     Parameters
     ----------
@@ -67,7 +83,8 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
         The output directory (default :func:`default_out`); it holds the
         state of the incremental runs.
     cables : list of str, optional
-        Only these cables.
+        Only these cables are brought up to date; the table keeps the rows
+        of the archive's other cables as their last run left them.
     workers : int
         Local processes (1: in this process).
     scheduler : str, optional
@@ -81,45 +98,65 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
     Returns
     -------
     TrackResult
-        The records table, each cable's history and events; ``.summary()`` is the ``track`` JSON of the
-        interface. :func:`stcs_ident.report.track.write_report` writes the report from it.
+        The records table, each cable's history and events, and what the run did (``counts``);
+        ``.summary()`` is the ``track`` JSON of the interface. :func:`stcs_ident.report.track.write_report`
+        writes the report from it.
     """
-    specs = discover(archive, cables)
+    specs = [replace(s, version=cable_version(s)) for s in discover(archive, cables)]
     out = Path(out) if out is not None else default_out(archive)
     out.mkdir(parents=True, exist_ok=True)
     remove_stale(out / "parts")  # what a killed run left, even if this one has nothing new to write there
-    known = processed_table(out)
-    pending = _pending(specs, known)
-    total = sum(len(items) for _, items in pending)
-    _run(_batches(pending, batch), total, workers, scheduler, out, progress)
-    table = processed_table(out)
+    known, read, unreadable = read_parts(out)
+    plans = [plan_cable(spec, known) for spec in specs]
+    total = sum(len(p.pending) for p in plans)
+    _run(_batches([(p.spec, p.pending) for p in plans], batch), total, workers, scheduler, out, progress)
+    if total:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TrackWarning)  # reported once, when read first
+            known, read, unreadable = read_parts(out)
+    counts = dict.fromkeys(COUNTS, 0)
+    tables = []
+    for plan in plans:
+        for key in COUNTS:
+            counts[key] += plan.counts[key]
+        rows = current_rows(plan, known)
+        tables.append(rows)
+        mine = [p for p in read + unreadable if p.name.startswith(cable_key(plan.spec.name) + "-")]
+        if plan.dirty or len(mine) > 1 or len(rows) != int((known["cable"] == plan.spec.name).sum()):
+            replace_parts(out, plan.spec.name, rows, mine)
+    specs, others, gone = _other_cables(archive, specs, known)
+    counts["removed"] += len(known[known["cable"].isin(gone)].drop_duplicates(["cable", "record"]))
+    for path in read:  # the parts of cables no longer in the archive
+        if path.name.split("-")[0] in {cable_key(name) for name in gone}:
+            path.unlink(missing_ok=True)
+    table = sort_rows(pd.concat([*tables, others], ignore_index=True).drop(columns="part"))
     table, histories = _histories(specs, table)
     write_table(out, table)
-    return TrackResult(str(archive), out, tuple(specs), table, histories)
+    return TrackResult(str(archive), out, tuple(specs), table, histories, counts=counts)
 
 
-def _pending(specs: list[CableSpec], known: pd.DataFrame) -> list[tuple[CableSpec, list]]:
-    """Per cable, the records not yet in the table: (path, id if already hashed, size, mtime_ns)."""
-    seen = {(c, r) for c, r in zip(known["cable"], known["record_id"])}
-    stats = {}
-    if "size" in known:
-        stats = {(c, p): (s, m, i) for c, p, s, m, i in
-                 zip(known["cable"], known["record"], known["size"], known["mtime_ns"], known["record_id"])}
-    out = []
-    for spec in specs:
-        items = []
-        for path in record_paths(spec):
-            st = path.stat()
-            relative = path.relative_to(spec.directory).as_posix()
-            cached = stats.get((spec.name, relative))
-            if cached is not None and cached[0] == st.st_size and cached[1] == st.st_mtime_ns:
-                continue  # the same file as when it was processed
-            record_id = content_id(path)
-            if (spec.name, record_id) in seen:
-                continue  # processed before, under another name or time stamp
-            items.append((str(path), record_id, int(st.st_size), int(st.st_mtime_ns)))
-        out.append((spec, items))
-    return out
+def _other_cables(archive, specs: list[CableSpec], known: pd.DataFrame):
+    """The specs of every cable in the table, in the archive's order (the selected ones, and the others that
+    have rows), the latest row per path of the others, and the names of the cables no longer in the archive."""
+    names = cable_names(archive)
+    selected = {s.name for s in specs}
+    rest = known[~known["cable"].isin(selected)].drop_duplicates(["cable", "record"], keep="last")
+    gone = sorted(set(rest["cable"]) - set(names))
+    keep = rest["cable"].isin(names)
+    by_name = {s.name: s for s in specs}
+    for name in sorted(set(rest.loc[keep, "cable"])):
+        try:
+            spec = discover(archive, [name])[0]
+        except InputError:  # a campaign that cannot be read now: its rows wait for a run of that cable
+            keep &= rest["cable"] != name
+            continue
+        by_name[name] = replace(spec, version=cable_version(spec))
+    kept = rest[keep]
+    # Rows processed under another campaign or toolkit are not this archive's any more: a run of their cable
+    # processes them again.
+    kept = kept[kept["version"] == kept["cable"].map(lambda c: by_name[c].version)]
+    ordered = [by_name[n] for n in names if n in by_name]
+    return ordered, kept, gone
 
 
 def _batches(pending, size: int) -> Iterable[tuple[CableSpec, list]]:

@@ -8,9 +8,10 @@
     ARCHIVE/<cable>/records/**/*       the records, in any registered format (by suffix: *.h5, *.csv, ...;
                                        start_time required, temperature optional)
 
-A record is known by the SHA-256 of its bytes, not by its name: a rerun
-skips what it processed before even when records were moved or renamed,
-and a record rewritten under the same name is processed again.
+A record is known by its place (cable and path below the cable's folder)
+and the SHA-256 of its bytes: a record rewritten under the same name is
+processed again, one copied or renamed within its cable reuses the row of
+its content (:mod:`.state`).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from ..io.campaign import load_campaign
 from ..io.content import content_id
 from ..io.records import record_suffixes
 
-__all__ = ["CableSpec", "content_id", "discover", "record_paths"]
+__all__ = ["CableSpec", "cable_names", "content_id", "discover", "record_paths"]
 
 
 @dataclass(frozen=True)
@@ -42,19 +43,21 @@ class CableSpec:
     reference_tension: float
     channels: tuple[tuple[str, float], ...] = ()
     record_format: tuple[tuple[str, Any], ...] = ()
+    #: What shaped the cable's rows (set by the run): its rows of another version are stale.
+    version: str = ""
 
 
 def discover(archive: str | os.PathLike, cables: list[str] | None = None) -> list[CableSpec]:
     """The cables of ``archive`` (folders holding a campaign.toml), all or those named in ``cables``."""
-    root = Path(archive)
+    given, root = str(archive), Path(archive).absolute()  # the records' paths reach other processes whole
     if not root.is_dir():
-        raise InputError("is not a directory (an archive holds one folder per cable)", file=str(root))
-    found = sorted(p.parent.name for p in root.glob("*/campaign.toml"))
+        raise InputError("is not a directory (an archive holds one folder per cable)", file=given)
+    found = cable_names(root)
     if not found:
-        raise InputError("holds no cable: expected <cable>/campaign.toml folders", file=str(root))
+        raise InputError("holds no cable: expected <cable>/campaign.toml folders", file=given)
     for name in cables or []:
         if name not in found:
-            raise InputError(f"no cable named {name!r} (known: {', '.join(found)})", field="--cable", file=str(root))
+            raise InputError(f"no cable named {name!r} (known: {', '.join(found)})", field="--cable", file=given)
     return [_cable(root / name) for name in (cables or found)]
 
 
@@ -75,3 +78,8 @@ def record_paths(spec: CableSpec) -> list[Path]:
     suffixes = record_suffixes()
     found = (Path(spec.directory) / "records").rglob("*")
     return sorted(p for p in found if p.name.lower().endswith(suffixes) and p.is_file())
+
+
+def cable_names(archive: str | os.PathLike) -> list[str]:
+    """The names of every cable of ``archive`` (folders holding a campaign.toml), sorted."""
+    return sorted(p.parent.name for p in Path(archive).glob("*/campaign.toml"))

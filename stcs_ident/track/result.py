@@ -48,6 +48,9 @@ class TrackResult(Result):
     histories : dict
         {cable: (row labels of ``table`` with a tension, in time order,
         :class:`~stcs_ident.track.events.History`)}.
+    counts : dict
+        What this run did, per kind of slot (:data:`~stcs_ident.track.state.COUNTS`: ``new``, ``changed``,
+        ``stale``, ``removed``, ``retried``, ``unchanged``); :meth:`run_line` says it in one line.
     settings : Settings
         The model settings every record was identified with.
     notes : tuple of Note
@@ -58,6 +61,7 @@ class TrackResult(Result):
     specs: tuple[CableSpec, ...]
     table: pd.DataFrame
     histories: dict[str, tuple[pd.Index, History]]
+    counts: dict[str, int] = field(default_factory=dict)
     settings: Settings = field(default_factory=Settings)
     notes: tuple = ()
 
@@ -109,6 +113,10 @@ class TrackResult(Result):
         events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items() for e in c["events"]],
                               columns=EVENT_COLUMNS)
         return {"cables": summary, "events": events, "records": self.table}
+
+    def run_line(self) -> str:
+        """What this run did: ``track: 3 new, 1 changed, 2 stale, 1 removed, 2 retried, 590 unchanged``."""
+        return "track: " + ", ".join(f"{n} {kind}" for kind, n in self.counts.items())
 
     def headline(self) -> str:
         """Archive, cables, records with a tension and failed, lasting changes found."""
