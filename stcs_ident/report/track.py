@@ -134,13 +134,13 @@ def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
              "numbered against the nominal model at the reference tension. The normalised tension removes a "
              "linear temperature effect fitted per cable; a lasting change is found by a two-sided CUSUM of the "
              "normalised tension (see the documentation of `track`)."), "", "## Cables", "",
-             "| cable | records | with a tension | failed | reference (kN) | per °C | scatter | events |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| cable | records | with a tension | failed | reference (kN) | per °C | scatter | events | state |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for _, c in cables.iterrows():
         thermal = "" if pd.isna(c["thermal_coefficient_per_C"]) else f"{100 * c['thermal_coefficient_per_C']:+.3f} %"
         scatter = "" if pd.isna(c["scatter"]) else f"{100 * c['scatter']:.2f} %"
         lines.append(f"| {c['cable']} | {c['records']} | {c['processed']} | {c['failed']} | "
-                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} |")
+                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} | {c['state']} |")
     lines += ["", "## Lasting changes", ""]
     if events.empty:
         lines.append("None found.")

@@ -88,6 +88,7 @@ class TrackResult(Result):
             "reference_tension": spec.reference_tension, "EI": spec.campaign.cable.EI,
             "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
+            "state": history.state,
             "events": [{"start_time": pd.Timestamp(times[e.index]).isoformat(),
                         "change": e.change, "uncertainty": e.uncertainty,
                         "alarm_time": pd.Timestamp(times[e.alarm]).isoformat()} for e in history.events],
@@ -108,7 +109,7 @@ class TrackResult(Result):
             {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
              "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
              "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"],
-             "events": len(c["events"])}
+             "events": len(c["events"]), "state": c["state"]}
             for name, c in cables.items()])
         events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items() for e in c["events"]],
                               columns=EVENT_COLUMNS)
