@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..io.tables import parquet_parts, write_parquet
+from ..io.tables import instant_column, parquet_parts, write_parquet
 from .process import COLUMNS
 
 __all__ = ["append_part", "processed_table", "write_table"]
@@ -31,7 +31,7 @@ ROW_COLUMNS = (*COLUMNS, "size", "mtime_ns")
 
 def _frame(rows: list[dict]) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(ROW_COLUMNS))
-    frame["start_time"] = pd.to_datetime(frame["start_time"], utc=True, errors="coerce", format="ISO8601")
+    frame["start_time"] = instant_column(frame["start_time"])  # the readers' rule for times (core/times.py)
     for name in ("temperature", "tension", "tension_sigma"):
         frame[name] = frame[name].astype(float)
     for name in ("n_modes", "size", "mtime_ns"):
