@@ -1,8 +1,13 @@
 """The ``stcs-ident`` command line: the top-level parser, and running one command of the table.
 
 Exit status 0 on success, 2 for bad input (one line on standard error
-naming the file, the field and what is wrong; nothing written), 1 for a
-computation that failed. ``--debug`` shows the traceback.
+naming the file, the field and what is wrong; nothing written) and for an
+output that cannot be written as given (read-only, full disk, gone: one
+line naming the path), 1 for a computation that failed, 130 for Ctrl-C
+(one line; the outputs already written whole are kept). ``--debug`` shows
+the traceback. Control characters in what the commands print (a test's
+name holding an escape sequence) are shown escaped, never sent raw to the
+terminal.
 
 Only the command being run is imported (:mod:`stcs_ident.cli.commands`),
 so ``--version`` and ``--help`` answer without loading the numerics.
@@ -21,7 +26,7 @@ from types import ModuleType
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.version import __version__
 from .commands import COMMANDS, Command, register_command, unregister_command
-from .common import examples_epilog, show_warning
+from .common import EscapedStream, examples_epilog, os_error_line, show_warning
 
 __all__ = ["COMMANDS", "DESCRIPTION", "EXAMPLES", "Command", "build_parser", "main", "register_command",
            "unregister_command"]
@@ -115,14 +120,22 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     command = _command_in(argv)
-    parser = build_parser([command] if command else [])
-    args = parser.parse_args(argv)
-    if not args.debug:
-        with warnings.catch_warnings():
-            warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts a command
-            warnings.showwarning = show_warning
-            return _run(args, parser)
-    return _run(args, parser)
+    try:
+        parser = build_parser([command] if command else [])
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        return _interrupted()
+    stdout = sys.stdout
+    sys.stdout = EscapedStream(stdout)  # names from files reach the terminal escaped (one place for every command)
+    try:
+        if not args.debug:
+            with warnings.catch_warnings():
+                warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts a command
+                warnings.showwarning = show_warning
+                return _run(args, parser)
+        return _run(args, parser)
+    finally:
+        sys.stdout = stdout
 
 
 def _as_option(err: InputError, command: str, parser: argparse.ArgumentParser) -> InputError:
@@ -155,6 +168,21 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             traceback.print_exc()
         print(f"stcs-ident: computation failed: {one_line(str(err))}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        if args.debug:
+            traceback.print_exc()
+        return _interrupted()
+    except OSError as err:  # what no writer named (a directory made for --plot, standard output closed): one line
+        if args.debug:
+            traceback.print_exc()
+        print(f"stcs-ident: {os_error_line(err)}", file=sys.stderr)
+        return 2
+
+
+def _interrupted() -> int:
+    """Ctrl-C: one line, exit status 130 (128 + SIGINT, as a shell reports it)."""
+    print("stcs-ident: interrupted (Ctrl-C); the outputs already written whole are kept", file=sys.stderr)
+    return 130
 
 
 if __name__ == "__main__":  # pragma: no cover
