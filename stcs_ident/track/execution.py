@@ -52,11 +52,12 @@ def check_scheduler(address) -> tuple[str, str, int]:
     return scheme, m["host"].strip("[]"), int(m["port"])
 
 
-def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+def probe_scheduler(address: str, timeout: float | None = None) -> None:
     """Refuse, within ``timeout`` seconds, a ``tcp://`` address where no Dask scheduler answers: nothing
     listening, no route, or a service that does not greet as Dask does (a scheduler sends its handshake,
     which names its ``pickle-protocol``, as soon as it accepts). Other schemes are left to Dask's own
-    timeout."""
+    timeout. ``timeout`` defaults to :data:`CONNECT_TIMEOUT`."""
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
     scheme, host, port = check_scheduler(address)
     if scheme != "tcp":
         return
@@ -149,12 +150,13 @@ def _watch_parent(parent: int) -> None:
 
 
 def run_dask(batches: Iterable[tuple], scheduler: str, work: Callable, done: Callable[[list], None],
-             timeout: float = CONNECT_TIMEOUT) -> None:
+             timeout: float | None = None) -> None:
     """``work(*batch)`` for every batch on the Dask cluster at ``scheduler``, ``done(rows)`` here as each
     finishes (twice the cluster's threads queued). The address is checked and the scheduler probed first
     (:func:`probe_scheduler`); Ctrl-C or any failure cancels what the cluster still holds and is raised
     again; what ``done`` wrote stays."""
     check_scheduler(scheduler)
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
     try:
         from distributed import Client, as_completed
     except ImportError:
