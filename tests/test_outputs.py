@@ -406,3 +406,38 @@ def test_control_characters_in_a_test_name_are_escaped(campaign, capsys):
     out, err = capsys.readouterr()
     assert status == 0, err
     assert "\x1b" not in out + err and "\\x1b[31mred" in out
+
+
+@pytest.fixture(scope="module")
+def dask_scheduler():
+    """The address of a local Dask cluster (one worker process) running in a subprocess."""
+    pytest.importorskip("distributed")
+    code = ("import sys, time\nfrom distributed import LocalCluster\nif __name__ == '__main__':\n"
+            "    c = LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=None)\n"
+            "    print(c.scheduler_address, flush=True)\n    sys.stdin.read()\n")
+    cluster = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True)
+    address = cluster.stdout.readline().strip()
+    yield address
+    cluster.stdin.close()  # the cluster ends when its input does
+    try:
+        cluster.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        cluster.kill()
+        cluster.wait()
+    cluster.stdout.close()
+
+
+@pytest.mark.slow
+def test_ctrl_c_on_dask_stops_with_one_line_and_keeps_the_parts(dask_scheduler, long_archive, tmp_path):
+    assert dask_scheduler.startswith("tcp://")
+    out = tmp_path / "out"
+    process = subprocess.Popen(_command("track", str(long_archive), "--out", str(out), "--scheduler", dask_scheduler),
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for_parts(out, process, timeout=120)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    _one_line(err)
+    assert "interrupted" in err
+    assert [p for p in (out / "parts").iterdir() if not p.name.startswith(".")]
