@@ -126,21 +126,34 @@ def test_json_onto_a_fifo_is_written_as_a_stream(campaign, tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["campaign", "result.fifo"]  # no temporary left
 
 
-def test_json_onto_dev_null_leaves_the_device(campaign, capsys):
-    before = os.stat("/dev/null")
-    assert main(["forward", str(campaign), "--json", "/dev/null"]) == 0
-    after = os.stat("/dev/null")
+@pytest.fixture
+def null_device(tmp_path):
+    """A character device that discards what is written: as root a null device made in ``tmp_path`` (a wrong
+    writer run as root would replace the system's /dev/null, which this very test once did), otherwise
+    /dev/null itself (which a user cannot replace: /dev is not theirs)."""
+    if os.geteuid() != 0:
+        return Path("/dev/null")
+    path = tmp_path / "null"
+    os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    return path
+
+
+def test_json_onto_a_device_leaves_the_device(null_device, campaign, capsys):
+    before = os.stat(null_device)
+    assert main(["forward", str(campaign), "--json", str(null_device)]) == 0
+    after = os.stat(null_device)
     assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
 
 
-def test_every_writer_streams_into_a_device():
+def test_every_writer_streams_into_a_device(null_device):
     import pandas as pd
     from matplotlib.figure import Figure
 
-    files.write_atomic("/dev/null", "{}\n")
-    files.write_csv(pd.DataFrame({"x": [1.0]}), "/dev/null")
-    files.write_figure(Figure(figsize=(1, 1)), "/dev/null")
-    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    files.write_atomic(null_device, "{}\n")
+    files.write_csv(pd.DataFrame({"x": [1.0]}), null_device)
+    files.write_figure(Figure(figsize=(1, 1)), null_device)
+    assert stat.S_ISCHR(os.stat(null_device).st_mode)
+    assert not list(null_device.parent.glob(f".{null_device.name}*"))  # no temporary left
 
 
 def test_json_onto_a_symlink_is_written_through_it(campaign, tmp_path, capsys):

@@ -56,10 +56,18 @@ def _output_error(err: OSError, path) -> OutputError:
     return OutputError(f"cannot write: {what}", file=str(path))
 
 
-def _ours(err: OSError, *paths) -> bool:
-    """Whether ``err`` is about one of ``paths`` (or names no file: a write that failed on an open stream)."""
-    names = {os.fspath(p) for p in paths}
-    return err.filename is None or os.fspath(err.filename) in names
+def _ours(err: OSError, *paths, within: Path | None = None, below: Path | None = None) -> bool:
+    """Whether ``err`` is about one of ``paths``, a file directly in ``within`` (a temporary of ours beside
+    the output), a file below ``below`` (in the temporary directory being filled), or names no file (a write
+    that failed on an open stream)."""
+    if err.filename is None:
+        return True
+    name = os.fspath(err.filename)
+    if name in {os.fspath(p) for p in paths}:
+        return True
+    if within is not None and os.path.dirname(name) == os.fspath(within):
+        return True
+    return below is not None and name.startswith(os.fspath(below) + os.sep)
 
 
 def output_target(path: str | os.PathLike) -> tuple[Path, bool]:
@@ -193,7 +201,7 @@ def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
     except OSError as err:
         if tmp is not None:
             _unlink_quietly(tmp)
-        if not _ours(err, path, target, directory, *([tmp] if tmp else [])):
+        if not _ours(err, path, target, directory, within=directory):
             raise
         raise _output_error(err, path) from err
     except BaseException:
@@ -301,8 +309,7 @@ def whole_directory(out: Path) -> Iterator[Path]:
         raise
     except OSError as err:
         _remove_tree(tmp)
-        if not _ours(err, given, out, out.parent, *([tmp] if tmp else [])) and not (
-                tmp is not None and str(err.filename or "").startswith(str(tmp))):
+        if not _ours(err, given, out, out.parent, *([tmp] if tmp else []), within=out.parent, below=tmp):
             raise
         raise _output_error(err, given) from err
     except BaseException:

@@ -37,13 +37,15 @@ CONNECT_TIMEOUT = 10.0
 #: Seconds between a worker's checks that its parent is alive.
 WATCH_INTERVAL = 0.5
 
-_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
+_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
 _ADDRESS = re.compile(r"(?:(?P<scheme>[a-z]+)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(?P<port>\d{1,5})")
 
 
 def check_scheduler(address) -> tuple[str, str, int]:
-    """``address`` as (scheme, host, port): ``[tcp|tls|ucx|ws|wss://]host:port`` with a port 1 … 65535,
-    else an :class:`~stcs_ident.core.errors.InputError` naming ``--scheduler`` (before any work)."""
+    """``address`` as (scheme, host, port): ``[tcp|tls|ucx|ws|wss://]host:port`` with a port 1 … 65535 (or
+    ``inproc://...``, a cluster in this process), else an :class:`~stcs_ident.core.errors.InputError` naming ``--scheduler`` (before any work)."""
+    if isinstance(address, str) and address.startswith("inproc://") and len(address) > len("inproc://"):
+        return "inproc", address[len("inproc://"):], 0  # a cluster in this process (a library caller's)
     m = _ADDRESS.fullmatch(address) if isinstance(address, str) else None
     scheme = (m["scheme"] or "tcp") if m else None
     if m is None or scheme not in _SCHEMES or not 1 <= int(m["port"]) <= 65535:
