@@ -43,7 +43,8 @@ _ADDRESS = re.compile(r"(?:(?P<scheme>[a-z]+)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[A
 
 def check_scheduler(address) -> tuple[str, str, int]:
     """``address`` as (scheme, host, port): ``[tcp|tls|ucx|ws|wss://]host:port`` with a port 1 … 65535 (or
-    ``inproc://...``, a cluster in this process), else an :class:`~stcs_ident.core.errors.InputError` naming ``--scheduler`` (before any work)."""
+    ``inproc://...``, a cluster in this process), else an :class:`~stcs_ident.core.errors.InputError`
+    naming ``--scheduler`` (before any work)."""
     if isinstance(address, str) and address.startswith("inproc://") and len(address) > len("inproc://"):
         return "inproc", address[len("inproc://"):], 0  # a cluster in this process (a library caller's)
     m = _ADDRESS.fullmatch(address) if isinstance(address, str) else None
