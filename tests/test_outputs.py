@@ -169,6 +169,20 @@ def test_json_onto_a_symlink_is_written_through_it(campaign, tmp_path, capsys):
     assert dangling.is_symlink() and (tmp_path / "new.json").read_text() == "{}\n"
 
 
+def test_track_json_onto_a_symlink_and_a_fifo(archive, tmp_path, capsys):
+    target, link, fifo = tmp_path / "real.json", tmp_path / "link.json", tmp_path / "summary.fifo"
+    link.symlink_to(target)
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    assert main(["track", str(archive), "--out", str(tmp_path / "o"), "--json", str(link)]) == 0
+    assert main(["track", str(archive), "--out", str(tmp_path / "o"), "--json", str(fifo)]) == 0
+    reader.join(timeout=30)
+    assert link.is_symlink() and '"cables"' in target.read_text()
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode) and got and '"cables"' in got[0]
+
+
 def test_a_symlinked_output_directory_stays_a_link(campaign, tmp_path, capsys):
     real, link = tmp_path / "real_dir", tmp_path / "link_dir"
     real.mkdir()
@@ -286,6 +300,29 @@ def test_a_malformed_scheduler_is_refused_at_once(archive, tmp_path, capsys):
     assert "--scheduler" in err and "notaurl" in err
     assert elapsed < 1.0  # "at once": no connection tried (before: a 20 s hang)
     assert not (tmp_path / "o").exists()  # before any work
+
+
+@pytest.mark.parametrize("address, parsed", [("tcp://10.0.0.5:8786", ("tcp", "10.0.0.5", 8786)),
+                                             ("host-1.example:8786", ("tcp", "host-1.example", 8786)),
+                                             ("tls://[::1]:8786", ("tls", "::1", 8786))])
+def test_a_scheduler_address_is_read(address, parsed):
+    assert execution.check_scheduler(address) == parsed
+
+
+@pytest.mark.parametrize("address", ["notaurl", "tcp://host", "tcp://host:0", "tcp://host:65536", "http://h:80",
+                                     "tcp://:8786", "tcp://host:8786/x", ""])
+def test_a_malformed_scheduler_address_is_refused(address):
+    with pytest.raises(InputError, match="--scheduler"):
+        execution.check_scheduler(address)
+
+
+def test_nothing_listening_is_refused_at_once(archive, tmp_path, capsys):
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        port = server.getsockname()[1]  # a port that was free, closed now: nothing listens there
+    assert main(["track", str(archive), "--out", str(tmp_path / "o"), "--scheduler", f"127.0.0.1:{port}"]) == 2
+    err = capsys.readouterr().err
+    _one_line(err)
+    assert "cannot reach" in err and not (tmp_path / "o").exists()
 
 
 @pytest.mark.parametrize("greeting", [b"", b"SSH-2.0-OpenSSH_9.6\r\n"])
