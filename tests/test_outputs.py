@@ -262,6 +262,25 @@ def test_a_read_only_output_is_refused_before_any_work(campaign, tmp_path, monke
     assert not analysed
 
 
+def test_an_output_whose_directory_is_gone_is_one_error_naming_it(tmp_path):
+    gone = tmp_path / "gone" / "result.json"
+    with pytest.raises(files.OutputError, match="cannot write") as caught:
+        files.write_atomic(gone, "{}\n")
+    assert caught.value.file == str(gone)
+
+
+def test_a_read_only_track_output_is_refused_before_any_record(archive, tmp_path, monkeypatch, capsys):
+    # Root ignores permissions, so the system's answer is simulated.
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, **k: False if Path(p) == tmp_path else real_access(p, mode, **k))
+    hashed = []
+    monkeypatch.setattr(sys.modules["stcs_ident.track.api"], "content_id", lambda path: hashed.append(path) or "x")
+    assert main(["track", str(archive), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    _one_line(err)
+    assert "--out" in err and "not writable" in err and not hashed
+
+
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a read-only directory")
 def test_a_really_read_only_directory_is_one_line(campaign, tmp_path, capsys):
     locked = tmp_path / "locked"
