@@ -510,3 +510,21 @@ def test_ctrl_c_on_dask_stops_with_one_line_and_keeps_the_parts(dask_scheduler, 
     _one_line(err)
     assert "interrupted" in err
     assert [p for p in (out / "parts").iterdir() if not p.name.startswith(".")]
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_ctrl_c_lost_in_a_finaliser_is_still_said(campaign, monkeypatch, capsys):
+    import stcs_ident.cli.forward
+
+    class Finalised:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.2)  # the handler runs here, inside __del__: Python prints its KeyboardInterrupt as ignored
+
+    def run(args):
+        Finalised()
+        return 0
+
+    monkeypatch.setattr(stcs_ident.cli.forward, "run", run)
+    assert main(["forward", str(campaign)]) == 130
+    _one_line(capsys.readouterr().err)

@@ -17,10 +17,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 import traceback
 import warnings
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from types import ModuleType
 
 from ..core.errors import ComputationError, InputError, one_line
@@ -127,15 +130,41 @@ def main(argv: list[str] | None = None) -> int:
         return _interrupted()
     stdout = sys.stdout
     sys.stdout = EscapedStream(stdout)  # names from files reach the terminal escaped (one place for every command)
+    with _ctrl_c() as pressed:
+        try:
+            if not args.debug:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts
+                    warnings.showwarning = show_warning
+                    status = _run(args, parser)
+            else:
+                status = _run(args, parser)
+        finally:
+            sys.stdout = stdout
+    # A KeyboardInterrupt raised while Python ran a finaliser (__del__) is printed as "ignored" and lost: the
+    # command then ends normally, but Ctrl-C was pressed, and it is said so.
+    return _interrupted() if pressed and status != 130 else status
+
+
+@contextmanager
+def _ctrl_c() -> Iterator[list]:
+    """While a command runs, Ctrl-C raises KeyboardInterrupt as usual and is also noted in the list yielded
+    (in the main thread, with Python's own handler in place; elsewhere the list stays empty)."""
+    pressed: list = []
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield pressed
+        return
+
+    def handler(signum, frame):
+        pressed.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, handler)
     try:
-        if not args.debug:
-            with warnings.catch_warnings():
-                warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts a command
-                warnings.showwarning = show_warning
-                return _run(args, parser)
-        return _run(args, parser)
+        yield pressed
     finally:
-        sys.stdout = stdout
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _as_option(err: InputError, command: str, parser: argparse.ArgumentParser) -> InputError:
