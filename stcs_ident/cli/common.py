@@ -124,7 +124,8 @@ def check_output(path) -> None:
 def write_output(path, text: str) -> None:
     """The JSON result, whole or not at all (``-``: standard output; a symbolic link written through, a FIFO
     or a device as a stream: :mod:`stcs_ident.core.files`); a failure names ``--json`` and the path."""
-    from ..core.files import OutputError, write_atomic
+    from ..core.errors import OutputError
+    from ..core.files import write_atomic
 
     try:
         write_atomic(path, text)

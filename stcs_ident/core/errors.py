@@ -50,6 +50,12 @@ def one_line(text: str, limit: int = 2000) -> str:
     return out if len(out) <= limit else out[:limit - 3] + "..."
 
 
+class OutputError(InputError):
+    """An output that cannot be written as given: a read-only directory or file system, a full disk, a
+    directory gone during the run, a path that is a directory or a socket. ``file`` is the path as the user
+    gave it; the command line says it in one line, exit status 2 (:mod:`stcs_ident.core.files`)."""
+
+
 class CampaignError(InputError):
     """A campaign file that is unreadable, incomplete or inconsistent."""
 

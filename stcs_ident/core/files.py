@@ -43,12 +43,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
-from .errors import InputError
-
-
-class OutputError(InputError):
-    """An output that cannot be written as given (read-only, full disk, gone, not a file one can write):
-    ``file`` is the path as the user gave it."""
+from .errors import InputError, OutputError
 
 
 def _output_error(err: OSError, path) -> OutputError:
