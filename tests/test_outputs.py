@@ -528,3 +528,14 @@ def test_ctrl_c_lost_in_a_finaliser_is_still_said(campaign, monkeypatch, capsys)
     monkeypatch.setattr(stcs_ident.cli.forward, "run", run)
     assert main(["forward", str(campaign)]) == 130
     _one_line(capsys.readouterr().err)
+
+
+def test_json_on_standard_output_stays_valid_json_whatever_the_names(campaign, capsys):
+    import json
+
+    toml = campaign / "campaign.toml"
+    toml.write_text(toml.read_text().replace('name = "T1"', 'name = "T1\\u001b\\u007f"'), encoding="utf-8")
+    assert main(["forward", str(campaign), "--json", "-"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out
+    assert json.loads(out)["tests"][0]["name"] == "T1\x1b\x7f"

@@ -127,6 +127,9 @@ def write_output(path, text: str) -> None:
     from ..core.errors import OutputError
     from ..core.files import write_atomic
 
+    if str(path) == "-":  # JSON escapes its control characters itself; DEL, which it keeps, must stay valid JSON
+        getattr(sys.stdout, "unescaped", sys.stdout).write(text)
+        return
     try:
         write_atomic(path, text)
     except OutputError as err:
@@ -157,6 +160,7 @@ class EscapedStream:
 
     def __init__(self, stream):
         self._stream = stream
+        self.unescaped = stream  # for what must reach standard output as written (``--json -``)
 
     def write(self, text: str) -> int:
         self._stream.write(printable(text))
