@@ -47,8 +47,9 @@ from .errors import InputError, OutputError
 
 
 def _output_error(err: OSError, path) -> OutputError:
-    what = err.strerror or type(err).__name__
-    return OutputError(f"cannot write: {what}", file=str(path))
+    out = OutputError(f"cannot write: {err.strerror or err or type(err).__name__}", file=str(path))
+    out.errno, out.strerror = err.errno, err.strerror
+    return out
 
 
 def _ours(err: OSError, *paths, within: Path | None = None, below: Path | None = None) -> bool:
@@ -193,6 +194,10 @@ def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
         _fsync(tmp)
         os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
         os.replace(tmp, target)
+    except OutputError:
+        if tmp is not None:
+            _unlink_quietly(tmp)
+        raise
     except OSError as err:
         if tmp is not None:
             _unlink_quietly(tmp)
@@ -223,6 +228,8 @@ def _streamed(target: Path, path, suffix: str) -> Iterator[Path]:
         yield tmp
         with open(tmp, "rb") as source, open(target, "wb") as sink:
             shutil.copyfileobj(source, sink)
+    except OutputError:
+        raise
     except OSError as err:
         if not _ours(err, path, target, tmp):
             raise
