@@ -58,15 +58,18 @@ def check_scheduler(address) -> tuple[str, str, int]:
 def probe_scheduler(address: str, timeout: float | None = None) -> None:
     """Refuse, within ``timeout`` seconds, a ``tcp://`` address where no Dask scheduler answers: nothing
     listening, no route, or a service that does not greet as Dask does (a scheduler sends its handshake,
-    which names its ``pickle-protocol``, as soon as it accepts). Other schemes are left to Dask's own
-    timeout. ``timeout`` defaults to :data:`CONNECT_TIMEOUT`."""
+    which names its ``pickle-protocol``, as soon as it accepts). For ``tls://``, ``ws://`` and ``wss://``
+    only whether something listens is checked (the greeting is wrapped), the rest is left to Dask's own
+    timeout; ``ucx://`` and ``inproc://`` are not probed. ``timeout`` defaults to :data:`CONNECT_TIMEOUT`."""
     timeout = CONNECT_TIMEOUT if timeout is None else timeout
     scheme, host, port = check_scheduler(address)
-    if scheme != "tcp":
+    if scheme in ("ucx", "inproc"):
         return
     deadline = time.monotonic() + timeout
     try:
         with socket.create_connection((host, port), timeout=timeout) as conn:
+            if scheme != "tcp":  # TLS or a websocket: only whether something listens (its greeting is wrapped)
+                return
             greeting = b""
             while b"pickle-protocol" not in greeting and len(greeting) < 65536:
                 left = deadline - time.monotonic()
