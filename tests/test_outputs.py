@@ -425,6 +425,7 @@ def long_archive(tmp_path_factory):
     return _archive(tmp_path_factory.mktemp("long"), 3)  # 72 records, 5 batches: a few seconds on 2 workers
 
 
+@pytest.mark.slow  # 5-15 s on two shared cores: the run, the Ctrl-C, the rerun that finishes the archive
 @pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux /proc")
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_ctrl_c_stops_with_one_line_and_keeps_the_parts(workers, long_archive, tmp_path):
