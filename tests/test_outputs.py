@@ -145,6 +145,22 @@ def test_json_onto_a_device_leaves_the_device(null_device, campaign, capsys):
     assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
 
 
+@pytest.mark.parametrize("argv", [["forward", "{c}"], ["spectra", "{c}"], ["identify", "{c}", "--test", "T1"],
+                                  ["diagnose", "{c}", "--test", "T1"],
+                                  ["tension", "--length", "19.715", "--mass", "16.6", "--frequencies", "7.24,14.42,21.77"]])
+def test_every_command_writes_its_json_into_a_device_and_through_a_link(argv, null_device, campaign, tmp_path,
+                                                                        capsys):
+    argv = [a.format(c=campaign) for a in argv]
+    before = os.stat(null_device)
+    assert main([*argv, "--json", str(null_device)]) == 0
+    after = os.stat(null_device)
+    assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
+    target, link = tmp_path / "real.json", tmp_path / "link.json"
+    link.symlink_to(target)
+    assert main([*argv, "--json", str(link)]) == 0
+    assert link.is_symlink() and target.read_text().lstrip().startswith("{")
+
+
 def test_every_writer_streams_into_a_device(null_device):
     import pandas as pd
     from matplotlib.figure import Figure
