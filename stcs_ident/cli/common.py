@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import time
 from collections.abc import Callable
@@ -72,8 +73,8 @@ def worker_count(text: str) -> int:
 
 
 def progress_line(message: str) -> None:
-    """A progress line on standard error."""
-    print(message, file=sys.stderr, flush=True)
+    """A progress line on standard error (control characters escaped)."""
+    print(one_line(message), file=sys.stderr, flush=True)
 
 
 def step_progress(command: str, unit: str) -> Callable[[int, int, str], None]:
@@ -87,7 +88,7 @@ def step_progress(command: str, unit: str) -> Callable[[int, int, str], None]:
                 from tqdm import tqdm
 
                 bar.append(tqdm(total=total, unit=unit, file=sys.stderr, desc=command, dynamic_ncols=True))
-            bar[0].set_postfix_str(label, refresh=False)
+            bar[0].set_postfix_str(one_line(label), refresh=False)
             bar[0].update(done - bar[0].n)
             if done == total:
                 bar[0].close()
@@ -97,7 +98,8 @@ def step_progress(command: str, unit: str) -> Callable[[int, int, str], None]:
     def on_line(done: int, total: int, label: str) -> None:
         elapsed = time.perf_counter() - started
         left = elapsed / done * (total - done) if done else float("nan")
-        progress_line(f"{command}: {unit} {done} of {total} ({label}), {elapsed:.0f} s, about {left:.0f} s left")
+        progress_line(f"{command}: {unit} {done} of {total} ({one_line(label)}), {elapsed:.0f} s, "
+                      f"about {left:.0f} s left")
     return on_line
 
 
@@ -120,13 +122,52 @@ def check_output(path) -> None:
 
 
 def write_output(path, text: str) -> None:
-    """The JSON result, whole or not at all (``-``: standard output); a failure names ``--json``."""
+    """The JSON result, whole or not at all (``-``: standard output; a symbolic link written through, a FIFO
+    or a device as a stream: :mod:`stcs_ident.core.files`); a failure names ``--json`` and the path."""
+    from ..core.errors import OutputError
     from ..core.files import write_atomic
 
+    if str(path) == "-":  # JSON escapes its control characters itself; DEL, which it keeps, must stay valid JSON
+        getattr(sys.stdout, "unescaped", sys.stdout).write(text)
+        return
     try:
         write_atomic(path, text)
+    except OutputError as err:
+        raise OutputError(err.message, field="--json", file=str(path)) from err
     except OSError as err:
-        raise InputError(f"cannot write: {err.strerror}", field="--json", file=str(path)) from err
+        raise OutputError(f"cannot write: {err.strerror or err}", field="--json", file=str(path)) from err
+
+
+def os_error_line(err: OSError) -> str:
+    """An operating-system error as one line naming its path(s): ``<path>: <what>``."""
+    what = err.strerror or str(err) or type(err).__name__
+    paths = [str(p) for p in (err.filename, err.filename2) if p is not None]
+    return one_line(f"{' -> '.join(paths)}: {what}" if paths else what)
+
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # C0 and C1 control characters but newline and tab
+
+
+def printable(text: str) -> str:
+    """``text`` with its control characters escaped (an escape sequence shown as ``\\x1b[31m``), lines and
+    tabs kept: what a file names (a test, a cable) never reaches the terminal raw."""
+    return _CONTROL.sub(lambda m: m[0].encode("unicode_escape").decode("ascii"), text)
+
+
+class EscapedStream:
+    """A text stream that writes through :func:`printable` to ``stream`` (the command line's standard output:
+    tables and ``--json -``, whose JSON escapes control characters itself)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.unescaped = stream  # for what must reach standard output as written (``--json -``)
+
+    def write(self, text: str) -> int:
+        self._stream.write(printable(text))
+        return len(text)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
 
 
 def campaign_inputs(campaign, file: str) -> list[str]:

@@ -1,8 +1,13 @@
 """The ``stcs-ident`` command line: the top-level parser, and running one command of the table.
 
 Exit status 0 on success, 2 for bad input (one line on standard error
-naming the file, the field and what is wrong; nothing written), 1 for a
-computation that failed. ``--debug`` shows the traceback.
+naming the file, the field and what is wrong; nothing written) and for an
+output that cannot be written as given (read-only, full disk, gone: one
+line naming the path), 1 for a computation that failed, 130 for Ctrl-C
+(one line; the outputs already written whole are kept). ``--debug`` shows
+the traceback. Control characters in what the commands print (a test's
+name holding an escape sequence) are shown escaped, never sent raw to the
+terminal.
 
 Only the command being run is imported (:mod:`stcs_ident.cli.commands`),
 so ``--version`` and ``--help`` answer without loading the numerics.
@@ -12,16 +17,19 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 import traceback
 import warnings
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from types import ModuleType
 
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.version import __version__
 from .commands import COMMANDS, Command, register_command, unregister_command
-from .common import examples_epilog, show_warning
+from .common import EscapedStream, examples_epilog, os_error_line, show_warning
 
 __all__ = ["COMMANDS", "DESCRIPTION", "EXAMPLES", "Command", "build_parser", "main", "register_command",
            "unregister_command"]
@@ -115,14 +123,48 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     command = _command_in(argv)
-    parser = build_parser([command] if command else [])
-    args = parser.parse_args(argv)
-    if not args.debug:
-        with warnings.catch_warnings():
-            warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts a command
-            warnings.showwarning = show_warning
-            return _run(args, parser)
-    return _run(args, parser)
+    try:
+        parser = build_parser([command] if command else [])
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        return _interrupted()
+    stdout = sys.stdout
+    sys.stdout = EscapedStream(stdout)  # names from files reach the terminal escaped (one place for every command)
+    with _ctrl_c() as pressed:
+        try:
+            if not args.debug:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("default")  # whatever the caller's filters: a warning never aborts
+                    warnings.showwarning = show_warning
+                    status = _run(args, parser)
+            else:
+                status = _run(args, parser)
+        finally:
+            sys.stdout = stdout
+    # A KeyboardInterrupt raised while Python ran a finaliser (__del__) is printed as "ignored" and lost: the
+    # command then ends normally, but Ctrl-C was pressed, and it is said so.
+    return _interrupted() if pressed and status != 130 else status
+
+
+@contextmanager
+def _ctrl_c() -> Iterator[list]:
+    """While a command runs, Ctrl-C raises KeyboardInterrupt as usual and is also noted in the list yielded
+    (in the main thread, with Python's own handler in place; elsewhere the list stays empty)."""
+    pressed: list = []
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield pressed
+        return
+
+    def handler(signum, frame):
+        pressed.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, handler)
+    try:
+        yield pressed
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _as_option(err: InputError, command: str, parser: argparse.ArgumentParser) -> InputError:
@@ -155,6 +197,21 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             traceback.print_exc()
         print(f"stcs-ident: computation failed: {one_line(str(err))}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        if args.debug:
+            traceback.print_exc()
+        return _interrupted()
+    except OSError as err:  # what no writer named (a directory made for --plot, standard output closed): one line
+        if args.debug:
+            traceback.print_exc()
+        print(f"stcs-ident: {os_error_line(err)}", file=sys.stderr)
+        return 2
+
+
+def _interrupted() -> int:
+    """Ctrl-C: one line, exit status 130 (128 + SIGINT, as a shell reports it)."""
+    print("stcs-ident: interrupted (Ctrl-C); the outputs already written whole are kept", file=sys.stderr)
+    return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

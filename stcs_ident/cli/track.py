@@ -45,6 +45,10 @@ def run(args: argparse.Namespace) -> int:
     from ..track.api import default_out, track
     from ..track.archive import discover, record_paths
 
+    if args.scheduler is not None:  # a malformed address, or no Dask scheduler behind it: refused before any work
+        from ..track.execution import probe_scheduler
+
+        probe_scheduler(args.scheduler)
     out = args.out if args.out is not None else str(default_out(args.archive))
     specs = discover(args.archive, args.cable)  # refuses a bad archive before any work
     inputs = [os.path.join(s.directory, "campaign.toml") for s in specs]

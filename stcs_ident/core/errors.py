@@ -50,6 +50,17 @@ def one_line(text: str, limit: int = 2000) -> str:
     return out if len(out) <= limit else out[:limit - 3] + "..."
 
 
+class OutputError(InputError, OSError):
+    """An output that cannot be written as given: a read-only directory or file system, a full disk, a
+    directory gone during the run, a path that is a directory or a socket. ``file`` is the path as the user
+    gave it; the command line says it in one line, exit status 2 (:mod:`stcs_ident.core.files`). Also an
+    :class:`OSError` (``errno`` and ``strerror`` those of the system's error, when there was one), so that a
+    caller catching the system's errors of a write still does."""
+
+    def __str__(self) -> str:
+        return self._text()
+
+
 class CampaignError(InputError):
     """A campaign file that is unreadable, incomplete or inconsistent."""
 

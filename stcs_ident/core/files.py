@@ -11,6 +11,22 @@ temporary files; they are hidden (a leading dot) and their names carry
 the host and the process (``.<name>.stcs~<host>~<pid>~<random>``), so the
 next run that writes into the same directory removes those whose process
 is gone (:func:`remove_stale`).
+
+An output path that is not a regular file is never renamed over:
+
+- a symbolic link is written *through*: the link stays, its target (the
+  end of the chain, :func:`output_target`) is replaced whole, the
+  temporary beside the target;
+- a FIFO or a character device (``/dev/null``, a terminal) is written to
+  as a stream: the content is made whole in a temporary of the system's
+  temporary directory, then copied into it (a FIFO's reader sees one
+  whole output or nothing);
+- a directory, a block device or a socket is refused.
+
+Every operating-system error on an output (a read-only directory, a full
+disk, a directory that vanished) is an :class:`OutputError` naming the path
+as the user gave it: one line, never a traceback. :func:`check_outputs`
+finds, before any work, the ones that can be known then.
 """
 
 from __future__ import annotations
@@ -19,12 +35,58 @@ import os
 import re
 import shutil
 import socket
+import stat
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
+
+from .errors import InputError, OutputError
+
+
+def _output_error(err: OSError, path) -> OutputError:
+    out = OutputError(f"cannot write: {err.strerror or err or type(err).__name__}", file=str(path))
+    out.errno, out.strerror = err.errno, err.strerror
+    return out
+
+
+def _ours(err: OSError, *paths, within: Path | None = None, below: Path | None = None) -> bool:
+    """Whether ``err`` is about one of ``paths``, a file directly in ``within`` (a temporary of ours beside
+    the output), a file below ``below`` (in the temporary directory being filled), or names no file (a write
+    that failed on an open stream)."""
+    if err.filename is None:
+        return True
+    name = os.fspath(err.filename)
+    if name in {os.fspath(p) for p in paths}:
+        return True
+    if within is not None and os.path.dirname(name) == os.fspath(within):
+        return True
+    return below is not None and name.startswith(os.fspath(below) + os.sep)
+
+
+def output_target(path: str | os.PathLike) -> tuple[Path, bool]:
+    """Where an output given as ``path`` is written, and whether as a stream.
+
+    Returns ``(target, stream)``: a symbolic link resolved to its final target (written through, the link
+    kept); ``stream`` True for a FIFO or a character device (opened and written, never renamed over).
+    Raises :class:`OutputError` for a directory, a block device or a socket.
+    """
+    target = Path(os.path.realpath(path))
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        return target, False
+    except OSError as err:
+        raise _output_error(err, path) from err
+    if stat.S_ISREG(mode):
+        return target, False
+    if stat.S_ISFIFO(mode) or stat.S_ISCHR(mode):
+        return target, True
+    kind = "a directory" if stat.S_ISDIR(mode) else "a block device" if stat.S_ISBLK(mode) else "a socket"
+    raise OutputError(f"is {kind}: an output is a regular file (replaced whole), a FIFO or a character device "
+                      "(written as a stream)", file=str(path))
 
 
 def umask() -> int:
@@ -109,23 +171,71 @@ def atomic_path(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
     flushed to disk, given the mode a plain ``open()`` would give (from the umask) and renamed to
     ``path``; when the block fails it is removed and ``path`` is untouched.
 
+    A symbolic link is written through (its target replaced, the link kept); a FIFO or a character
+    device is written to as a stream, never renamed over (:func:`output_target`). An operating-system
+    error on the output is an :class:`OutputError` naming ``path``.
+
     The one way the package puts a file in place: :func:`atomic_file`, :func:`write_atomic`,
     :func:`write_csv` and :func:`write_figure` go through it.
     """
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    _clean_once(directory)
-    fd, name = tempfile.mkstemp(prefix=_prefix(target.name), suffix=suffix, dir=directory)
-    os.close(fd)
-    tmp = Path(name)
+    target, stream = output_target(path)
+    if stream:
+        with _streamed(target, path, suffix) as tmp:
+            yield tmp
+        return
+    directory = target.parent
+    tmp = None
     try:
+        _clean_once(directory)
+        fd, name = tempfile.mkstemp(prefix=_prefix(target.name), suffix=suffix, dir=directory)
+        os.close(fd)
+        tmp = Path(name)
         yield tmp
         _fsync(tmp)
         os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes 0600; give the mode a plain open() would
         os.replace(tmp, target)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
+    except OutputError:
+        if tmp is not None:
+            _unlink_quietly(tmp)
         raise
+    except OSError as err:
+        if tmp is not None:
+            _unlink_quietly(tmp)
+        if not _ours(err, path, target, directory, within=directory):
+            raise
+        raise _output_error(err, path) from err
+    except BaseException:
+        if tmp is not None:
+            _unlink_quietly(tmp)
+        raise
+
+
+def _unlink_quietly(path: Path) -> None:
+    try:
+        path.unlink(missing_ok=True)
+    except OSError:  # the directory went read-only or away: nothing more to do
+        pass
+
+
+@contextmanager
+def _streamed(target: Path, path, suffix: str) -> Iterator[Path]:
+    """A temporary file (in the system's temporary directory) whose content is copied into the FIFO or
+    device ``target`` when the block ends; removed either way."""
+    fd, name = tempfile.mkstemp(prefix=".stcs-stream~", suffix=suffix)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        with open(tmp, "rb") as source, open(target, "wb") as sink:
+            shutil.copyfileobj(source, sink)
+    except OutputError:
+        raise
+    except OSError as err:
+        if not _ours(err, path, target, tmp):
+            raise
+        raise _output_error(err, path) from err
+    finally:
+        _unlink_quietly(tmp)
 
 
 @contextmanager
@@ -178,17 +288,62 @@ def replace_directory(tmp: Path, out: Path) -> None:
 @contextmanager
 def whole_directory(out: Path) -> Iterator[Path]:
     """A new directory beside ``out`` to fill; when the block ends it replaces ``out`` as a whole
-    (:func:`replace_directory`), and when the block fails it is removed and ``out`` is untouched."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    _clean_once(out.parent)
-    tmp = Path(tempfile.mkdtemp(prefix=_prefix(out.name), suffix=".tmp", dir=out.parent))
+    (:func:`replace_directory`), and when the block fails it is removed and ``out`` is untouched.
+
+    ``out`` a symbolic link to a directory: the directory it points to is replaced, the link kept.
+    An operating-system error on the output is an :class:`OutputError` naming ``out`` (or the file inside
+    it, by its final name)."""
+    given = Path(out)
+    out = Path(os.path.realpath(out))
+    tmp = None
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _clean_once(out.parent)
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(out.name), suffix=".tmp", dir=out.parent))
         os.chmod(tmp, 0o777 & ~umask())  # mkdtemp makes 0700; give the mode a plain mkdir would
         yield tmp
         replace_directory(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+    except OutputError as err:
+        _remove_tree(tmp)
+        inside = str(err.file or "")
+        if tmp is not None and inside.startswith(str(tmp) + os.sep):  # name the file by its final path
+            raise OutputError(err.message, field=err.field, file=str(given / inside[len(str(tmp)) + 1:])) from err
         raise
+    except OSError as err:
+        _remove_tree(tmp)
+        if not _ours(err, given, out, out.parent, *([tmp] if tmp else []), within=out.parent, below=tmp):
+            raise
+        raise _output_error(err, given) from err
+    except BaseException:
+        _remove_tree(tmp)
+        raise
+
+
+def _remove_tree(path: Path | None) -> None:
+    if path is not None:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def writable_problem(path: str | os.PathLike, is_directory: bool) -> str | None:
+    """What keeps the output ``path`` from being written, as far as it can be known before any work
+    (None: nothing known): a file output's directory must exist and be writable, a stream writable; a
+    directory output's first existing ancestor (or itself) writable. Permissions as the system checks them
+    (``os.access``: a read-only file system refuses even root)."""
+    real = Path(os.path.realpath(path))
+    if not is_directory:
+        target, stream = output_target(path)
+        if stream:
+            return None if os.access(target, os.W_OK) else "cannot write: Permission denied"
+        if not target.parent.is_dir():
+            return None  # said by the checks of the directory (check_output)
+        if not os.access(target.parent, os.W_OK | os.X_OK):
+            return f"cannot write: the directory {target.parent} is not writable"
+        return None
+    for above in (real, *real.parents):
+        if above.exists():
+            ok = os.access(above, os.W_OK | os.X_OK)  # written into, or the new directory made in it
+            return None if ok else f"cannot write: {above} is not writable"
+    return None
 
 
 def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
@@ -197,11 +352,10 @@ def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
 
     ``outputs`` are (option, path, is_directory) (a path None or "-" is skipped); ``inputs`` the files
     the command reads. A file output may not be an input (also through a link); a directory output may not
-    be an input, hold one (it is replaced as a whole, or written into), or lie below a file. Raises
-    :class:`~stcs_ident.core.errors.InputError` naming the option.
+    be an input, hold one (it is replaced as a whole, or written into), or lie below a file; an output must
+    be writable (:func:`writable_problem`). Raises :class:`~stcs_ident.core.errors.InputError` naming the
+    option.
     """
-    from .errors import InputError
-
     read = [os.path.realpath(p) for p in inputs]
     for option, path, is_directory in outputs:
         if path is None or str(path) == "-":
@@ -222,3 +376,9 @@ def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
                 if not above.is_dir():
                     raise InputError(f"lies below {above}, which is a file", field=option, file=str(path))
                 break
+        try:
+            problem = writable_problem(path, is_directory)
+        except OutputError as err:
+            problem = err.message
+        if problem is not None:
+            raise OutputError(problem, field=option, file=str(path))

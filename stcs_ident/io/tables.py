@@ -15,8 +15,9 @@ from pathlib import Path
 import pandas as pd
 
 from ..core.files import atomic_path
+from ..core.times import check_instant
 
-__all__ = ["parquet_parts", "read_parquet_files", "write_parquet"]
+__all__ = ["instant_column", "parquet_parts", "read_parquet_files", "write_parquet"]
 
 
 def write_parquet(frame: pd.DataFrame, path: str | os.PathLike) -> None:
@@ -57,3 +58,17 @@ def read_parquet_files(paths) -> tuple[list[tuple[Path, pd.DataFrame]], list[tup
         except Exception as err:  # noqa: BLE001 (pyarrow raises its own types: ArrowInvalid, OSError, ...)
             unreadable.append((Path(path), " ".join(f"{type(err).__name__}: {err}".split())))
     return read, unreadable
+
+
+def instant_column(values) -> pd.Series:
+    """Start times (ISO 8601 text or None) as a column of UTC time stamps to the nanosecond, by the rule the
+    readers apply (:mod:`stcs_ident.core.times`): None is ``NaT``; a text the rule refuses raises
+    :class:`~stcs_ident.core.errors.InputError` (it never becomes ``NaT`` silently)."""
+    values = pd.Series(values, dtype=object)
+    present = values.notna()
+    for value in values[present]:
+        check_instant(value)
+    column = pd.Series(pd.NaT, index=values.index, dtype="datetime64[ns, UTC]")
+    if present.any():
+        column[present] = pd.to_datetime(values[present], utc=True, format="ISO8601").astype("datetime64[ns, UTC]")
+    return column

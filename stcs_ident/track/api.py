@@ -183,42 +183,15 @@ def _run(batches, total: int, workers: int, scheduler: str | None, out: Path, pr
 
 
 def _run_local(batches, workers: int, out: Path, bar) -> None:
-    import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from .execution import run_local  # Ctrl-C and a killed parent handled there
 
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
-    queue = iter(batches)
-    with ProcessPoolExecutor(workers, mp_context=context) as pool:
-        running = {pool.submit(process_batch, *job) for job in _take(queue, 2 * workers)}
-        while running:
-            done, running = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
-                rows = future.result()
-                append_part(out, rows)
-                bar(len(rows))
-            running |= {pool.submit(process_batch, *job) for job in _take(queue, len(done))}
+    run_local(batches, workers, process_batch, _part_writer(out, bar))
 
 
 def _run_dask(batches, scheduler: str, out: Path, bar) -> None:
-    try:
-        from distributed import Client, as_completed
-    except ImportError:
-        raise InputError("needs Dask distributed: pip install 'dask[distributed]'", field="--scheduler") from None
-    try:
-        client = Client(scheduler, timeout="10s", set_as_default=False)
-    except (OSError, TimeoutError) as err:
-        raise InputError(f"cannot reach the scheduler: {err}", field="--scheduler") from None
-    with client:
-        queue = iter(batches)
-        n = max(2, 2 * sum(client.nthreads().values()))
-        futures = as_completed([client.submit(process_batch, *job, pure=False) for job in _take(queue, n)],
-                               loop=client.loop)
-        for future in futures:
-            rows = future.result()
-            append_part(out, rows)
-            bar(len(rows))
-            for job in _take(queue, 1):
-                futures.add(client.submit(process_batch, *job, pure=False))
+    from .execution import run_dask  # the address checked, the scheduler probed, Ctrl-C handled there
+
+    run_dask(batches, scheduler, process_batch, _part_writer(out, bar))
 
 
 def _take(iterator, n: int) -> list:
@@ -271,3 +244,10 @@ def _histories(specs: list[CableSpec], table: pd.DataFrame):
         histories[spec.name] = (rows, history)
     return table, histories
 
+
+def _part_writer(out: Path, bar) -> Callable[[list], None]:
+    """A finished batch's rows into a part of the table, then the progress advanced."""
+    def write(rows: list) -> None:
+        append_part(out, rows)
+        bar(len(rows))
+    return write

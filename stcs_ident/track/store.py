@@ -31,7 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..core.errors import TrackWarning
-from ..io.tables import read_parquet_files, write_parquet
+from ..io.tables import instant_column, read_parquet_files, write_parquet
 from .process import COLUMNS
 
 __all__ = ["append_part", "cable_key", "processed_table", "read_parts", "replace_parts", "write_table"]
@@ -53,7 +53,7 @@ def cable_key(cable: str) -> str:
 
 def _frame(rows: list[dict]) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(ROW_COLUMNS))
-    frame["start_time"] = pd.to_datetime(frame["start_time"], utc=True, errors="coerce", format="ISO8601")
+    frame["start_time"] = instant_column(frame["start_time"])  # the readers' rule for times (core/times.py)
     for name in ("temperature", "tension", "tension_sigma"):
         frame[name] = frame[name].astype(float)
     for name in ("n_modes", "size", "mtime_ns"):

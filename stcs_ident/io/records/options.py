@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from datetime import date, datetime
+from datetime import datetime
 from typing import Any
 
 from ...core.errors import InputError
+from ...core.times import instant_problem
 from .validation import UNITS
 
 __all__ = ["OPTIONS", "check_options", "option_problem", "option_value"]
@@ -28,7 +29,7 @@ OPTIONS = {
     "separator": "one character (the column separator)",
     "decimal": "one character (the decimal mark)",
     "skip_rows": "a list of line numbers >= 1 (0-based, the header is line 0)",
-    "start_time": "an ISO 8601 date-time",
+    "start_time": "an ISO 8601 date-time, YYYY-MM-DD[Thh:mm[:ss[.f]]][Z|±hh:mm], from 1677-09-22 to 2262-04-10",
     "temperature": "a number of degC",
     "variable": "a non-empty string (the MATLAB variable)",
     "group": "a non-empty string (the TDMS group)",
@@ -52,7 +53,7 @@ def option_problem(key: str, value: Any) -> str | None:
         ok = isinstance(value, list | tuple) and all(isinstance(v, int) and not isinstance(v, bool) and v >= 1
                                                      for v in value)
     elif key == "start_time":
-        ok = isinstance(value, datetime) or (isinstance(value, str) and _iso(value))
+        ok = instant_problem(value.isoformat() if isinstance(value, datetime) else value) is None
     elif key == "unit":
         ok = isinstance(value, str) and value.strip() in UNITS
     else:
@@ -84,9 +85,3 @@ def check_options(options: Mapping[str, Any], file: str | None = None) -> dict[s
     return out
 
 
-def _iso(text: str) -> bool:
-    try:
-        parsed = datetime.fromisoformat(text)
-    except ValueError:
-        return False
-    return isinstance(parsed, date)

@@ -23,7 +23,6 @@ its first bad sample (0-based index).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from datetime import datetime
 from typing import Any
 
 import numpy as np
@@ -38,6 +37,7 @@ from ...core.record import (
     check_shape,
     sampling_rate,
 )
+from ...core.times import check_instant
 from .screening import screen_channels
 
 __all__ = [
@@ -182,10 +182,7 @@ def check_sampling_rate(value: Any, file: str | None) -> float:
 
 
 def _check_start_time(value: Any, file: str | None) -> None:
-    try:
-        datetime.fromisoformat(value)
-    except (TypeError, ValueError):
-        raise InputError(f"is not an ISO 8601 time: {value!r}", field="start_time", file=file) from None
+    check_instant(value, field="start_time", file=file)  # the one rule for times (core/times.py)
 
 
 def _scale(array: np.ndarray, factor: float) -> np.ndarray:
