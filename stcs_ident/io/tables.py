@@ -61,13 +61,14 @@ def read_parquet_files(paths) -> tuple[list[tuple[Path, pd.DataFrame]], list[tup
 
 
 def instant_column(values) -> pd.Series:
-    """Start times (ISO 8601 text or None) as a column of UTC time stamps to the nanosecond, by the rule the
-    readers apply (:mod:`stcs_ident.core.times`): None is ``NaT``; a text the rule refuses raises
-    :class:`~stcs_ident.core.errors.InputError` (it never becomes ``NaT`` silently)."""
+    """Start times (ISO 8601 text, a time stamp of the table, or None) as a column of UTC time stamps to the
+    nanosecond, by the rule the readers apply (:mod:`stcs_ident.core.times`): None is ``NaT``; a text the
+    rule refuses raises :class:`~stcs_ident.core.errors.InputError` (it never becomes ``NaT`` silently)."""
     values = pd.Series(values, dtype=object)
     present = values.notna()
     for value in values[present]:
-        check_instant(value)
+        if not isinstance(value, pd.Timestamp):  # a time stamp is a row of the table already: held, so valid
+            check_instant(value)
     column = pd.Series(pd.NaT, index=values.index, dtype="datetime64[ns, UTC]")
     if present.any():
         column[present] = pd.to_datetime(values[present], utc=True, format="ISO8601").astype("datetime64[ns, UTC]")
