@@ -37,7 +37,9 @@ def _fit(seed: int, recorded: float = 1.3 * C_TRUE, damper: bool = True):
     campaign = Campaign("c", STAY, (Setup("S", (point,)),), (Test("T1", "S", 5.0e6),))
     measurement = Measurement(campaign.tests[0], MODES, f, sf, "given", z, sz)
     params = "tension,EI,coefficient" if damper else "tension,EI"
-    return identify(campaign, params=params, picked={"T1": measurement})
+    # The simulated stay's length, mass per length, damper position and mass are exact here: their tolerances
+    # stay out of σ, which these tests compare with the frequencies' and damping ratios' own scatter.
+    return identify(campaign, params=params, picked={"T1": measurement}, tolerances=False)
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])

@@ -244,3 +244,18 @@ def test_the_size_of_a_change_comes_with_an_honest_one_sigma():
     z = np.abs(np.array(z))
     assert len(z) >= 0.9 * 300
     assert 0.6 <= np.mean(z <= 1) <= 0.8 and np.mean(z <= 3) >= 0.98, (np.mean(z <= 1), np.mean(z <= 3))
+
+
+def test_a_healthy_one_day_archive_reports_no_change_but_not_enough_history(tmp_path):
+    """The issue's case end to end: two healthy cables, one day of hourly records, through spectra, identify and
+    the history. A day of records only sets the level, the thermal coefficient and the scatter: no lasting change
+    may be reported (before, C2 reported +0.37 %), and each cable says it has not enough history yet."""
+    campaign = _campaign(tmp_path / "campaign")
+    simulate_archive({"C1": campaign, "C2": campaign}, tmp_path / "archive",
+                     options=ArchiveOptions(days=1, interval=3600), seed=7)
+    summary = track(tmp_path / "archive", tmp_path / "out", workers=2).summary()
+    for name in ("C1", "C2"):
+        cable = summary["cables"][name]
+        assert cable["processed"] == 24
+        assert cable["events"] == []
+        assert cable["state"] == "not enough history yet"
