@@ -194,15 +194,6 @@ def _run_dask(batches, scheduler: str, out: Path, bar) -> None:
     run_dask(batches, scheduler, process_batch, _part_writer(out, bar))
 
 
-def _take(iterator, n: int) -> list:
-    out = []
-    for item in iterator:
-        out.append(item)
-        if len(out) >= n:
-            break
-    return out
-
-
 def _progress_bar(total: int, progress) -> Callable:
     if callable(progress):
         done = [0]
