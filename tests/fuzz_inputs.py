@@ -462,3 +462,11 @@ if __name__ == "__main__":  # pragma: no cover
             if o.status in FINDINGS:
                 print(o.case.kind, o.status, o.code, o.case.argv[:4], o.stderr.strip().splitlines()[-1:])
     os._exit(0)
+
+
+def write_base_campaign(directory):
+    """The base campaign (a hanger with a clamp; T1 a table, T2 a record) written into ``directory``."""
+    (directory / "records").mkdir(parents=True)
+    (directory / "campaign.toml").write_text(BASE_TOML.format(f=_frequencies()), encoding="utf-8")
+    _record(directory / "records" / "T2.h5", np.random.default_rng(0))
+    return directory

@@ -15,7 +15,6 @@ import time
 from pathlib import Path
 
 import h5py
-import numpy as np
 import pytest
 
 from stcs_ident.cli.main import main
@@ -26,7 +25,7 @@ from stcs_ident.io.campaign import load_campaign
 from stcs_ident.simulate.archive import ArchiveOptions, simulate_archive
 from stcs_ident.track import execution
 from stcs_ident.track.api import track
-from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
+from tests.fuzz_inputs import BASE_TOML, _frequencies, write_base_campaign
 
 # ---------------------------------------------------------------------------------------------------------
 # Fixtures: a small campaign with one record, a small archive.
@@ -34,11 +33,7 @@ from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
 
 @pytest.fixture
 def campaign(tmp_path):
-    directory = tmp_path / "campaign"
-    (directory / "records").mkdir(parents=True)
-    (directory / "campaign.toml").write_text(BASE_TOML.format(f=_frequencies()), encoding="utf-8")
-    _record(directory / "records" / "T2.h5", np.random.default_rng(0))
-    return directory
+    return write_base_campaign(tmp_path / "campaign")
 
 
 def _archive(root: Path, days: float) -> Path:

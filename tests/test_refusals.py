@@ -11,17 +11,13 @@ import numpy as np
 import pytest
 
 from stcs_ident.cli.main import main
-from tests.fuzz_inputs import BASE_TOML, _frequencies, _record
+from tests.fuzz_inputs import write_base_campaign
 
 
 @pytest.fixture
 def campaign(tmp_path):
     """The fuzzer's base campaign (a hanger with a clamp; T1 a table, T2 a record)."""
-    directory = tmp_path / "c"
-    (directory / "records").mkdir(parents=True)
-    (directory / "campaign.toml").write_text(BASE_TOML.format(f=_frequencies()), encoding="utf-8")
-    _record(directory / "records" / "T2.h5", np.random.default_rng(0))
-    return directory
+    return write_base_campaign(tmp_path / "c")
 
 
 def refusal(argv, capsys) -> str:

@@ -1,4 +1,5 @@
-"""The checks of one number of the model: finite, positive, in its band, a frequency, a mode number.
+"""The checks of one number of the model: finite, positive, in its band, a frequency, a mode number (and a
+pair of bounds).
 
 Each returns the value as a float (an int for a mode number) or raises
 :class:`~stcs_ident.core.errors.ModelError` naming the field; the model
@@ -112,3 +113,22 @@ def non_negative_number(value, name: str) -> float:
     if v < 0:
         raise ModelError(f"must be >= 0, got {value!r}", field=name)
     return v
+
+
+def checked_bounds(bounds) -> tuple[tuple[str, tuple[float, float]], ...]:
+    """``Campaign.bounds`` as sorted (kind, (lower, upper)) pairs of finite increasing numbers."""
+    pairs = list(bounds.items()) if isinstance(bounds, dict) else list(bounds)
+    out: dict[str, tuple[float, float]] = {}
+    for key, given in pairs:
+        field = f"bounds.{key}"
+        if key in out:
+            raise ModelError("a key is given twice", field="bounds")
+        if isinstance(given, (str, bytes)) or not hasattr(given, "__len__") or len(given) != 2:
+            raise ModelError(f"must be two numbers [lower, upper], got {given!r}", field=field)
+        lo, hi = (finite_number(v, field) for v in given)
+        if not lo < hi:
+            raise ModelError(f"must satisfy lower < upper, got [{lo:g}, {hi:g}]", field=field)
+        if lo < 0:
+            raise ModelError(f"the lower bound must be >= 0, got {lo:g}", field=field)
+        out[key] = (lo, hi)
+    return tuple(sorted(out.items()))

@@ -19,6 +19,7 @@ from .checks import (  # noqa: F401 (re-exported: the checks were defined here, 
     BANDS,
     FREQUENCY_BAND,
     MAX_MODE,
+    checked_bounds,
     finite_number,
     frequency,
     in_band,
@@ -421,7 +422,7 @@ class Campaign:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="campaign.name")
-        object.__setattr__(self, "bounds", _checked_bounds(self.bounds))
+        object.__setattr__(self, "bounds", checked_bounds(self.bounds))
         object.__setattr__(self, "published", tuple(self.published))
         given = dict(self.tolerance)
         if len(given) != len(tuple(self.tolerance)):
@@ -472,25 +473,6 @@ def _record_format(value: Any, field: str) -> tuple[tuple[str, Any], ...]:
         if not isinstance(key, str) or not key:
             raise ModelError(f"keys must be non-empty strings, got {key!r}", field=field)
     return tuple((key, tuple(v) if isinstance(v, list) else v) for key, v in pairs)
-
-
-def _checked_bounds(bounds) -> tuple[tuple[str, tuple[float, float]], ...]:
-    """``Campaign.bounds`` as sorted (kind, (lower, upper)) pairs of finite increasing numbers."""
-    pairs = list(bounds.items()) if isinstance(bounds, dict) else list(bounds)
-    out: dict[str, tuple[float, float]] = {}
-    for key, given in pairs:
-        field = f"bounds.{key}"
-        if key in out:
-            raise ModelError("a key is given twice", field="bounds")
-        if isinstance(given, (str, bytes)) or not hasattr(given, "__len__") or len(given) != 2:
-            raise ModelError(f"must be two numbers [lower, upper], got {given!r}", field=field)
-        lo, hi = (finite_number(v, field) for v in given)
-        if not lo < hi:
-            raise ModelError(f"must satisfy lower < upper, got [{lo:g}, {hi:g}]", field=field)
-        if lo < 0:
-            raise ModelError(f"the lower bound must be >= 0, got {lo:g}", field=field)
-        out[key] = (lo, hi)
-    return tuple(sorted(out.items()))
 
 
 def _unique(names: Iterable[str], kind: str) -> None:
