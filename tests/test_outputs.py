@@ -4,6 +4,7 @@ Ctrl-C, a bad scheduler or a killed parent; an output never renamed over what is
 from __future__ import annotations
 
 import errno
+import importlib
 import os
 import signal
 import socket
@@ -262,7 +263,11 @@ def test_a_read_only_output_is_refused_before_any_work(campaign, tmp_path, monke
     real_access = os.access
     monkeypatch.setattr(os, "access", lambda p, mode, **k: False if Path(p) == locked else real_access(p, mode, **k))
     analysed = []
-    monkeypatch.setattr("stcs_ident.cli.common.picked_spectra", lambda *a: analysed.append(1) or [])
+    # Patched where the spectra command looks it up: patching only cli.common's name would, when cli.spectra is
+    # first imported during this test, bind the stub into cli.spectra for the rest of the process (every later
+    # `spectra` in this worker then picked nothing: test_refusals' link tests failed under -n 2, in that order).
+    monkeypatch.setattr(importlib.import_module("stcs_ident.cli.spectra"), "picked_spectra",
+                        lambda *a: analysed.append(1) or [])
     for argv, option in ((["spectra", str(campaign), "--plot", str(locked / "plots")], "--plot"),
                          (["forward", str(campaign), "--json", str(locked / "r.json")], "--json"),
                          (["simulate", str(campaign), "--out", str(locked / "sim")], "--out")):
