@@ -287,8 +287,8 @@ def _campaign_text(extra: str) -> str:
     ("  [test.record_format]\n  decimal = \",,\"\n", "test[T2].record_format.decimal", "one character"),
     ("  [test.record_format]\n  unit = \"V\"\n", "test[T2].record_format.unit", "a unit of acceleration"),
     ("  [test.record_format]\n  start_time = \"yesterday\"\n", "test[T2].record_format.start_time", "ISO 8601"),
-    ("  [test.channels]\n  acc3 = { position = 9.9, direction = \"out\" }\n", "test[T2].channels.acc3.direction",
-     "out-of-plane channels are not supported yet"),
+    ("  [test.channels]\n  acc3 = { position = 9.9, direction = \"up\" }\n", "test[T2].channels.acc3.direction",
+     "an angle in degrees"),
     ("  [test.channels]\n  acc3 = { position = 9.9, side = 1 }\n", "test[T2].channels.acc3.side", "unknown key"),
     ("  [test.channels]\n  acc3 = { direction = \"in\" }\n", "test[T2].channels.acc3.position", "required"),
 ])

@@ -29,6 +29,7 @@ from .checks import (  # noqa: F401 (re-exported: the checks were defined here, 
     real_number,
 )
 from .errors import ModelError
+from .planes import check_direction, check_plane
 
 #: Most attachments in one setup. Every frequency evaluation solves the cable with a segment per attachment,
 #: and its time grows steeply with their number (6 modes of an 8 m hanger: 5 ms with 20, 1 s with 50,
@@ -160,16 +161,22 @@ class Attachment:
     mass : float
         kg.
     stiffness : float
-        Transverse spring to ground, N/m.
+        Transverse spring to ground in the cable's plane, N/m.
+    stiffness_out : float or None
+        The spring out of the cable's plane, N/m (keyword only); None: the same as ``stiffness``.
     """
 
     name: str
     position: float
     mass: float = 0.0
     stiffness: float = 0.0
+    stiffness_out: float | None = field(default=None, kw_only=True)
 
     def __post_init__(self):
-        _check_point(self, "attachment")
+        where = _check_point(self, "attachment")
+        if self.stiffness_out is not None:
+            object.__setattr__(self, "stiffness_out", in_band(self.stiffness_out, f"{where}.stiffness_out",
+                                                              "stiffness", zero=True))
 
 
 @dataclass(frozen=True)
@@ -192,13 +199,24 @@ class Damper(Attachment):
         Spring in parallel with the dashpot, N/m.
     coefficient : float
         Dashpot, N s/m (> 0; keyword only).
+    angle : float
+        The damper's axis, radians from the cable's plane (keyword only; 0: in-plane). Its dashpot, spring
+        and moving mass act cos²α in-plane and sin²α out-of-plane (:mod:`stcs_ident.core.planes`).
     """
 
     coefficient: float = field(default=0.0, kw_only=True)
+    angle: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         where = _check_point(self, "damper")
         object.__setattr__(self, "coefficient", in_band(self.coefficient, f"{where}.coefficient", "coefficient"))
+        angle = finite_number(self.angle, f"{where}.angle")
+        if abs(angle) > math.pi:
+            raise ModelError(f"must lie within ±180 degrees, got {math.degrees(angle):g}", field=f"{where}.angle")
+        object.__setattr__(self, "angle", angle)
+        if self.stiffness_out is not None:
+            raise ModelError("a damper acts along its axis: give its angle, not a stiffness_out",
+                             field=f"{where}.stiffness_out")
 
 
 def _noun(a: Attachment) -> str:
@@ -284,6 +302,14 @@ class Test:
         How to read the record's file (``[test.record_format]``: unit,
         sampling_rate, separator, ...; io checks the keys and values); a
         mapping is accepted.
+    planes : tuple of str or None
+        The plane of each of ``frequencies``: ``"in"`` (in-plane, the
+        default for all) or ``"out"`` (out-of-plane); mode numbers count
+        per plane. None without frequencies.
+    channel_directions : tuple of (name, direction)
+        The record's channel directions (``"in"``, ``"out"``, ``"axial"`` or
+        degrees: :mod:`stcs_ident.core.planes`), for a record whose file
+        gives none; a mapping is accepted.
     """
 
     __test__ = False  # not a pytest class
@@ -298,12 +324,16 @@ class Test:
     channels: tuple[tuple[str, float], ...] = ()
     uncertainty: tuple[float, ...] | None = None
     record_format: tuple[tuple[str, Any], ...] = ()
+    planes: tuple[str, ...] | None = None
+    channel_directions: tuple[tuple[str, str | float], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="test.name")
         where = f"test[{self.name}]"
         object.__setattr__(self, "record_format", _record_format(self.record_format, f"{where}.record_format"))
+        object.__setattr__(self, "channel_directions", _directions(self.channel_directions,
+                                                                   f"{where}.channels"))
         channels = tuple(dict(self.channels).items())
         for name, _ in channels:
             if not isinstance(name, str) or not name:
@@ -324,11 +354,20 @@ class Test:
                 )
             for k in modes:
                 mode_number(k, f"{where}.modes")
-            if len(set(modes)) != len(modes):
-                raise ModelError("mode numbers must be distinct", field=f"{where}.modes")
+            planes = ("in",) * len(freqs) if self.planes is None else tuple(self.planes)
+            if len(planes) != len(freqs):
+                raise ModelError(f"has {len(planes)} entries but frequencies has {len(freqs)}",
+                                 field=f"{where}.planes")
+            planes = tuple(check_plane(p, f"{where}.planes") for p in planes)
+            if len(set(zip(planes, modes))) != len(modes):
+                raise ModelError("mode numbers must be distinct" + (" within each plane" if "out" in planes else ""),
+                                 field=f"{where}.modes")
             object.__setattr__(self, "modes", modes)
+            object.__setattr__(self, "planes", planes)
         elif self.modes is not None:
             raise ModelError("given without frequencies", field=f"{where}.modes")
+        else:  # planes are those of frequencies (a copy of a test without its frequencies drops them)
+            object.__setattr__(self, "planes", None)
         if self.uncertainty is not None:
             field_name = f"{where}.uncertainty"
             if self.frequencies is None:
@@ -418,6 +457,8 @@ class Campaign:
     #: by kind, in the variable's units (a ratio to nominal; the kind's SI unit when the nominal value is 0;
     #: the fixity of an end). A kind not given keeps its registered bounds (:mod:`stcs_ident.core.kinds`).
     bounds: tuple[tuple[str, tuple[float, float]], ...] = ()
+    #: The channel directions of records whose files give none (top-level ``[channels]``; a test's own wins).
+    channel_directions: tuple[tuple[str, str | float], ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -436,6 +477,7 @@ class Campaign:
         object.__setattr__(self, "record_format", _record_format(self.record_format, "record_format"))
         object.__setattr__(self, "channels", tuple(
             (name, finite_number(position, f"channels.{name}")) for name, position in dict(self.channels).items()))
+        object.__setattr__(self, "channel_directions", _directions(self.channel_directions, "channels"))
         object.__setattr__(self, "setups", tuple(self.setups))
         object.__setattr__(self, "tests", tuple(self.tests))
         _unique((s.name for s in self.setups), "setup")
@@ -464,6 +506,16 @@ class Campaign:
         if neither) and the reader options (the campaign's ``record_format`` updated with the test's)."""
         positions = dict(test.channels or self.channels) or None
         return positions, {**dict(self.record_format), **dict(test.record_format)}
+
+    def record_directions(self, test: Test) -> dict[str, str | float] | None:
+        """The channel directions the campaign gives for ``test``'s record (the test's table, else the
+        campaign's; None if neither: the file's directions, else in-plane)."""
+        return dict(test.channel_directions or self.channel_directions) or None
+
+
+def _directions(value: Any, field: str) -> tuple[tuple[str, str | float], ...]:
+    """Channel directions as (name, direction) pairs (:func:`~stcs_ident.core.planes.check_direction`)."""
+    return tuple((str(name), check_direction(d, f"{field}.{name}.direction")) for name, d in dict(value).items())
 
 
 def _record_format(value: Any, field: str) -> tuple[tuple[str, Any], ...]:

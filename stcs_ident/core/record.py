@@ -1,8 +1,9 @@
 """The acceleration record: a frozen dataclass in SI units.
 
-Acceleration is transverse and in-plane, m/s² (records in g are converted
-when read), shape (n_samples, n_channels); channel positions are metres
-from end A along the chord.
+Acceleration in m/s² (records in g are converted when read), shape
+(n_samples, n_channels), each channel along its direction (in-plane
+transverse unless the record says otherwise); channel positions are
+metres from end A along the chord.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ModelError
+from .planes import check_direction
 
 STANDARD_GRAVITY = 9.80665  # m/s² per g
 
@@ -96,6 +98,26 @@ def check_position_values(positions: Any, names: list[str], file: str | None) ->
     return positions
 
 
+def check_directions(directions: Any, names: list[str], file: str | None) -> tuple[str | float, ...]:
+    """One direction per channel (:func:`~stcs_ident.core.planes.check_direction`), ModelError naming the file
+    and ``channel_direction`` otherwise."""
+    values = list(np.asarray(directions, dtype=object).reshape(-1)) if not isinstance(directions, str) else [directions]
+    if len(values) != len(names):
+        raise ModelError(f"must have {len(names)} entries, one per channel, got {len(values)}",
+                         field="channel_direction", file=file)
+    out = []
+    for name, value in zip(names, values):
+        if isinstance(value, bytes):
+            value = value.decode("utf-8", "replace")
+        if isinstance(value, np.generic):
+            value = value.item()
+        try:
+            out.append(check_direction(value, "channel_direction"))
+        except ModelError as err:
+            raise ModelError(f"channel {name!r}: {err.message}", field="channel_direction", file=file) from None
+    return tuple(out)
+
+
 #: Rows checked at a time by the scans of a whole record (bounded temporaries on a record of gigabytes).
 BLOCK_ROWS = 65536
 
@@ -142,6 +164,11 @@ class Record:
     replaced : tuple of (option, given, file's value)
         The file's values that the campaign's ``record_format`` replaced
         (``("sampling_rate", 256.0, 255.9)``), for the report to say.
+    channel_directions : tuple or None
+        Per channel, ``"in"``, ``"out"``, ``"axial"`` or an angle in degrees
+        (:mod:`stcs_ident.core.planes`); None when neither the file nor the
+        campaign gives them: every channel is then read as in-plane
+        (:attr:`directions`), and results say so.
     """
 
     acceleration: np.ndarray
@@ -153,6 +180,7 @@ class Record:
     dropped: tuple[tuple[str, str], ...] = field(default_factory=tuple)
     temperature: float | None = None
     replaced: tuple[tuple[str, Any, Any], ...] = ()
+    channel_directions: tuple[str | float, ...] | None = None
 
     def __post_init__(self):
         file = self.source
@@ -166,6 +194,15 @@ class Record:
             np.asarray(self.channel_positions, dtype=float).reshape(-1), names, file))
         if self.temperature is not None:
             object.__setattr__(self, "temperature", check_temperature(self.temperature, file))
+        if self.channel_directions is not None:
+            object.__setattr__(self, "channel_directions", check_directions(self.channel_directions, names, file))
+
+    @property
+    def directions(self) -> tuple[str | float, ...]:
+        """Each channel's direction; ``"in"`` for all when the record has none (:attr:`channel_directions`)."""
+        if self.channel_directions is None:
+            return ("in",) * self.n_channels
+        return self.channel_directions
 
     @property
     def n_samples(self) -> int:

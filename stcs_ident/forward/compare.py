@@ -229,7 +229,7 @@ def compare_forward(campaign: Campaign, tests: list[str] | None = None, n_modes:
             if test.frequencies is not None:
                 table = dict(zip(test.modes, test.frequencies))
             test = replace(test, frequencies=tuple(float(f) for f in freqs) or None,
-                           modes=tuple(int(k) for k in modes) or None, reference=())
+                           modes=tuple(int(k) for k in modes) or None, planes=None, reference=())
         atts = campaign.setup(test.setup).attachments
         shown = _modes_of(test, n_modes)
         if test.modes is not None:

@@ -47,6 +47,7 @@ import numpy as np
 
 from ..core.errors import ComputationError, ModelError
 from ..core.model import Attachment, Cable
+from ..core.planes import plane_overrides, plane_view
 from .batch import build_batch, mode_items
 from .roots import FORCE_NUMPY, solve_modes
 
@@ -85,7 +86,7 @@ class ComplexModes:
 
 
 def complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
-                  tension_model: str = "uniform", certify: bool = True) -> ComplexModes:
+                  tension_model: str = "uniform", certify: bool = True, plane: str = "in") -> ComplexModes:
     """The first ``n_modes`` complex modes of one configuration (see the module docstring).
 
     Parameters
@@ -100,6 +101,8 @@ def complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: floa
         As the undamped solver.
     certify : bool
         Check the count by the argument principle (costs about as much as the solve).
+    plane : {"in", "out"}
+        The plane of the motion (:func:`~stcs_ident.core.planes.plane_view`).
 
     Returns
     -------
@@ -112,7 +115,7 @@ def complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: floa
         If a path does not converge or the count finds a mode the paths missed.
     """
     s = batch_complex_modes(cable, attachments, float(tension), n_modes, tension_model=tension_model,
-                            certify=certify)
+                            certify=certify, plane=plane)
     return _modes(s)
 
 
@@ -122,15 +125,19 @@ def _modes(s: np.ndarray) -> ComplexModes:
 
 
 def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension, n_modes: int = 6, *,
-                        tension_model: str = "uniform", certify: bool = True, **overrides) -> np.ndarray:
+                        tension_model: str = "uniform", certify: bool = True, plane: str | None = "in",
+                        **overrides) -> np.ndarray:
     """Complex eigenvalues s (rad/s) of many parameter sets, shape ``broadcast_shape + (n_modes,)``.
 
-    Parameters as :func:`~stcs_ident.forward.batch_frequencies`, with one more per-attachment override,
-    ``coefficients`` (N s/m, the dashpots; 0 for an attachment without one).
+    Parameters as :func:`~stcs_ident.forward.batch_frequencies` (``plane`` too), with one more per-attachment
+    override, ``coefficients`` (N s/m, the dashpots; 0 for an attachment without one).
     """
     if int(n_modes) < 1:
         raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
     n_modes = int(n_modes)
+    if plane is not None:
+        overrides = plane_overrides(attachments, overrides, plane)
+        cable, attachments = plane_view(cable, attachments, plane)
     shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
     total = math.prod(shape)
     out = np.empty((total, n_modes), dtype=complex)

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.errors import ComputationError
 from ..core.model import Attachment, Cable
+from ..core.planes import plane_view
 from .batch import build_batch
 from .damped import batch_complex_modes
 from .shapes import segment_solutions
@@ -73,7 +74,7 @@ class ComplexShapes:
 
 
 def complex_mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
-                        tension_model: str = "uniform") -> ComplexShapes:
+                        tension_model: str = "uniform", plane: str = "in") -> ComplexShapes:
     """The first ``n_modes`` complex modes of a configuration with dampers (see the module docstring).
 
     Raises
@@ -81,8 +82,9 @@ def complex_mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension
     ComputationError
         If K(s) is not singular at an eigenvalue (a mode whose nodes all rest).
     """
+    cable, attachments = plane_view(cable, attachments, plane)
     atts = sorted(attachments, key=lambda a: a.position)
-    roots = batch_complex_modes(cable, atts, float(tension), n_modes, tension_model=tension_model)
+    roots = batch_complex_modes(cable, atts, float(tension), n_modes, tension_model=tension_model, plane=None)
     _, [(batch, _)] = build_batch(cable, atts, float(tension), tension_model=tension_model)
     nodes = np.concatenate([[0.0], [a.position for a in atts], [cable.length]])
     idx = np.zeros(1, dtype=np.int64)

@@ -18,13 +18,15 @@ import numpy as np
 
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable
+from ..core.planes import plane_overrides, plane_view
 from .batch import CHUNK, build_batch, mode_items
 from .damped import batch_complex_modes
 from .roots import solve_modes
 
 
 def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, n_modes: int = 6, *,
-                      tension_model: str = "uniform", progress=None, **overrides) -> np.ndarray:
+                      tension_model: str = "uniform", progress=None, plane: str | None = "in",
+                      **overrides) -> np.ndarray:
     """First ``n_modes`` natural frequencies (Hz) of many parameter sets at once.
 
     Parameters
@@ -38,6 +40,10 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
     tension_model : {"uniform", "per-segment", "none"}
     progress : callable(done, total), optional
         Called after each chunk of parameter sets.
+    plane : {"in", "out"} or None
+        The plane of the transverse motion (:func:`~stcs_ident.core.planes.plane_view`: out-of-plane, no
+        sag-extensibility, springs at ``stiffness_out``, dampers at sin² of their angle); None takes the
+        attachments' values as they are (already a plane's).
     **overrides :
         Arrays broadcast together with ``tension``: ``EI``, ``length``,
         ``mass_per_length``, ``end_a``, ``end_b`` (rotational stiffness,
@@ -56,9 +62,12 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
     if int(n_modes) < 1:
         raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
     n_modes = int(n_modes)
+    if plane is not None:
+        overrides = plane_overrides(attachments, overrides, plane)
+        cable, attachments = plane_view(cable, attachments, plane)
     if _damped(attachments, overrides):  # complex modes: the frequency is |s|/2π
         return np.abs(batch_complex_modes(cable, attachments, tension, n_modes, tension_model=tension_model,
-                                          **overrides)) / (2 * math.pi)
+                                          plane=None, **overrides)) / (2 * math.pi)
     shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
     total = math.prod(shape)
     if len(groups) == 1 and total <= CHUNK:  # the usual small batch: no scattering
@@ -89,19 +98,21 @@ def _damped(attachments, overrides) -> bool:
 
 
 def natural_frequencies(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
-                        tension_model: str = "uniform") -> np.ndarray:
+                        tension_model: str = "uniform", plane: str | None = "in") -> np.ndarray:
     """The first ``n_modes`` natural frequencies (Hz) of one configuration.
 
     Exact for the model of ``docs/model.md`` (segments between attachments solved
     in closed form); found by the Wittrick–Williams count, so none is missed,
-    and refined to 1e-12 relative.
+    and refined to 1e-12 relative. ``plane``: ``"in"`` (in-plane) or ``"out"`` (out-of-plane,
+    :func:`~stcs_ident.core.planes.plane_view`).
     """
-    return batch_frequencies(cable, attachments, float(tension), n_modes, tension_model=tension_model)
+    return batch_frequencies(cable, attachments, float(tension), n_modes, tension_model=tension_model, plane=plane)
 
 
 def count_below(cable: Cable, attachments: Sequence[Attachment], tension: float, frequency: float, *,
-                tension_model: str = "uniform") -> int:
-    """Number of natural frequencies strictly below ``frequency`` (Hz): J(ω)."""
+                tension_model: str = "uniform", plane: str = "in") -> int:
+    """Number of natural frequencies strictly below ``frequency`` (Hz) in ``plane``: J(ω)."""
+    cable, attachments = plane_view(cable, attachments, plane)
     _, [(batch, _)] = build_batch(cable, attachments, float(tension), tension_model=tension_model)
     J, _, _ = batch.evaluate(np.array([0]), np.array([2 * math.pi * float(frequency)]))
     return int(J[0])

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.errors import ComputationError
 from ..core.model import Attachment, Cable
+from ..core.planes import plane_view
 from .batch import build_batch
 from .dsm import natural_frequencies
 
@@ -84,7 +85,7 @@ class ModeShapes:
 
 
 def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int = 6, *,
-                tension_model: str = "uniform") -> ModeShapes:
+                tension_model: str = "uniform", plane: str = "in") -> ModeShapes:
     """Natural frequencies and mass-normalised mode shapes of one configuration.
 
     A mode whose nodes are all at rest (a bare clamped cable without
@@ -93,7 +94,10 @@ def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float,
     values. Such a configuration is solved again with a null attachment
     (no mass, no spring: it changes no frequency or shape) at an irrational
     fraction of the span, where no such node falls.
+
+    ``plane``: ``"in"`` or ``"out"`` (:func:`~stcs_ident.core.planes.plane_view`).
     """
+    cable, attachments = plane_view(cable, attachments, plane)
     try:
         return _mode_shapes(cable, attachments, tension, n_modes, tension_model)
     except _NodesAtRest:
@@ -120,7 +124,7 @@ def _null_node(length: float, attachments: Sequence[Attachment]) -> Attachment:
 
 def _mode_shapes(cable, attachments, tension, n_modes, tension_model) -> ModeShapes:
     atts = sorted(attachments, key=lambda a: a.position)
-    freqs = natural_frequencies(cable, atts, tension, n_modes, tension_model=tension_model)
+    freqs = natural_frequencies(cable, atts, tension, n_modes, tension_model=tension_model, plane=None)
     _, [(batch, _)] = build_batch(cable, atts, float(tension), tension_model=tension_model)
     topo = batch.topology
     nodes = np.concatenate([[0.0], [a.position for a in atts], [cable.length]])

@@ -26,6 +26,7 @@ from typing import Any
 from ..core import kinds
 from ..core.errors import CampaignError, ModelError
 from ..core.model import Attachment, Boundary, Cable, Campaign, Damper, Published, Setup, Test
+from ..core.planes import check_direction
 from .campaign_toml import campaign_to_toml
 from .records.options import option_problem, option_value
 
@@ -40,10 +41,10 @@ _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
 _SETUP_KEYS = ("name", "attachment", "damper")
-_ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "damping")
-_DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass")
+_ATTACHMENT_KEYS = ("name", "position", "mass", "stiffness", "stiffness_out", "damping")
+_DAMPER_KEYS = ("name", "position", "coefficient", "stiffness", "mass", "angle")
 _TEST_KEYS = ("name", "setup", "tension", "frequencies", "modes", "record", "reference", "channels", "uncertainty",
-              "record_format")
+              "record_format", "planes")
 _CHANNEL_KEYS = ("position", "direction")
 
 _BOUNDARY_HELP = '"clamped", "pinned" or a rotational stiffness >= 0 N m/rad'
@@ -134,9 +135,10 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     published = [_parse_published(t, i) for i, t in enumerate(_tables(data.get("published", []), "published"), 1)]
     tolerance = _parse_tolerance(_table(data.get("tolerance", {}), "tolerance"))
     bounds = _parse_bounds(_table(data.get("bounds", {}), "bounds"))
+    channels, directions = _parse_channels(data.get("channels", {}), "channels")
     return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance,
                     bounds=bounds, record_format=_parse_record_format(data.get("record_format", {}), "record_format"),
-                    channels=_parse_channels(data.get("channels", {}), "channels"))
+                    channels=channels, channel_directions=directions)
 
 
 def _parse_bounds(table: dict[str, Any]) -> dict[str, Any]:
@@ -257,8 +259,12 @@ def _parse_point(table: dict[str, Any], index: int, kind: str, keys, length: flo
     try:
         if kind.endswith(".damper"):
             coefficient = _number(_required(table, "coefficient", where), f"{where}.coefficient")
-            return Damper(name, position, mass, stiffness, coefficient=coefficient)
-        return Attachment(name, position, mass, stiffness)
+            angle = math.radians(_number(table.get("angle", 0.0), f"{where}.angle"))  # degrees in the file
+            return Damper(name, position, mass, stiffness, coefficient=coefficient, angle=angle)
+        stiffness_out = table.get("stiffness_out")
+        if stiffness_out is not None:
+            stiffness_out = _number(stiffness_out, f"{where}.stiffness_out")
+        return Attachment(name, position, mass, stiffness, stiffness_out=stiffness_out)
     except ModelError as err:
         # The model names the field from the attachment down; add the setup.
         setup_where = kind.rsplit(".", 1)[0]
@@ -278,6 +284,15 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
     if uncertainty is not None:  # one number for all the frequencies, or one per frequency
         uncertainty = (_numbers(uncertainty, f"{where}.uncertainty") if isinstance(uncertainty, list)
                        else _number(uncertainty, f"{where}.uncertainty"))
+    planes = table.get("planes")
+    if planes is not None and frequencies is None:
+        raise CampaignError("given without frequencies", field=f"{where}.planes")
+    if planes is not None:  # one plane for all the frequencies, or one per frequency
+        planes = (tuple(_string(p, f"{where}.planes") for p in planes) if isinstance(planes, list)
+                  else _string(planes, f"{where}.planes"))
+        if isinstance(planes, str):
+            planes = (planes,) * len(frequencies) if isinstance(frequencies, list) else (planes,)
+    channels, directions = _parse_channels(table.get("channels", {}), f"{where}.channels")
     return Test(
         name=name,
         setup=_string(_required(table, "setup", where), f"{where}.setup"),
@@ -286,26 +301,28 @@ def _parse_test(table: dict[str, Any], index: int) -> Test:
         modes=None if modes is None else _integers(modes, f"{where}.modes"),
         record=None if record is None else _string(record, f"{where}.record"),
         reference=tuple((k, _numbers(v, f"{where}.reference.{k}")) for k, v in reference.items()),
-        channels=_parse_channels(table.get("channels", {}), f"{where}.channels"),
-        uncertainty=uncertainty,
+        channels=channels, channel_directions=directions,
+        uncertainty=uncertainty, planes=planes,
         record_format=_parse_record_format(table.get("record_format", {}), f"{where}.record_format"),
     )
 
 
-def _parse_channels(value: Any, field: str) -> tuple[tuple[str, float], ...]:
-    """A channel table: ``name = position`` (m from end A) or ``name = {position = .., direction = "in"}``."""
-    out = []
+def _parse_channels(value: Any, field: str) -> tuple[tuple[tuple[str, float], ...], tuple[tuple[str, Any], ...]]:
+    """A channel table: ``name = position`` (m from end A) or ``name = {position = .., direction = "out"}``
+    (``"in"``, ``"out"``, ``"axial"`` or degrees). Returns the positions and the directions given."""
+    out, directions = [], []
     for name, entry in _table(value, field).items():
         where = f"{field}.{name}"
         if isinstance(entry, dict):
             _check_keys(entry, _CHANNEL_KEYS, where)
-            direction = entry.get("direction", "in")
-            if direction != "in":
-                raise CampaignError(f"direction {_show(direction)}: out-of-plane channels are not supported yet "
-                                    '(only "in", the in-plane transverse direction)', field=f"{where}.direction")
+            if "direction" in entry:
+                try:
+                    directions.append((name, check_direction(entry["direction"], f"{where}.direction")))
+                except ModelError as err:
+                    raise CampaignError(err.message, field=err.field) from None
             entry = _required(entry, "position", where)
         out.append((name, _number(entry, where)))
-    return tuple(out)
+    return tuple(out), tuple(directions)
 
 
 def _parse_record_format(value: Any, field: str) -> tuple[tuple[str, Any], ...]:

@@ -58,7 +58,7 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
     if campaign.record_format:
         data["record_format"] = _record_format_table(campaign.record_format)
     if campaign.channels:
-        data["channels"] = {name: float(position) for name, position in campaign.channels}
+        data["channels"] = _channels_table(campaign.channels, campaign.channel_directions)
     if campaign.bounds:
         data["bounds"] = {key: [float(lo), float(hi)] for key, (lo, hi) in campaign.bounds}
     return data
@@ -85,10 +85,14 @@ def _setup_table(setup: Setup) -> dict[str, Any]:
         point = {"name": a.name, "position": float(a.position)}
         if getattr(a, "coefficient", None) is not None:
             point["coefficient"] = float(a.coefficient)
+            if a.angle:
+                point["angle"] = _degrees(a.angle)
             dampers.append(point)
         else:
             attachments.append(point)
         point.update(mass=float(a.mass), stiffness=float(a.stiffness))
+        if getattr(a, "stiffness_out", None) is not None:
+            point["stiffness_out"] = float(a.stiffness_out)
     # The reader builds a setup's attachments before its dampers, so this order reads back equal.
     if attachments:
         table["attachment"] = attachments
@@ -107,12 +111,22 @@ def _test_table(test: Test) -> dict[str, Any]:
     if test.reference:
         table["reference"] = {label: [float(f) for f in values] for label, values in test.reference}
     if test.channels:
-        table["channels"] = {name: float(position) for name, position in test.channels}
+        table["channels"] = _channels_table(test.channels, test.channel_directions)
+    if test.planes is not None and "out" in test.planes:
+        table["planes"] = list(test.planes)
     if test.uncertainty is not None:
         table["uncertainty"] = [float(u) for u in test.uncertainty]
     if test.record_format:
         table["record_format"] = _record_format_table(test.record_format)
     return table
+
+
+def _channels_table(channels, directions) -> dict[str, Any]:
+    """``name = position``, or ``name = {position, direction}`` where a direction is given."""
+    given = dict(directions)
+    return {name: float(position) if name not in given else
+            {"position": float(position), "direction": given[name] if isinstance(given[name], str) else
+             float(given[name])} for name, position in channels}
 
 
 def _published_table(item: Published) -> dict[str, Any]:

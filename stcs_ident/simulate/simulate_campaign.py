@@ -130,7 +130,7 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
             truth_tests.append(_simulate_test(campaign, test, tmp / rel, positions, per_test[test.name],
                                               streams[i], options, field_per_test[test.name]))
             truth_tests[-1]["record"] = rel
-            nominal_tests.append(replace(test, frequencies=None, modes=None, reference=(), record=rel))
+            nominal_tests.append(replace(test, frequencies=None, modes=None, planes=None, reference=(), record=rel))
             if progress is not None:
                 progress(i + 1, len(selected))
         nominal = replace(campaign, tests=tuple(nominal_tests), directory=None)

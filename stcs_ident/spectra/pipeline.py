@@ -74,8 +74,14 @@ class TestSpectra(PickingResult):
     nominal_frequencies: np.ndarray | None = None
     options: PickingOptions = field(default_factory=PickingOptions)
     record_replaced: tuple[tuple[str, Any, Any], ...] = ()
+    planes: tuple[str, ...] | None = None  # per mode, "in" or "out" (None: all in-plane)
 
     main_table = "modes"
+
+    @property
+    def mode_planes(self) -> tuple[str, ...]:
+        """The plane of each numbered mode (``"in"`` or ``"out"``); mode numbers count per plane."""
+        return ("in",) * len(self.modes) if self.planes is None else tuple(self.planes)
 
     def tables(self) -> dict[str, pd.DataFrame]:
         """``modes`` (one row per numbered mode) and ``peaks`` (one row per peak found)."""
@@ -139,7 +145,7 @@ def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX
     """
     path = record_path(campaign, test)
     positions, reading = campaign.record_reading(test)
-    record = read_record(path, positions=positions, **reading)
+    record = read_record(path, positions=positions, directions=campaign.record_directions(test), **reading)
     return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model,
                           options=options)
 

@@ -21,7 +21,8 @@ from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
-from ...core.errors import InputError
+from ...core.errors import InputError, ModelError
+from ...core.planes import check_direction, direction_text
 from ...core.record import Record
 from .options import check_options
 from .validation import overridden
@@ -153,7 +154,8 @@ def reader_for(path: str | os.PathLike) -> RecordReader:
                      file=file)
 
 
-def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
+def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | None = None,
+                directions: Mapping[str, Any] | None = None, **options: Any) -> Record:
     """Read an acceleration record in any registered format (:func:`reader_for` picks it).
 
     Parameters
@@ -162,6 +164,9 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
         The record file.
     positions : mapping of str to float, optional
         m from end A, by channel name, for channels whose file gives no position (CSV).
+    directions : mapping of str to direction, optional
+        By channel name, ``"in"``, ``"out"``, ``"axial"`` or degrees (the campaign's channel table); they
+        replace the file's (and ``replaced`` says where they differ); a channel named in neither is in-plane.
     **options
         Reader options (:data:`~stcs_ident.io.records.options.OPTIONS`: ``unit``, ``sampling_rate``,
         ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``start_time``, ``temperature``,
@@ -185,7 +190,30 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
     replaced = list(record.replaced)
     changes = {key: overridden(key, getattr(record, key), options, replaced) for key in ("start_time", "temperature")
                if options.get(key) is not None}
+    if directions:
+        changes["channel_directions"] = given_directions(record, directions, replaced)
     return replace(record, **changes, replaced=tuple(replaced)) if changes else record
+
+
+def given_directions(record: Record, directions: Mapping[str, Any], replaced: list) -> tuple:
+    """The record's channel directions with the campaign's ``directions`` (by channel name) in place of the
+    file's; a difference from a file's direction is recorded in ``replaced``."""
+    file = record.source
+    found = record.channel_directions
+    out = []
+    for k, name in enumerate(record.channel_names):
+        own = None if found is None else found[k]
+        if name not in directions:
+            out.append("in" if own is None else own)
+            continue
+        try:
+            given = check_direction(directions[name], "channel_direction")
+        except ModelError as err:
+            raise InputError(f"channel {name!r}: {err.message}", field="channel_direction", file=file) from None
+        if own is not None and own != given:
+            replaced.append((f"direction of {name}", direction_text(given), direction_text(own)))
+        out.append(given)
+    return tuple(out)
 
 
 def file_head(path: str | os.PathLike, size: int = HEAD_BYTES) -> bytes:

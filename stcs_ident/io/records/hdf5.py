@@ -3,8 +3,10 @@
 The layout is the one of the interface contract: root attributes
 ``format = "stcs-record"``, ``version = 1``, ``sampling_rate`` (Hz),
 ``unit`` (``"m/s^2"`` or ``"g"``) and optional ``start_time`` (ISO 8601);
-datasets ``/acceleration`` (n_samples, n_channels), ``/channel_name`` and
-``/channel_position`` (m from end A). The checks every record source shares
+datasets ``/acceleration`` (n_samples, n_channels), ``/channel_name``,
+``/channel_position`` (m from end A) and optional ``/channel_direction``
+(``in``, ``out``, ``axial`` or an angle in degrees, as text; without it
+every channel is in-plane). The checks every record source shares
 (and their errors) are in :mod:`~stcs_ident.io.records.validation`; dead and
 clipped channels are dropped as :mod:`~stcs_ident.io.records.screening` says.
 A file that is missing, unreadable or not HDF5 raises an
@@ -22,6 +24,7 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.files import atomic_path
+from ...core.planes import direction_text
 from ...core.record import Record
 from .base import RecordReader, file_head
 from .validation import one_line, overridden, validated_record
@@ -98,10 +101,11 @@ def _read(file: str, options: dict[str, Any]) -> Record:
         acceleration = _read_dataset(h5, "acceleration", file)
         names = _read_dataset(h5, "channel_name", file)
         positions = _read_dataset(h5, "channel_position", file)
+        directions = _read_dataset(h5, "channel_direction", file) if "channel_direction" in h5 else None
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
     return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
-                            source=file, temperature=temperature, replaced=replaced)
+                            source=file, temperature=temperature, replaced=replaced, directions=directions)
 
 
 def write_record(record: Record, path: str | os.PathLike, *, float32: bool = False) -> None:
@@ -121,6 +125,9 @@ def write_record(record: Record, path: str | os.PathLike, *, float32: bool = Fal
         h5["acceleration"] = np.asarray(record.acceleration, dtype=np.float32 if float32 else np.float64)
         h5.create_dataset("channel_name", data=list(record.channel_names), dtype=h5py.string_dtype())
         h5["channel_position"] = np.asarray(record.channel_positions, dtype=np.float64)
+        if record.channel_directions is not None:
+            h5.create_dataset("channel_direction", data=[direction_text(d) for d in record.channel_directions],
+                              dtype=h5py.string_dtype())
 
 
 def _open_hdf5(file: str) -> h5py.File:

@@ -31,6 +31,7 @@ from ...core.errors import InputError
 from ...core.record import (
     STANDARD_GRAVITY,
     Record,
+    check_directions,
     check_finite,
     check_names,
     check_position_values,
@@ -124,15 +125,18 @@ def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: flo
 def validated_record(
     acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
     *, unit: str, start_time: str | None, source: str | None, temperature: float | None = None,
-    replaced: Iterable[tuple[str, Any, Any]] = (),
+    replaced: Iterable[tuple[str, Any, Any]] = (), directions: Any = None,
 ) -> Record:
     """Check the parts of a record, convert to m/s², drop dead and clipped channels (``replaced``: the file's
-    values that the campaign's options replaced, :func:`overridden`)."""
+    values that the campaign's options replaced, :func:`overridden`; ``directions``: one per channel, or None
+    when the file gives none)."""
     file = source
     given = acceleration
     acceleration = check_shape(np.asarray(acceleration, dtype=float), file)
     names = check_names(names, acceleration.shape[1], file)
     positions = check_position_values(positions, names, file)
+    if directions is not None:
+        directions = check_directions(directions, names, file)
     sampling_rate = check_sampling_rate(sampling_rate, file)
     scale = unit_scale(unit, file)
     if start_time is not None:
@@ -148,6 +152,7 @@ def validated_record(
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
         start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature,
         replaced=tuple(replaced),
+        channel_directions=None if directions is None else tuple(directions[k] for k in keep),
     )
 
 
