@@ -115,7 +115,7 @@ def assign(frequencies, sigma, families, unassigned_cost: float = NumberingOptio
 
 def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], cable: Cable,
                  attachments: Sequence[Attachment], tension: float, *, options: NumberingOptions | None = None,
-                 tension_model: str = "uniform") -> Numbering:
+                 tension_model: str = "uniform", plane: str = "in") -> Numbering:
     """Number the peaks by matching the whole family of the cable model.
 
     Parameters
@@ -133,6 +133,9 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
         searched; another family within ``ambiguity`` in cost counts as
         equally good; a peak left unassigned costs ``unassigned_cost``.
     tension_model : the forward model's tension model
+    plane : "in" (default) or "out"
+        Number against that plane's family (:func:`~stcs_ident.core.planes.plane_view`: out-of-plane, no
+        sag-extensibility, springs at ``stiffness_out``, dampers at sin² of their angle).
     """
     options = NumberingOptions() if options is None else options
     f = np.asarray(frequencies, float)
@@ -143,6 +146,7 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
         return Numbering(np.zeros(0, int), np.zeros(0, bool), 1.0, 1.0, np.zeros(0), 0.0, ())
     order = np.argsort(f)
     f, u = f[order], u[order]
+    tension_model = (tension_model, {"plane": plane})
     modes, doubtful, cost, tr, er, family, alternatives = _number(
         f, u, cable, attachments, tension, options.model_tolerance, options, tension_model)
     if np.any(modes == 0):
@@ -170,14 +174,15 @@ def number_modes(frequencies: Sequence[float], uncertainties: Sequence[float], c
 
 def _number(f, u, cable, attachments, tension, model_tolerance, options: NumberingOptions, tension_model):
     """One numbering pass over sorted peaks with a model tolerance: (modes, doubtful, cost, tension ratio,
-    EI ratio, family, alternatives)."""
+    EI ratio, family, alternatives). ``tension_model`` here and below: (the tension model, the plane keyword
+    of batch_frequencies)."""
     tension_range, EI_range, cost_unassigned = options.tension_range, options.EI_range, options.unassigned_cost
     sigma = np.sqrt(u**2 + (model_tolerance * f) ** 2)
     t_ratio = np.geomspace(*tension_range, 49)
     ei_ratio = np.geomspace(*EI_range, 15) if cable.EI > 0 else np.array([1.0])
     n_modes = _modes_needed(f, cable, attachments, tension, tension_range[0], tension_model)
     fam = batch_frequencies(cable, attachments, tension * t_ratio[:, None], n_modes,
-                            EI=cable.EI * ei_ratio[None, :], tension_model=tension_model)
+                            EI=cable.EI * ei_ratio[None, :], tension_model=tension_model[0], **tension_model[1])
     flat = fam.reshape(-1, n_modes)
     all_modes, all_cost = assign(f, sigma, flat, cost_unassigned)
     # candidate numberings from the best grid families, each refined by a
@@ -238,7 +243,8 @@ def _refine(f, sigma, modes, t0, r0, cable, attachments, tension, tension_model,
 def _family(x, cable, attachments, tension, tension_model, n_modes):
     t = math.exp(x[0])
     EI = cable.EI * math.exp(x[1]) if len(x) > 1 else cable.EI
-    return batch_frequencies(cable, attachments, tension * t, n_modes, EI=EI, tension_model=tension_model)
+    return batch_frequencies(cable, attachments, tension * t, n_modes, EI=EI, tension_model=tension_model[0],
+                             **tension_model[1])
 
 
 def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
@@ -246,7 +252,7 @@ def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
     n = 8
     while True:
         soft = batch_frequencies(cable, attachments, tension * lowest_ratio, n, EI=cable.EI * 0.2,
-                                 tension_model=tension_model)
+                                 tension_model=tension_model[0], **tension_model[1])
         if soft[-1] > 1.2 * f.max() or n > 400:
             return n
         n = int(n * 1.6)

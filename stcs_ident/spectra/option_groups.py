@@ -26,7 +26,7 @@ from .option_checks import (
 
 __all__ = [
     "DecayCheckOptions", "DetectionOptions", "EventOptions", "FilterOptions", "FitOptions", "FloorOptions",
-    "NumberingOptions", "OnsetScale", "OverviewOptions", "RefineOptions", "ResidualOptions",
+    "NumberingOptions", "OnsetScale", "OverviewOptions", "PlaneOptions", "RefineOptions", "ResidualOptions",
 ]
 
 
@@ -447,4 +447,49 @@ class NumberingOptions(OptionGroup):
     _checks: ClassVar[dict[str, Callable]] = {
         "model_tolerance": positive, "relaxed_tolerance": at_least(1.0), "unassigned_cost": positive,
         "tension_range": ratio_range, "EI_range": ratio_range, "ambiguity": non_negative,
+    }
+
+
+def _frequencies(value) -> str | None:
+    return None if value == () else tuple_of(positive)(value)
+
+
+@dataclass(frozen=True)
+class PlaneOptions(OptionGroup):
+    """The two planes and what is not the cable's (:mod:`.plane_analysis`, :mod:`.structural`); used only for a
+    record whose channels have directions. Not one of :class:`.options.PickingOptions`'s groups (those tune the
+    picking of one set of channels); :func:`.pipeline.analyse_test` takes it as ``plane_options`` and the
+    result records it.
+
+    Attributes
+    ----------
+    structural : tuple of float
+        Known frequencies of the structure (deck, pylon), Hz: a peak within 3σ of one of them or of a
+        harmonic of one is structural, never numbered (default none).
+    leak_ratio : float
+        A peak seen in both planes at one frequency (within 3σ) is one mode leaking through a misaligned
+        sensor when the weaker plane's amplitude is below this fraction of the stronger's (0.15: a sensor
+        turned by up to 8.6°, sin 8.6° = 0.15); above it, both planes carry a mode (two modes, kept apart).
+    min_mac : float
+        A numbered peak whose operating shape has a modal assurance criterion below this against the
+        model's shape of its mode, where that is meaningful (two positions or more in the plane, the model's
+        shape not at a node of them all), is structural (0.5: sensor noise and the model's error leave a
+        cable mode's MAC near 0.9 or above at the simulated SNRs).
+    axial_snr_db : float
+        An unassigned peak standing this high above the floor of an axial channel moves the anchorage
+        (structural; 10 dB: the cable's own modes barely move a sensor along the chord).
+    max_harmonic : int
+        Harmonics of a structural frequency considered, up to this order (5).
+    """
+
+    structural: tuple[float, ...] = ()
+    leak_ratio: float = 0.15
+    min_mac: float = 0.5
+    axial_snr_db: float = 10.0
+    max_harmonic: int = 5
+
+    _name: ClassVar[str] = "planes"
+    _checks: ClassVar[dict[str, Callable]] = {
+        "structural": _frequencies, "leak_ratio": fraction, "min_mac": fraction,
+        "axial_snr_db": non_negative, "max_harmonic": count,
     }
