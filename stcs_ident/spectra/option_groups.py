@@ -493,3 +493,8 @@ class PlaneOptions(OptionGroup):
         "structural": _frequencies, "leak_ratio": fraction, "min_mac": fraction,
         "axial_snr_db": non_negative, "max_harmonic": count,
     }
+
+    def summary(self) -> dict:
+        """Plain data for JSON (the structural frequencies as a list)."""
+        return {"structural": list(self.structural), "leak_ratio": self.leak_ratio, "min_mac": self.min_mac,
+                "axial_snr_db": self.axial_snr_db, "max_harmonic": self.max_harmonic}

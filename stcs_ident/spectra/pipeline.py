@@ -16,19 +16,27 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..core.errors import InputError
 from ..core.model import Campaign, Test
+from ..core.notes import Note
+from ..core.planes import PLANE_NAMES
 from ..core.record import Record
 from ..forward import natural_frequencies
 from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
+from .option_groups import PlaneOptions
 from .options import PickingOptions
 from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
+from .plane_analysis import PlanesOutcome, analyse_planes
+from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.
 DEFAULT_MAX_MODES = 30
+#: Said of a record whose channels have no directions.
+NO_DIRECTIONS = "no channel directions given: every channel read as in-plane"
 
 
 @dataclass(frozen=True, repr=False)
@@ -54,6 +62,16 @@ class TestSpectra(PickingResult):
     options : the picking and numbering options used (how the result was made)
     record_replaced : (option, given, file's value) the campaign's ``record_format`` replaced in the record's
         file (:attr:`Record.replaced`)
+    planes : per mode, ``"in"`` or ``"out"`` (None: all in-plane, a record without channel directions)
+    mac : per mode, the modal assurance criterion of its operating shape against the model's shape of the mode
+        at the sensors of its plane (NaN where not meaningful: fewer than two positions, or all at its nodes)
+    shapes : per mode, its operating shape: (channel, amplitude signed by phase) over its plane's channels
+    structural : (frequency, uncertainty, reason) of the peaks that are not the cable's (the deck's or pylon's
+        modes moving the anchorage, their harmonics): never numbered
+    unassigned_planes : the plane of each of ``unassigned`` (None: all in-plane)
+    plane_peaks : (plane, PeakResult) per plane, for a record with channel directions (``peaks`` is the first)
+    plane_options : the options of the planes and of the structural peaks used
+    plane_notes : what the analysis has to say (:attr:`notes`)
     """
 
     __test__ = False
@@ -75,8 +93,20 @@ class TestSpectra(PickingResult):
     options: PickingOptions = field(default_factory=PickingOptions)
     record_replaced: tuple[tuple[str, Any, Any], ...] = ()
     planes: tuple[str, ...] | None = None  # per mode, "in" or "out" (None: all in-plane)
+    mac: np.ndarray | None = None
+    shapes: tuple[tuple[tuple[str, float], ...], ...] | None = None
+    structural: tuple[tuple[float, float, str], ...] = ()
+    unassigned_planes: tuple[str, ...] | None = None
+    plane_peaks: tuple[tuple[str, PeakResult], ...] = ()
+    plane_options: PlaneOptions = field(default_factory=PlaneOptions)
+    plane_notes: tuple[Note, ...] = ()
 
     main_table = "modes"
+
+    @property
+    def notes(self) -> tuple[Note, ...]:
+        """What the analysis has to say (a record read without channel directions, leaks set aside)."""
+        return self.plane_notes
 
     @property
     def mode_planes(self) -> tuple[str, ...]:
@@ -85,12 +115,20 @@ class TestSpectra(PickingResult):
 
     def tables(self) -> dict[str, pd.DataFrame]:
         """``modes`` (one row per numbered mode) and ``peaks`` (one row per peak found)."""
-        return {"modes": self.to_dataframe(), "peaks": self.peaks.to_dataframe()}
+        if not self.plane_peaks:
+            return {"modes": self.to_dataframe(), "peaks": self.peaks.to_dataframe()}
+        frames = []
+        for plane, result in self.plane_peaks:
+            frame = result.to_dataframe()
+            frame.insert(0, "plane", plane)
+            frames.append(frame)
+        return {"modes": self.to_dataframe(), "peaks": pd.concat(frames, ignore_index=True)}
 
     def headline(self) -> str:
         """Test, modes numbered, peaks left unnumbered, channels dropped."""
         modes = f" ({_ranges(self.modes)})" if self.modes else ""
         extra = f", {len(self.unassigned)} peaks unnumbered" if self.unassigned else ""
+        extra += f", {len(self.structural)} structural peaks" if self.structural else ""
         extra += f", {len(self.dropped)} channels dropped" if self.dropped else ""
         return f"{self.name}: {len(self.modes)} modes picked{modes} from an {self.peaks.kind} record{extra}"
 
@@ -98,8 +136,12 @@ class TestSpectra(PickingResult):
         return pd.DataFrame({
             "mode": self.modes, "frequency_Hz": self.frequencies, "uncertainty_Hz": self.uncertainty,
             "damping": self.damping, "doubtful": self.doubtful,
-            "channels": [" ".join(c) for c in self.channels],
+            "channels": [" ".join(c) for c in self.channels], "plane": self.mode_planes,
+            "mac": self._macs(),
         })
+
+    def _macs(self) -> np.ndarray:
+        return np.full(len(self.modes), np.nan) if self.mac is None else np.asarray(self.mac, float)
 
     def summary(self) -> dict:
         return {
@@ -108,10 +150,15 @@ class TestSpectra(PickingResult):
             "uncertainty": [float(x) for x in self.uncertainty],
             "damping": [None if math.isnan(x) else float(x) for x in self.damping],
             "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
-            "unassigned": [{"frequency": f, "uncertainty": u} for f, u in self.unassigned],
+            "unassigned": [{"frequency": f, "uncertainty": u, "plane": p} for (f, u), p in zip(
+                self.unassigned, self.unassigned_planes or ("in",) * len(self.unassigned))],
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
             "options": self.options.summary(), "record_replaced": [
                 {"option": option, "given": given, "file": found} for option, given, found in self.record_replaced],
+            "plane": list(self.mode_planes), "mac": [None if math.isnan(x) else float(x) for x in self._macs()],
+            "shape": [dict(s) for s in self.shapes] if self.shapes is not None else [{} for _ in self.modes],
+            "structural": [{"frequency": f, "uncertainty": u, "reason": r} for f, u, r in self.structural],
+            "plane_options": self.plane_options.summary(), "notes": [str(n) for n in self.notes],
         }
 
 
@@ -135,25 +182,35 @@ def record_path(campaign: Campaign, test: Test) -> str:
 
 
 def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX_MODES,
-                 tension_model: str = "uniform", options: PickingOptions | None = None) -> TestSpectra:
+                 tension_model: str = "uniform", options: PickingOptions | None = None,
+                 plane_options: PlaneOptions | None = None) -> TestSpectra:
     """Pick and number the modal frequencies of one test's record (in any format io reads; the test's
     ``channels`` give the positions a file lacks, its ``record_format`` the reader options, the campaign's
     top-level ones where the test gives none).
 
     ``options`` tunes the picking and the numbering (default: the
-    calibrated values); the result records them.
+    calibrated values); the result records them. ``plane_options``: the planes and the structural peaks
+    (:class:`.option_groups.PlaneOptions`; used for a record whose channels have directions).
     """
     path = record_path(campaign, test)
     positions, reading = campaign.record_reading(test)
     record = read_record(path, positions=positions, directions=campaign.record_directions(test), **reading)
     return analyse_record(campaign, test, record, path, max_modes=max_modes, tension_model=tension_model,
-                          options=options)
+                          options=options, plane_options=plane_options)
 
 
 def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *, max_modes: int = DEFAULT_MAX_MODES,
-                   tension_model: str = "uniform", options: PickingOptions | None = None) -> TestSpectra:
-    """:func:`analyse_test` of a record already read (from ``path``); its mean is removed in place."""
+                   tension_model: str = "uniform", options: PickingOptions | None = None,
+                   plane_options: PlaneOptions | None = None) -> TestSpectra:
+    """:func:`analyse_test` of a record already read (from ``path``); its mean is removed in place.
+
+    A record with channel directions is analysed per plane (:mod:`.plane_analysis`); one without is read as
+    in-plane throughout, and the result says so in its notes.
+    """
     options = PickingOptions() if options is None else options
+    plane_options = PlaneOptions() if plane_options is None else plane_options
+    if not isinstance(plane_options, PlaneOptions):
+        raise InputError(f"must be a PlaneOptions, got {plane_options!r}", field="plane_options")
     cable = campaign.cable
     atts = campaign.setup(test.setup).attachments
     check_positions(record, cable.length, file=path)
@@ -161,6 +218,10 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     check_duration(record, nominal[0] / 1.5, file=path)  # a few periods of mode 1, with margin for a 15 % error
     usable = 0.45  # of the sampling rate: the analysis band ends below the anti-aliasing filter's roll-off
     check_bandwidth(record, nominal[0], usable=usable, file=path)
+    if record.channel_directions is not None:
+        outcome = analyse_planes(record, cable, atts, test.tension, max_modes=max_modes, tension_model=tension_model,
+                                 options=options, plane_options=plane_options)
+        return _plane_spectra(test, record, path, outcome, options, plane_options)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
     result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True,  # the record is ours
                         options=options)
@@ -170,6 +231,8 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                              tension_model=tension_model)
     order = [i for i in np.argsort(numbering.modes) if numbering.modes[i] > 0]
     peaks = result.peaks
+    macs, shapes = _operating_shapes(record, [peaks[i] for i in order], [int(numbering.modes[i]) for i in order],
+                                     numbering, cable, atts, test.tension, tension_model)
     return TestSpectra(
         name=test.name, record=path,
         modes=tuple(int(numbering.modes[i]) for i in order),
@@ -182,12 +245,59 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         damping_uncertainty=np.array([np.nan if peaks[i].damping_uncertainty is None else peaks[i].damping_uncertainty
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
-        options=options, record_replaced=tuple(record.replaced),
+        options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
+        plane_options=plane_options, plane_notes=(Note.plain("directions", NO_DIRECTIONS),),
+    )
+
+
+def _operating_shapes(record: Record, peaks, modes, numbering: Numbering, cable, atts, tension, tension_model):
+    """Per numbered peak of a record read in-plane: MAC against the model's shape (NaN where it cannot tell
+    shapes apart) and the operating shape per channel. Reported only: the numbers stay the family fit's."""
+    shapes = tuple(tuple((n, float(a)) for n, a in zip(record.channel_names, p.amplitude)) for p in peaks)
+    model = model_shapes(cable, atts, tension, modes, record.channel_positions, plane="in",
+                         tension_model=tension_model, tension_ratio=numbering.tension_ratio,
+                         EI_ratio=numbering.EI_ratio)
+    macs = np.full(len(peaks), np.nan)
+    if model is not None:
+        for k, p in enumerate(peaks):
+            phi = model[0][:, k]
+            if shape_is_meaningful(record.channel_positions, phi, model[1][k], cable.length):
+                macs[k] = mac(p.amplitude, phi)
+    return macs, shapes
+
+
+def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome, options: PickingOptions,
+                   plane_options: PlaneOptions) -> TestSpectra:
+    """The TestSpectra of a record analysed per plane."""
+    peaks = outcome.peaks
+    chosen = [peaks[m.plane].peaks[m.index] for m in outcome.modes]
+    first = next(iter(peaks))
+    unassigned = [peaks[plane].peaks[k] for plane, k in outcome.unassigned]
+    notes = tuple(Note.plain("leak", f"{PLANE_NAMES[plane]} peak at {peaks[plane].peaks[k].frequency:.4f} Hz "
+                                     f"set aside: {reason}") for plane, k, reason in outcome.leaks)
+    return TestSpectra(
+        name=test.name, record=path, modes=tuple(m.mode for m in outcome.modes),
+        frequencies=np.array([p.frequency for p in chosen], float),
+        uncertainty=np.array([p.uncertainty for p in chosen], float),
+        damping=np.array([np.nan if p.damping is None else p.damping for p in chosen], float),
+        channels=tuple(tuple(p.channels) for p in chosen), doubtful=tuple(m.doubtful for m in outcome.modes),
+        unassigned=tuple((float(p.frequency), float(p.uncertainty)) for p in unassigned),
+        dropped=tuple(record.dropped), peaks=peaks[first], numbering=outcome.numbering[first],
+        damping_uncertainty=np.array([np.nan if p.damping_uncertainty is None else p.damping_uncertainty
+                                      for p in chosen], float),
+        nominal_frequencies=np.asarray(outcome.nominal[first], float), options=options,
+        record_replaced=tuple(record.replaced), planes=tuple(m.plane for m in outcome.modes),
+        mac=np.array([m.mac for m in outcome.modes], float), shapes=tuple(m.shape for m in outcome.modes),
+        structural=tuple((float(peaks[plane].peaks[k].frequency), float(peaks[plane].peaks[k].uncertainty), reason)
+                         for plane, k, reason in outcome.structural),
+        unassigned_planes=tuple(plane for plane, _ in outcome.unassigned),
+        plane_peaks=tuple(peaks.items()), plane_options=plane_options, plane_notes=notes,
     )
 
 
 def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, progress=None,
-                     tension_model: str = "uniform", options: PickingOptions | None = None) -> list[TestSpectra]:
+                     tension_model: str = "uniform", options: PickingOptions | None = None,
+                     plane_options: PlaneOptions | None = None) -> list[TestSpectra]:
     """:func:`analyse_test` for every selected test that has a record (with the same ``options``)."""
     selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
     with_record = [t for t in selected if t.record is not None]
@@ -195,5 +305,6 @@ def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, prog
     for k, test in enumerate(with_record, 1):
         if progress is not None:
             progress(f"spectra: test {test.name} ({k} of {len(with_record)})")
-        out.append(analyse_test(campaign, test, tension_model=tension_model, options=options))
+        out.append(analyse_test(campaign, test, tension_model=tension_model, options=options,
+                                plane_options=plane_options))
     return out

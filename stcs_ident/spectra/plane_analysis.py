@@ -1,0 +1,240 @@
+"""Peaks picked and numbered per plane, and the peaks that are not the cable's (a record with channel directions).
+
+1. Channels by plane (:mod:`.channels`): in-plane and out-of-plane components, axial channels aside.
+2. Peaks per plane: :func:`.peaks.find_peaks` on each plane's channels alone, so a mode of one plane is fitted
+   with the noise of that plane's channels and a close pair (an in-plane and an out-of-plane mode a few per
+   mil apart, each in its own channels) is never fitted as one peak. A peak found in both planes within 3σ
+   is one mode leaking through a misaligned sensor where the weaker plane's amplitude (rms over its
+   channels) is below ``leak_ratio`` of the stronger's: it is kept in the stronger plane only. Otherwise
+   both planes carry it: two peaks, never merged.
+3. Structural peaks (:mod:`.structural`): a peak at a given structural frequency or a harmonic of one is
+   set aside before numbering. Each plane's peaks are numbered against that plane's family
+   (:func:`.numbering.number_modes` with ``plane``); a numbered peak whose operating shape has a MAC below
+   ``min_mac`` against its mode's model shape (where meaningful) is structural, and the plane is numbered
+   again without it. Of the unassigned peaks, one standing on the axial channels, or found in both planes
+   with the other plane's peak not a cable mode either, or at a harmonic of a structural peak, is structural.
+   The rest stay unassigned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.planes import PLANE_NAMES
+from ..core.record import Record
+from ..forward import natural_frequencies
+from .channels import PlaneChannels, plane_channels, plane_record
+from .numbering import Numbering, number_modes
+from .option_groups import PlaneOptions
+from .options import PickingOptions
+from .overview import ambient_overview
+from .peak_result import PeakResult
+from .peaks import find_peaks
+from .structural import harmonic_of, mac, model_shapes, shape_is_meaningful
+
+__all__ = ["PlaneMode", "PlanesOutcome", "analyse_planes"]
+
+
+@dataclass(frozen=True)
+class PlaneMode:
+    """One numbered peak of one plane."""
+
+    plane: str
+    mode: int
+    index: int  # in the plane's PeakResult
+    doubtful: bool
+    mac: float  # NaN where not meaningful
+    shape: tuple[tuple[str, float], ...]
+
+
+@dataclass(frozen=True)
+class PlanesOutcome:
+    """What :func:`analyse_planes` found: per plane its channels, peaks, numbering and nominal frequencies;
+    the numbered modes, the unassigned and the structural peaks (plane, index, reason), the leaks dropped."""
+
+    channels: dict[str, PlaneChannels]
+    peaks: dict[str, PeakResult]
+    numbering: dict[str, Numbering]
+    nominal: dict[str, np.ndarray]
+    modes: list[PlaneMode] = field(default_factory=list)
+    unassigned: list[tuple[str, int]] = field(default_factory=list)
+    structural: list[tuple[str, int, str]] = field(default_factory=list)
+    leaks: list[tuple[str, int, str]] = field(default_factory=list)
+
+
+def analyse_planes(record: Record, cable, attachments, tension: float, *, max_modes: int, tension_model: str,
+                   options: PickingOptions, plane_options: PlaneOptions) -> PlanesOutcome:
+    """Peaks per plane, numbered per plane, structural ones set apart (the module's steps)."""
+    channels, axial = plane_channels(record)
+    fs = record.sampling_rate
+    peaks, nominal = {}, {}
+    for plane, chans in channels.items():
+        nominal[plane] = natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
+                                             plane=plane)
+        f_max = min(0.45 * fs, 1.3 * nominal[plane][-1])
+        peaks[plane] = find_peaks(plane_record(record, chans), f_min=0.5 * nominal[plane][0], f_max=f_max,
+                                  overwrite=True, options=options)  # the plane's record is a copy, ours
+    out = PlanesOutcome(channels, peaks, {}, nominal)
+    kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
+    pairs = _pairs(peaks)
+    for (i, j) in pairs:
+        a, b = peaks["in"].peaks[i], peaks["out"].peaks[j]
+        sa, sb = _strength(a.amplitude), _strength(b.amplitude)
+        if min(sa, sb) < plane_options.leak_ratio * max(sa, sb):
+            weak, strong = (("in", i), "out") if sa < sb else (("out", j), "in")
+            kept[weak[0]].discard(weak[1])
+            out.leaks.append((*weak, f"the {PLANE_NAMES[strong]} mode leaking through a sensor's misalignment"))
+    structural: dict[tuple[str, int], str] = {}
+    given = [(f, 0.0) for f in plane_options.structural]
+    for plane, result in peaks.items():
+        for k in sorted(kept[plane]):
+            p = result.peaks[k]
+            hit = harmonic_of(p.frequency, p.uncertainty, given, plane_options.max_harmonic)
+            if hit is not None:
+                structural[(plane, k)] = _harmonic_text(*hit, "given structural frequency")
+    for plane, result in peaks.items():
+        candidates = [k for k in sorted(kept[plane]) if (plane, k) not in structural]
+        for attempt in range(4):  # numbered, then again without the peaks whose shape is not their mode's
+            numbering = _number(result, candidates, cable, attachments, tension, tension_model, options, plane)
+            shapes = _shapes(result, channels[plane], candidates, numbering, cable, attachments, tension,
+                             tension_model, plane)
+            rejected = [k for k, (value, meaningful, mode) in shapes.items()
+                        if meaningful and value < plane_options.min_mac and attempt < 3]
+            for k in rejected:
+                value, _, mode = shapes[k]
+                structural[(plane, k)] = (f"operating shape unlike mode {mode}'s ({PLANE_NAMES[plane]}): "
+                                          f"MAC {value:.2f}")
+            if not rejected:
+                break
+            candidates = [k for k in candidates if k not in rejected]
+        out.numbering[plane] = numbering
+        names = channels[plane].names
+        for pos, k in enumerate(candidates):
+            mode = int(numbering.modes[pos])
+            if mode > 0:
+                value, meaningful, _ = shapes[k]
+                amplitude = result.peaks[k].amplitude
+                out.modes.append(PlaneMode(plane, mode, k, bool(numbering.doubtful[pos]),
+                                           value if meaningful else float("nan"),
+                                           tuple((n, float(a)) for n, a in zip(names, amplitude))))
+            else:
+                out.unassigned.append((plane, k))
+    _unassigned_structural(out, record, axial, pairs, structural, options, plane_options)
+    out.structural.extend((plane, k, reason) for (plane, k), reason in structural.items())
+    out.structural.sort(key=lambda s: peaks[s[0]].peaks[s[1]].frequency)
+    out.modes.sort(key=lambda m: (m.plane != "in", m.mode))
+    return out
+
+
+def _number(result: PeakResult, candidates, cable, attachments, tension, tension_model, options, plane) -> Numbering:
+    f = np.array([result.peaks[k].frequency for k in candidates], float)
+    u = np.array([result.peaks[k].uncertainty for k in candidates], float)
+    return number_modes(f, u, cable, attachments, tension, options=options.numbering, tension_model=tension_model,
+                        plane=plane)
+
+
+def _shapes(result, chans: PlaneChannels, candidates, numbering, cable, attachments, tension, tension_model,
+            plane) -> dict[int, tuple[float, bool, int]]:
+    """Per numbered candidate: (MAC against its mode's model shape, whether meaningful, mode)."""
+    numbered = [(k, int(m)) for k, m in zip(candidates, numbering.modes) if m > 0]
+    if not numbered:
+        return {}
+    model = model_shapes(cable, attachments, tension, [m for _, m in numbered], chans.positions, plane=plane,
+                         tension_model=tension_model, tension_ratio=numbering.tension_ratio,
+                         EI_ratio=numbering.EI_ratio)
+    out = {}
+    for col, (k, mode) in enumerate(numbered):
+        if model is None:
+            out[k] = (float("nan"), False, mode)
+            continue
+        phi, largest = model[0][:, col], model[1][col]
+        value = mac(result.peaks[k].amplitude, phi)
+        meaningful = shape_is_meaningful(chans.positions, phi, largest, cable.length) and np.isfinite(value)
+        out[k] = (value, bool(meaningful), mode)
+    return out
+
+
+def _pairs(peaks: dict[str, PeakResult]) -> list[tuple[int, int]]:
+    """(in index, out index) of the peaks found in both planes within 3σ (combined), nearest first, each peak in
+    one pair at most."""
+    if "in" not in peaks or "out" not in peaks:
+        return []
+    a, b = peaks["in"].peaks, peaks["out"].peaks
+    close = []
+    for i, p in enumerate(a):
+        for j, q in enumerate(b):
+            z = abs(p.frequency - q.frequency) / np.hypot(p.uncertainty, q.uncertainty)
+            if z <= 3.0:
+                close.append((z, i, j))
+    used_a, used_b, out = set(), set(), []
+    for _, i, j in sorted(close):
+        if i not in used_a and j not in used_b:
+            used_a.add(i)
+            used_b.add(j)
+            out.append((i, j))
+    return out
+
+
+def _strength(amplitude: np.ndarray) -> float:
+    """A peak's amplitude over a plane's channels (rms)."""
+    return float(np.sqrt(np.mean(np.square(amplitude)))) if len(amplitude) else 0.0
+
+
+def _harmonic_text(base: float, order: int, what: str) -> str:
+    if order == 1:
+        return f"at the {what} {base:.4g} Hz"
+    return f"harmonic {order} of the {what} {base:.4g} Hz"
+
+
+def _unassigned_structural(out: PlanesOutcome, record: Record, axial, pairs, structural: dict, options,
+                           plane_options: PlaneOptions) -> None:
+    """Move the unassigned peaks that show the anchorage's motion, both planes or a structural harmonic into
+    ``structural`` (in place)."""
+    if not out.unassigned:
+        return
+    peaks = out.peaks
+    unassigned = set(out.unassigned)
+    axial_snr = _axial_snr(record, axial, options)
+    partner = {("in", i): ("out", j) for i, j in pairs} | {("out", j): ("in", i) for i, j in pairs}
+    for key in sorted(unassigned):
+        p = peaks[key[0]].peaks[key[1]]
+        if axial_snr is not None:
+            snr = axial_snr(p.frequency)
+            if snr >= plane_options.axial_snr_db:
+                structural[key] = f"on the axial channels ({snr:.0f} dB): the anchorage moving"
+                continue
+        other = partner.get(key)
+        if other is not None and (other in unassigned or other in structural):
+            structural[key] = "in both planes at one frequency"
+    changed = True
+    while changed:  # harmonics of the structural peaks, found or given
+        changed = False
+        bases = [(peaks[pl].peaks[k].frequency, peaks[pl].peaks[k].uncertainty) for pl, k in structural]
+        for key in sorted(unassigned):
+            if key in structural:
+                continue
+            p = peaks[key[0]].peaks[key[1]]
+            hit = harmonic_of(p.frequency, p.uncertainty, bases, plane_options.max_harmonic)
+            if hit is not None:
+                structural[key] = _harmonic_text(*hit, "structural peak at")
+                changed = True
+    out.unassigned[:] = [key for key in out.unassigned if key not in structural]
+
+
+def _axial_snr(record: Record, axial, options: PickingOptions):
+    """f ↦ the highest height above its floor of the axial channels' spectra at f, dB (None without axial
+    channels)."""
+    if not axial:
+        return None
+    x = record.acceleration[:, list(axial)]
+    overview = ambient_overview(x - x.mean(axis=0), record.sampling_rate, options=options.overview,
+                                floor_options=options.floor)
+    ratio = overview.channel_spectra / overview.channel_floor
+
+    def snr(frequency: float) -> float:
+        values = [np.interp(frequency, overview.frequency, col) for col in ratio.T]
+        return float(10 * np.log10(max(max(values), 1e-12)))
+
+    return snr
