@@ -6,7 +6,15 @@ import argparse
 import os
 import sys
 
-from .common import add_campaign_argument, add_json_option, command_parser, picked_spectra, prepare, write_output
+from .common import (
+    add_campaign_argument,
+    add_json_option,
+    command_parser,
+    picked_spectra,
+    prepare,
+    progress_line,
+    write_output,
+)
 
 
 def add_parser(sub) -> None:
@@ -15,14 +23,36 @@ def add_parser(sub) -> None:
     add_campaign_argument(parser)
     add_json_option(parser)
     parser.add_argument("--plot", metavar="DIR", help="write one PNG per test and the picked modes (modes.csv) into DIR")
+    parser.add_argument("--structural", metavar="HZ[,HZ...]", type=_frequencies,
+                        help="known frequencies of the deck or pylon (Hz): peaks at them or their harmonics are "
+                             "reported as structural, never numbered (records with channel directions)")
+
+
+def _frequencies(text: str) -> tuple[float, ...]:
+    """``1.23,2.5`` as (1.23, 2.5); argparse reports the error with the option's name."""
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be frequencies in Hz separated by commas, got {text!r}") from None
+    if not values or not all(v > 0 and v < float("inf") for v in values):
+        raise argparse.ArgumentTypeError(f"must be positive frequencies in Hz separated by commas, got {text!r}")
+    return values
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``spectra``; returns the exit status."""
-    from ..report.forward import spectra_text, to_json
+    from ..report.forward import to_json
+    from ..report.spectra_tables import spectra_text
 
     campaign, file, tests = prepare(args)
-    results = picked_spectra(campaign, tests, file)
+    if args.structural:
+        from ..spectra.option_groups import PlaneOptions
+        from ..spectra.pipeline import analyse_campaign
+
+        results = analyse_campaign(campaign, tests, progress=progress_line,
+                                   plane_options=PlaneOptions(structural=args.structural))
+    else:
+        results = picked_spectra(campaign, tests, file)
     skipped = [t.name for t in campaign.tests if t.record is None and (not tests or t.name in tests)]
     if args.json:
         write_output(args.json, to_json({"campaign": campaign.name, "tests": [r.summary() for r in results],

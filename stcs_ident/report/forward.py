@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
 
 from ..core.files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
 from ..core.formatting import number, rms
 from ..forward.compare import ForwardResult
+from .spectra_tables import spectra_text  # noqa: F401  (re-exported: the spectra command's text is written there)
 
 
 def _fmt(value, digits=3, width=9) -> str:
@@ -77,28 +77,3 @@ def _json_default(value):
     if hasattr(value, "tolist"):
         return value.tolist()
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
-
-def spectra_text(campaign: str, results, skipped) -> str:
-    """The ``spectra`` tables: per test, mode, frequency, uncertainty, channels."""
-    lines = [f"Campaign {campaign}: modal frequencies picked from the records", ""]
-    for r in results:
-        lines.append(f"Test {r.name} ({r.peaks.kind} record {os.path.basename(r.record)})")
-        for name, reason in r.dropped:
-            lines.append(f"  channel {name} dropped: {reason}")
-        for option, given, found in getattr(r, "record_replaced", ()):
-            lines.append(f"  record: {option} {given!r} from record_format replaces the file's {found!r}")
-        lines.append(f"{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9}  channels")
-        for k, f, u, z, ch, doubt in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels, r.doubtful):
-            flag = "?" if doubt else " "
-            zeta = number(100 * z, "{:.2f}")
-            lines.append(f"{k:>3}{flag} {f:11.4f} {u:11.5f} {zeta:>9}  {' '.join(ch)}")
-        if any(r.doubtful):
-            lines.append("  ? = doubtful mode number: another family of modes fits almost as well")
-        for f, u in r.unassigned:
-            lines.append(f"  unassigned peak at {f:.4f} ± {u:.5f} Hz")
-        lines.append("")
-    if skipped:
-        lines.append(f"Tests without a record (nothing to pick): {', '.join(skipped)}")
-        lines.append("")
-    return "\n".join(lines)

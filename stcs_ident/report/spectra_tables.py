@@ -1,24 +1,28 @@
-"""The ``spectra`` table: the numbered modes picked from each test's record, as CSV.
+"""The ``spectra`` outputs: the numbered modes picked from each test's record, as CSV and as text.
 
 The numbers come from each result's ``to_dataframe()`` and fields; this
-module only stacks them into one table (one row per test and mode).
+module only stacks them into one table (one row per test and mode) and
+writes them as the command's text.
 """
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
 import pandas as pd
 
 from ..core import files
+from ..core.formatting import number
+from ..core.planes import PLANE_NAMES
 
-__all__ = ["MODES_CSV", "modes_table", "write_modes_csv"]
+__all__ = ["MODES_CSV", "modes_table", "spectra_text", "write_modes_csv"]
 
 #: File name of the table, in the ``--plot`` directory.
 MODES_CSV = "modes.csv"
 _COLUMNS = ["test", "record_kind", "mode", "frequency_Hz", "uncertainty_Hz", "damping", "damping_uncertainty",
-            "doubtful", "channels"]
+            "doubtful", "channels", "plane", "mac"]
 
 
 def modes_table(results) -> pd.DataFrame:
@@ -34,8 +38,9 @@ def modes_table(results) -> pd.DataFrame:
     pandas.DataFrame
         Columns ``test``, ``record_kind`` (``impulse`` or ``ambient``), ``mode``, ``frequency_Hz``,
         ``uncertainty_Hz`` (1σ), ``damping`` (ratio, NaN where not estimated), ``damping_uncertainty``
-        (1σ), ``doubtful`` (the mode number is doubtful) and ``channels`` (where the peak was seen,
-        space-separated).
+        (1σ), ``doubtful`` (the mode number is doubtful), ``channels`` (where the peak was seen,
+        space-separated), ``plane`` (``in`` or ``out``: mode numbers count per plane) and ``mac`` (of the
+        operating shape against the model's, NaN where not meaningful).
     """
     frames = []
     for r in results:
@@ -55,3 +60,42 @@ def write_modes_csv(results, directory: str | os.PathLike) -> str:
     path = os.path.join(directory, MODES_CSV)
     files.write_csv(modes_table(results), path, index=False)
     return path
+
+
+def spectra_text(campaign: str, results, skipped) -> str:
+    """The ``spectra`` tables: per test, mode (and its plane where the record has channel directions),
+    frequency, uncertainty, damping, MAC, channels; then the peaks left unnumbered, the structural ones (the
+    deck's or pylon's, never numbered) and the notes."""
+    lines = [f"Campaign {campaign}: modal frequencies picked from the records", ""]
+    for r in results:
+        lines.append(f"Test {r.name} ({r.peaks.kind} record {os.path.basename(r.record)})")
+        for name, reason in r.dropped:
+            lines.append(f"  channel {name} dropped: {reason}")
+        for option, given, found in getattr(r, "record_replaced", ()):
+            lines.append(f"  record: {option} {given!r} from record_format replaces the file's {found!r}")
+        planes = r.planes is not None
+        macs = r.to_dataframe()["mac"]
+        head = f"{'plane':>5} " if planes else ""
+        lines.append(f"{head}{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9} {'MAC':>5}  channels")
+        for k, f, u, z, ch, doubt, plane, m in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels,
+                                                   r.doubtful, r.mode_planes, macs):
+            flag = "?" if doubt else " "
+            zeta = number(100 * z, "{:.2f}")
+            mac = "" if math.isnan(m) else f"{m:.2f}"
+            head = f"{plane:>5} " if planes else ""
+            lines.append(f"{head}{k:>3}{flag} {f:11.4f} {u:11.5f} {zeta:>9} {mac:>5}  {' '.join(ch)}")
+        if any(r.doubtful):
+            lines.append("  ? = doubtful mode number: another family of modes fits almost as well")
+        where = r.unassigned_planes or ("in",) * len(r.unassigned)
+        for (f, u), plane in zip(r.unassigned, where):
+            side = f" ({PLANE_NAMES[plane]})" if planes else ""
+            lines.append(f"  unassigned peak at {f:.4f} ± {u:.5f} Hz{side}")
+        for f, u, reason in r.structural:
+            lines.append(f"  structural peak at {f:.4f} ± {u:.5f} Hz, not the cable's: {reason}")
+        for note in r.notes:
+            lines.append(f"  note: {note}")
+        lines.append("")
+    if skipped:
+        lines.append(f"Tests without a record (nothing to pick): {', '.join(skipped)}")
+        lines.append("")
+    return "\n".join(lines)

@@ -104,8 +104,8 @@ def _spread(angles) -> float:
     return best
 
 
-def plane_record(record: Record, channels: PlaneChannels) -> Record:
-    """The record of one plane's channels (no directions: they all lie in the plane)."""
+def plane_record(record: Record, channels: PlaneChannels, extra: tuple[int, ...] = ()) -> Record:
+    """The record of one plane's channels, then the record's channels ``extra`` as they are (no directions)."""
     x = record.acceleration
     columns = []
     for indices, coefficients in channels.combinations:
@@ -113,6 +113,9 @@ def plane_record(record: Record, channels: PlaneChannels) -> Record:
             columns.append(x[:, indices[0]])
         else:
             columns.append(x[:, list(indices)] @ np.asarray(coefficients))
+    columns += [x[:, k] for k in extra]
+    names = channels.names + tuple(record.channel_names[k] for k in extra)
+    positions = np.concatenate([channels.positions, record.channel_positions[list(extra)]])
     return Record(acceleration=np.column_stack(columns), sampling_rate=record.sampling_rate,
-                  channel_names=channels.names, channel_positions=channels.positions, start_time=record.start_time,
+                  channel_names=names, channel_positions=positions, start_time=record.start_time,
                   source=record.source, temperature=record.temperature)

@@ -475,9 +475,10 @@ class PlaneOptions(OptionGroup):
         model's shape of its mode, where that is meaningful (two positions or more in the plane, the model's
         shape not at a node of them all), is structural (0.5: sensor noise and the model's error leave a
         cable mode's MAC near 0.9 or above at the simulated SNRs).
-    axial_snr_db : float
-        An unassigned peak standing this high above the floor of an axial channel moves the anchorage
-        (structural; 10 dB: the cable's own modes barely move a sensor along the chord).
+    axial_ratio : float
+        A peak whose largest amplitude on the axial channels reaches this fraction of its largest transverse
+        amplitude moves the anchorage (structural; 0.3: a cable's own mode moves a sensor along the chord by
+        about the slope of its sag profile times its transverse motion, a few per cent).
     max_harmonic : int
         Harmonics of a structural frequency considered, up to this order (5).
     """
@@ -485,16 +486,16 @@ class PlaneOptions(OptionGroup):
     structural: tuple[float, ...] = ()
     leak_ratio: float = 0.15
     min_mac: float = 0.5
-    axial_snr_db: float = 10.0
+    axial_ratio: float = 0.3
     max_harmonic: int = 5
 
     _name: ClassVar[str] = "planes"
     _checks: ClassVar[dict[str, Callable]] = {
         "structural": _frequencies, "leak_ratio": fraction, "min_mac": fraction,
-        "axial_snr_db": non_negative, "max_harmonic": count,
+        "axial_ratio": positive, "max_harmonic": count,
     }
 
     def summary(self) -> dict:
         """Plain data for JSON (the structural frequencies as a list)."""
         return {"structural": list(self.structural), "leak_ratio": self.leak_ratio, "min_mac": self.min_mac,
-                "axial_snr_db": self.axial_snr_db, "max_harmonic": self.max_harmonic}
+                "axial_ratio": self.axial_ratio, "max_harmonic": self.max_harmonic}

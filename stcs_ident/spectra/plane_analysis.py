@@ -1,18 +1,21 @@
 """Peaks picked and numbered per plane, and the peaks that are not the cable's (a record with channel directions).
 
 1. Channels by plane (:mod:`.channels`): in-plane and out-of-plane components, axial channels aside.
-2. Peaks per plane: :func:`.peaks.find_peaks` on each plane's channels alone, so a mode of one plane is fitted
-   with the noise of that plane's channels and a close pair (an in-plane and an out-of-plane mode a few per
-   mil apart, each in its own channels) is never fitted as one peak. A peak found in both planes within 3σ
+2. Peaks per plane: :func:`.peaks.find_peaks` on each plane's channels and the axial ones, so a mode of one
+   plane is fitted with the noise of that plane's channels, a close pair (an in-plane and an out-of-plane mode
+   a few per mil apart, each in its own channels) is never fitted as one peak, and a deck mode beside a cable
+   mode is detected through the axial channels, where the cable's mode hardly shows, and fitted as a peak of
+   its own. A peak found in both planes within 3σ
    is one mode leaking through a misaligned sensor where the weaker plane's amplitude (rms over its
    channels) is below ``leak_ratio`` of the stronger's: it is kept in the stronger plane only. Otherwise
    both planes carry it: two peaks, never merged.
-3. Structural peaks (:mod:`.structural`): a peak at a given structural frequency or a harmonic of one is
-   set aside before numbering. Each plane's peaks are numbered against that plane's family
+3. Structural peaks (:mod:`.structural`): a peak at a given structural frequency or a harmonic of one, or
+   whose amplitude on the axial channels reaches ``axial_ratio`` of its transverse amplitude (the anchorage
+   moving along the chord), is set aside before numbering. Each plane's peaks are numbered against that plane's family
    (:func:`.numbering.number_modes` with ``plane``); a numbered peak whose operating shape has a MAC below
    ``min_mac`` against its mode's model shape (where meaningful) is structural, and the plane is numbered
-   again without it. Of the unassigned peaks, one standing on the axial channels, or found in both planes
-   with the other plane's peak not a cable mode either, or at a harmonic of a structural peak, is structural.
+   again without it. Of the unassigned peaks, one found in both planes with the other plane's peak not a
+   cable mode either, or at a harmonic of a structural peak, is structural.
    The rest stay unassigned.
 """
 
@@ -29,7 +32,6 @@ from .channels import PlaneChannels, plane_channels, plane_record
 from .numbering import Numbering, number_modes
 from .option_groups import PlaneOptions
 from .options import PickingOptions
-from .overview import ambient_overview
 from .peak_result import PeakResult
 from .peaks import find_peaks
 from .structural import harmonic_of, mac, model_shapes, shape_is_meaningful
@@ -74,14 +76,14 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
         nominal[plane] = natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
                                              plane=plane)
         f_max = min(0.45 * fs, 1.3 * nominal[plane][-1])
-        peaks[plane] = find_peaks(plane_record(record, chans), f_min=0.5 * nominal[plane][0], f_max=f_max,
+        peaks[plane] = find_peaks(plane_record(record, chans, axial), f_min=0.5 * nominal[plane][0], f_max=f_max,
                                   overwrite=True, options=options)  # the plane's record is a copy, ours
     out = PlanesOutcome(channels, peaks, {}, nominal)
     kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
     pairs = _pairs(peaks)
     for (i, j) in pairs:
         a, b = peaks["in"].peaks[i], peaks["out"].peaks[j]
-        sa, sb = _strength(a.amplitude), _strength(b.amplitude)
+        sa, sb = _strength(a.amplitude[:len(channels["in"])]), _strength(b.amplitude[:len(channels["out"])])
         if min(sa, sb) < plane_options.leak_ratio * max(sa, sb):
             weak, strong = (("in", i), "out") if sa < sb else (("out", j), "in")
             kept[weak[0]].discard(weak[1])
@@ -89,11 +91,17 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     structural: dict[tuple[str, int], str] = {}
     given = [(f, 0.0) for f in plane_options.structural]
     for plane, result in peaks.items():
+        n = len(channels[plane])
         for k in sorted(kept[plane]):
             p = result.peaks[k]
             hit = harmonic_of(p.frequency, p.uncertainty, given, plane_options.max_harmonic)
             if hit is not None:
                 structural[(plane, k)] = _harmonic_text(*hit, "given structural frequency")
+            elif len(p.amplitude) > n:  # axial channels: the anchorage moving along the chord
+                ratio = np.abs(p.amplitude[n:]).max() / max(np.abs(p.amplitude[:n]).max(), 1e-300)
+                if ratio >= plane_options.axial_ratio:
+                    structural[(plane, k)] = (f"on the axial channels at {ratio:.2f} of the transverse amplitude: "
+                                              "the anchorage moving")
     for plane, result in peaks.items():
         candidates = [k for k in sorted(kept[plane]) if (plane, k) not in structural]
         for attempt in range(4):  # numbered, then again without the peaks whose shape is not their mode's
@@ -115,13 +123,13 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
             mode = int(numbering.modes[pos])
             if mode > 0:
                 value, meaningful, _ = shapes[k]
-                amplitude = result.peaks[k].amplitude
+                amplitude = result.peaks[k].amplitude[:len(names)]
                 out.modes.append(PlaneMode(plane, mode, k, bool(numbering.doubtful[pos]),
                                            value if meaningful else float("nan"),
                                            tuple((n, float(a)) for n, a in zip(names, amplitude))))
             else:
                 out.unassigned.append((plane, k))
-    _unassigned_structural(out, record, axial, pairs, structural, options, plane_options)
+    _unassigned_structural(out, pairs, structural, plane_options)
     out.structural.extend((plane, k, reason) for (plane, k), reason in structural.items())
     out.structural.sort(key=lambda s: peaks[s[0]].peaks[s[1]].frequency)
     out.modes.sort(key=lambda m: (m.plane != "in", m.mode))
@@ -150,7 +158,7 @@ def _shapes(result, chans: PlaneChannels, candidates, numbering, cable, attachme
             out[k] = (float("nan"), False, mode)
             continue
         phi, largest = model[0][:, col], model[1][col]
-        value = mac(result.peaks[k].amplitude, phi)
+        value = mac(result.peaks[k].amplitude[:len(chans)], phi)
         meaningful = shape_is_meaningful(chans.positions, phi, largest, cable.length) and np.isfinite(value)
         out[k] = (value, bool(meaningful), mode)
     return out
@@ -188,23 +196,15 @@ def _harmonic_text(base: float, order: int, what: str) -> str:
     return f"harmonic {order} of the {what} {base:.4g} Hz"
 
 
-def _unassigned_structural(out: PlanesOutcome, record: Record, axial, pairs, structural: dict, options,
-                           plane_options: PlaneOptions) -> None:
-    """Move the unassigned peaks that show the anchorage's motion, both planes or a structural harmonic into
-    ``structural`` (in place)."""
+def _unassigned_structural(out: PlanesOutcome, pairs, structural: dict, plane_options: PlaneOptions) -> None:
+    """Move the unassigned peaks found in both planes or at a structural harmonic into ``structural`` (in
+    place)."""
     if not out.unassigned:
         return
     peaks = out.peaks
     unassigned = set(out.unassigned)
-    axial_snr = _axial_snr(record, axial, options)
     partner = {("in", i): ("out", j) for i, j in pairs} | {("out", j): ("in", i) for i, j in pairs}
     for key in sorted(unassigned):
-        p = peaks[key[0]].peaks[key[1]]
-        if axial_snr is not None:
-            snr = axial_snr(p.frequency)
-            if snr >= plane_options.axial_snr_db:
-                structural[key] = f"on the axial channels ({snr:.0f} dB): the anchorage moving"
-                continue
         other = partner.get(key)
         if other is not None and (other in unassigned or other in structural):
             structural[key] = "in both planes at one frequency"
@@ -221,20 +221,3 @@ def _unassigned_structural(out: PlanesOutcome, record: Record, axial, pairs, str
                 structural[key] = _harmonic_text(*hit, "structural peak at")
                 changed = True
     out.unassigned[:] = [key for key in out.unassigned if key not in structural]
-
-
-def _axial_snr(record: Record, axial, options: PickingOptions):
-    """f ↦ the highest height above its floor of the axial channels' spectra at f, dB (None without axial
-    channels)."""
-    if not axial:
-        return None
-    x = record.acceleration[:, list(axial)]
-    overview = ambient_overview(x - x.mean(axis=0), record.sampling_rate, options=options.overview,
-                                floor_options=options.floor)
-    ratio = overview.channel_spectra / overview.channel_floor
-
-    def snr(frequency: float) -> float:
-        values = [np.interp(frequency, overview.frequency, col) for col in ratio.T]
-        return float(10 * np.log10(max(max(values), 1e-12)))
-
-    return snr
