@@ -70,7 +70,7 @@ def make_case(kind: str, seed: int, *, layout: str = "biaxial", deck: bool = Tru
     rng = np.random.default_rng(seed)
     tension_true = k.tension * rng.uniform(0.93, 1.07)  # the nominal tension a few per cent off
     positions = np.array(k.positions) * k.cable.length
-    fs, n = k.sampling_rate, int(round(k.duration * k.sampling_rate))
+    fs, n = k.sampling_rate, round(k.duration * k.sampling_rate)
     planes, truth = {}, {}
     for j, plane in enumerate(("in", "out")):
         cable, atts = plane_view(k.cable, k.attachments, plane)

@@ -80,20 +80,11 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
                                   overwrite=True, options=options)  # the plane's record is a copy, ours
     out = PlanesOutcome(channels, peaks, {}, nominal)
     kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
-    pairs = _pairs(peaks)
-    for (i, j) in pairs:
-        a, b = peaks["in"].peaks[i], peaks["out"].peaks[j]
-        sa, sb = _strength(a.amplitude[:len(channels["in"])]), _strength(b.amplitude[:len(channels["out"])])
-        if min(sa, sb) < plane_options.leak_ratio * max(sa, sb):
-            weak, strong = (("in", i), "out") if sa < sb else (("out", j), "in")
-            kept[weak[0]].discard(weak[1])
-            out.leaks.append((*weak, f"the {PLANE_NAMES[strong]} mode leaking through a sensor's misalignment"))
     structural: dict[tuple[str, int], str] = {}
     given = [(f, 0.0) for f in plane_options.structural]
     for plane, result in peaks.items():
         n = len(channels[plane])
-        for k in sorted(kept[plane]):
-            p = result.peaks[k]
+        for k, p in enumerate(result.peaks):
             hit = harmonic_of(p.frequency, p.uncertainty, given, plane_options.max_harmonic)
             if hit is not None:
                 structural[(plane, k)] = _harmonic_text(*hit, "given structural frequency")
@@ -102,6 +93,21 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
                 if ratio >= plane_options.axial_ratio:
                     structural[(plane, k)] = (f"on the axial channels at {ratio:.2f} of the transverse amplitude: "
                                               "the anchorage moving")
+    pairs = _pairs(peaks)
+    for (i, j) in pairs:
+        a, b = peaks["in"].peaks[i], peaks["out"].peaks[j]
+        if ("in", i) in structural and ("out", j) in structural:  # one structural peak, seen by both: once
+            weak = ("in", i) if a.uncertainty > b.uncertainty else ("out", j)
+            kept[weak[0]].discard(weak[1])
+            del structural[weak]
+            continue
+        if ("in", i) in structural or ("out", j) in structural:
+            continue
+        sa, sb = _strength(a.amplitude[:len(channels["in"])]), _strength(b.amplitude[:len(channels["out"])])
+        if min(sa, sb) < plane_options.leak_ratio * max(sa, sb):
+            weak, strong = (("in", i), "out") if sa < sb else (("out", j), "in")
+            kept[weak[0]].discard(weak[1])
+            out.leaks.append((*weak, f"the {PLANE_NAMES[strong]} mode leaking through a sensor's misalignment"))
     for plane, result in peaks.items():
         candidates = [k for k in sorted(kept[plane]) if (plane, k) not in structural]
         for attempt in range(4):  # numbered, then again without the peaks whose shape is not their mode's

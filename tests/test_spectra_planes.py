@@ -1,0 +1,218 @@
+"""Spectra per plane, and the peaks that are not the cable's (spectra/channels.py, plane_analysis.py,
+structural.py; issue 24, points 3 and 4).
+
+The records are simulated per plane and combined (tests/plane_records.py): independent wind in each plane,
+a deck mode moving the anchorage within 2 % of a cable mode, a second one elsewhere in the band, their
+second harmonics, and the axial channel that sees the anchorage move.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from stcs_ident.core.errors import InputError
+from stcs_ident.core.record import Record
+from stcs_ident.report.spectra_tables import modes_table, spectra_text
+from stcs_ident.spectra.channels import plane_channels, plane_record
+from stcs_ident.spectra.option_groups import PlaneOptions
+from stcs_ident.spectra.pipeline import NO_DIRECTIONS, analyse_record
+from stcs_ident.spectra.structural import harmonic_of, mac, shape_is_meaningful
+
+from .plane_records import make_case
+
+# ---------------------------------------------------------------------------------------------------------------
+# Channels by plane
+
+
+def _record(directions, positions=(3.0, 3.0, 5.0, 7.0), n=512, seed=0):
+    rng = np.random.default_rng(seed)
+    u, v = rng.standard_normal((n, len(positions))), rng.standard_normal((n, len(positions)))
+    angles = [{"in": 0.0, "out": 90.0}.get(d, d) for d in directions]
+    acc = np.column_stack([
+        u[:, k] * math.cos(math.radians(a)) + v[:, k] * math.sin(math.radians(a)) if d != "axial" else u[:, k]
+        for k, (d, a) in enumerate(zip(directions, angles))])
+    return Record(acceleration=acc, sampling_rate=100.0, channel_names=tuple(f"c{k}" for k in range(len(directions))),
+                  channel_positions=np.array(positions), channel_directions=tuple(directions)), u, v
+
+
+def test_a_turned_sensor_pair_is_rotated_into_in_and_out():
+    # c0 at 30° and c1 at 120° at one position: the in/out components are recovered exactly (the pair spans
+    # the plane); c2 (10°) goes to its nearer plane, divided by cos 10°; c3 is axial.
+    record, u, v = _record([30.0, 120.0, 10.0, "axial"])
+    planes, axial = plane_channels(record)
+    assert axial == (3,)
+    assert planes["in"].names == ("c0+c1:in", "c2") and planes["out"].names == ("c0+c1:out",)
+    inn, out = plane_record(record, planes["in"]), plane_record(record, planes["out"], axial)
+    np.testing.assert_allclose(inn.acceleration[:, 0], u[:, 0], atol=1e-12)  # rounding only
+    np.testing.assert_allclose(out.acceleration[:, 0], v[:, 1 - 1], atol=1e-12)
+    expected = u[:, 2] + math.tan(math.radians(10)) * v[:, 2]  # the in-plane reading plus tan θ of the other
+    np.testing.assert_allclose(inn.acceleration[:, 1], expected, atol=1e-12)
+    assert out.channel_names == ("c0+c1:out", "c3")  # the axial channel rides along
+
+
+def test_aligned_pairs_keep_their_names_and_values():
+    record, _, _ = _record(["in", "out", "in", "out"], positions=(3.0, 3.0, 5.0, 5.0))
+    planes, axial = plane_channels(record)
+    assert axial == () and planes["in"].names == ("c0", "c2") and planes["out"].names == ("c1", "c3")
+    np.testing.assert_array_equal(plane_record(record, planes["out"]).acceleration[:, 1], record.acceleration[:, 3])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Structural helpers
+
+
+def test_mac_and_when_it_is_meaningful():
+    phi = np.array([0.5, 0.9, 1.0])
+    assert mac(2 * phi, phi) == pytest.approx(1.0, abs=1e-15)
+    assert mac(np.array([1.0, 0.0, -1.0]), np.array([1.0, 5.0, 1.0])) == 0.0
+    assert math.isnan(mac(np.zeros(3), phi))
+    assert shape_is_meaningful(np.array([10.0, 20.0, 30.0]), phi, 1.0, 100.0)
+    assert not shape_is_meaningful(np.array([10.0, 10.0, 10.0]), phi, 1.0, 100.0)  # one position
+    assert not shape_is_meaningful(np.array([10.0, 20.0]), np.array([0.01, -0.02]), 1.0, 100.0)  # at nodes
+
+
+def test_harmonics_within_three_sigma():
+    assert harmonic_of(4.02, 0.01, [(2.0, 0.001)], 5) == (2.0, 2)
+    assert harmonic_of(4.10, 0.01, [(2.0, 0.001)], 5) is None  # 0.1 Hz off is 10σ
+    assert harmonic_of(12.0, 0.01, [(2.0, 0.0)], 5) is None  # order 6 beyond max_harmonic
+
+
+def test_plane_options_are_checked():
+    with pytest.raises(InputError, match="planes.structural"):
+        PlaneOptions(structural=(1.0, -2.0))
+    with pytest.raises(InputError, match="planes.min_mac"):
+        PlaneOptions(min_mac=1.5)
+    case = make_case("hanger", 1)
+    with pytest.raises(InputError, match="plane_options"):
+        analyse_record(case.campaign, case.test, case.record, "x", plane_options={"structural": [1.0]})
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Records
+
+
+def _analyse(case, **options):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # doubtful numbers are flagged in the result; not what is tested here
+        return analyse_record(case.campaign, case.test, case.record, "x", **options)
+
+
+def test_a_record_without_directions_is_read_in_plane_and_says_so():
+    case = make_case("hanger", 2, deck=False)
+    record = case.record
+    plain = Record(acceleration=record.acceleration[:, ::2].copy(), sampling_rate=record.sampling_rate,
+                   channel_names=record.channel_names[::2], channel_positions=record.channel_positions[::2])
+    r = _analyse(case.__class__(plain, case.campaign, case.test, case.truth))
+    assert r.planes is None and set(r.mode_planes) == {"in"} and r.structural == ()
+    assert [str(n) for n in r.notes] == [NO_DIRECTIONS]
+    assert r.summary()["notes"] == [NO_DIRECTIONS] and r.summary()["plane"] == ["in"] * len(r.modes)
+    truth = case.truth["in"]
+    z = (r.frequencies - truth[np.array(r.modes) - 1]) / r.uncertainty
+    assert len(r.modes) >= 5 and np.all(np.abs(z) < 4)  # 4σ: a 1-in-16000 miss per mode for an honest 1σ
+    assert np.all(r.mac > 0.8)  # three sensors, 30 dB: a cable mode's operating shape is its model shape
+
+
+def test_in_and_out_modes_at_one_frequency_are_never_merged():
+    # The hanger has no sag: its in-plane and out-of-plane families coincide, every mode is a pair.
+    case = make_case("hanger", 3, deck=False)
+    r = _analyse(case)
+    numbered = {(p, m) for p, m in zip(r.mode_planes, r.modes)}
+    both = {m for p, m in numbered if p == "in"} & {m for p, m in numbered if p == "out"}
+    assert len(both) >= 4  # each plane's channels carry their own mode: two peaks, one per plane
+    for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
+        assert abs(f - case.truth[plane][mode - 1]) < 4 * u, (plane, mode)  # 4σ as above
+    assert [n.kind for n in r.notes] == []  # nothing set aside as a leak: the sensors are aligned
+
+
+def test_a_misaligned_sensor_leaks_the_other_plane_which_is_set_aside():
+    # Only the out-of-plane motion, read by sensors turned 5° (the "in" channels see sin 5° = 0.087 of it).
+    case = make_case("stay", 4, deck=False)
+    acc = case.record.acceleration.copy()
+    names = case.record.channel_names
+    rng = np.random.default_rng(4)
+    for k, name in enumerate(names):
+        if name.startswith("in"):
+            out = names.index("out" + name[2:])
+            acc[:, k] = math.sin(math.radians(5)) * acc[:, out] + 1e-3 * acc[:, out].std() * rng.standard_normal(
+                len(acc))
+    case.record = Record(acceleration=acc, sampling_rate=case.record.sampling_rate, channel_names=names,
+                         channel_positions=case.record.channel_positions,
+                         channel_directions=case.record.channel_directions)
+    r = _analyse(case)
+    assert "in" not in r.mode_planes and sum(p == "out" for p in r.mode_planes) >= 4
+    assert sum(n.kind == "leak" for n in r.notes) >= 4
+    assert all(p != "in" for p in (r.unassigned_planes or ()))
+
+
+def test_deck_modes_are_structural_and_reported():
+    case = make_case("stay", 5, layout="triaxial", near=0.01)
+    r = _analyse(case)
+    structural = [f for f, _, _ in r.structural]
+    for f_deck, _plane in case.deck:  # each deck mode is reported as structural (not merely dropped)
+        assert any(abs(f - f_deck) < 0.01 * f_deck for f in structural), (f_deck, r.structural)
+    for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
+        assert abs(f - case.truth[plane][mode - 1]) < 4 * u, (plane, mode)
+    summary = json.loads(json.dumps(r.summary()))  # JSON-able
+    assert {s["frequency"] for s in summary["structural"]} == set(structural)
+    assert summary["plane"] == list(r.mode_planes) and len(summary["shape"]) == len(r.modes)
+    assert set(summary["shape"][0]) <= set(case.record.channel_names)
+    table = modes_table([r])
+    assert table["plane"].tolist() == list(r.mode_planes) and "mac" in table
+    text = spectra_text("c", [r], [])
+    assert text.count("structural peak at") == len(r.structural) and "plane" in text
+
+
+def test_given_structural_frequencies_are_never_numbered():
+    case = make_case("hanger", 6, layout="biaxial", near=0.015)
+    r = _analyse(case, plane_options=PlaneOptions(structural=tuple(f for f, _ in case.deck)))
+    for f_deck, _ in case.deck:  # no numbered peak within 3σ of a given frequency or its harmonics
+        for f, u in zip(r.frequencies, r.uncertainty):
+            assert all(abs(f - order * f_deck) > 3 * u for order in range(1, 6)), (f, f_deck)
+    reasons = [why for _, _, why in r.structural]
+    assert any("given structural frequency" in why for why in reasons)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Acceptance (slow): no deck mode numbered, 1σ coverage per plane, on held-out seeds.
+
+HELD_OUT = 10_000  # tuned on seeds 0-99; these were not looked at before the test was written
+
+
+def _score(kind, seeds, layout):
+    z = {"in": [], "out": []}
+    numbered_deck = []
+    for seed in seeds:
+        case = make_case(kind, seed, layout=layout)
+        r = _analyse(case)
+        for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
+            true = case.truth[plane][mode - 1]
+            z[plane].append((f - true) / u)
+            # A deck mode numbered as a cable mode: the numbered peak is off its mode beyond 3σ and nearer a
+            # structural frequency (a deck mode or harmonic) than the mode's true frequency.
+            if abs(f - true) > 3 * u and any(abs(f - s) < abs(f - true) for s in case.structural):
+                numbered_deck.append((kind, seed, plane, mode, f))
+    return z, numbered_deck
+
+
+@pytest.mark.slow
+def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane():
+    z = {"in": [], "out": []}
+    numbered_deck = []
+    for kind, layout, n in (("stay", "triaxial", 60), ("stay", "biaxial", 40), ("hanger", "triaxial", 60),
+                            ("hanger", "biaxial", 40)):
+        zk, dk = _score(kind, range(HELD_OUT, HELD_OUT + n), layout)
+        for plane in z:
+            z[plane] += zk[plane]
+        numbered_deck += dk
+    assert numbered_deck == []
+    for plane, values in z.items():
+        a = np.abs(values)
+        assert a.size >= 400
+        # The issue's band: 68 ± 7 % within 1σ (the binomial spread of 400 pairs is ± 2.3 %), ≥ 98 % within 3σ.
+        assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
+        assert np.mean(a <= 3) >= 0.98, (plane, np.mean(a <= 3))
