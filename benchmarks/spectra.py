@@ -38,6 +38,13 @@ the minimum over the runs and, when ``threadpoolctl`` is importable (it
 comes with pyOMA-2's scikit-learn), the time with BLAS limited to one
 thread, and prints the load average.
 
+Planes: ``python benchmarks/spectra.py --planes [--repeat N]`` times :func:`analyse_record` on a biaxial
+record of the stay with deck modes (benchmarks/plane_records.py: 3 positions x in/out, 400 s at 12.8 Hz),
+read per plane (with its channel directions) and read as one plane (the same record without them, as
+every record was read before the planes), and prints the seconds per channel of each (minimum over N
+interleaved runs, default 5). Run with another checkout's package first on ``PYTHONPATH`` to time that
+code on the same records (a checkout without the planes reads both as one plane).
+
 Run: ``python benchmarks/spectra.py [--quick]`` (about 1.5 minutes on two idle
 cores; ``--quick``: one record per case, one timing repeat, about 25 s), or
 ``python benchmarks/spectra.py --throughput [--repeat N]`` for the find_peaks
@@ -406,13 +413,59 @@ def print_throughput(tp: dict) -> None:
         print("  (other processes were running: wall times are inflated; compare the min column and the 1-thread row)")
 
 
+def planes_throughput(repeat: int = 5, seeds=(0, 1, 2)) -> dict:
+    """Seconds per channel of analyse_record on biaxial records of the stay read per plane and read as one
+    plane (minimum over ``repeat`` interleaved runs, summed over the seeds' records)."""
+    import warnings
+    from dataclasses import replace
+
+    from stcs_ident.spectra.pipeline import analyse_record
+
+    try:
+        from benchmarks.plane_records import make_case
+    except ImportError:  # run as a script from the repository's root
+        from plane_records import make_case
+
+    cases = [make_case("stay", seed, layout="biaxial") for seed in seeds]
+    times = {"planes": [], "one plane": []}
+    n_channels = sum(c.record.n_channels for c in cases)
+    for _ in range(repeat):
+        for label, runs in times.items():
+            total = 0.0
+            for c in cases:
+                record = c.record if label == "planes" else replace(c.record, channel_directions=None)
+                record = replace(record, acceleration=record.acceleration.copy())  # analysed in place
+                t = time.perf_counter()
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    analyse_record(c.campaign, c.test, record, "bench")
+                total += time.perf_counter() - t
+            runs.append(total / n_channels)
+    return {label: min(v) for label, v in times.items()} | {"n_channels": n_channels, "repeat": repeat,
+                                                            "records": len(cases)}
+
+
+def print_planes_throughput(tp: dict) -> None:
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"\nPlanes: analyse_record on {tp['records']} biaxial records of the stay ({tp['n_channels']} channels in "
+          f"all), minimum of {tp['repeat']} runs, load average {load:.2f}")
+    for label in ("planes", "one plane"):
+        print(f"  read {label:>9}: {1e3 * tp[label]:8.1f} ms per channel")
+    print(f"  ratio planes / one plane: {tp['planes'] / tp['one plane']:.2f}")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one record per case and one timing repeat (~30 s)")
     parser.add_argument("--throughput", action="store_true",
                         help="only the find_peaks throughput case (no pyOMA-2 needed), --repeat runs")
+    parser.add_argument("--planes", action="store_true",
+                        help="only the per-channel time of a biaxial record read per plane and as one plane")
     parser.add_argument("--repeat", type=int, default=5, help="timing runs with --throughput (default 5)")
     args = parser.parse_args(argv)
+    if args.planes:
+        print_planes_throughput(planes_throughput(max(1, args.repeat)))
+        return 0
     print_header()
     if args.throughput:
         print_throughput(throughput(quick=False, with_fdd=False, repeat=max(1, args.repeat)))

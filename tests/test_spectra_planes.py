@@ -1,8 +1,8 @@
 """Spectra per plane, and the peaks that are not the cable's (spectra/channels.py, plane_analysis.py,
 structural.py; issue 24, points 3 and 4).
 
-The records are simulated per plane and combined (tests/plane_records.py): independent wind in each plane,
-a deck mode moving the anchorage within 2 % of a cable mode, a second one elsewhere in the band, their
+The records are simulated per plane and combined (benchmarks/plane_records.py): independent wind in each
+plane, a deck mode moving the anchorage within 2 % of a cable mode, a second one elsewhere in the band, their
 second harmonics, and the axial channel that sees the anchorage move.
 """
 
@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 import pytest
 
+from benchmarks.plane_records import make_case
 from stcs_ident.core.errors import InputError
 from stcs_ident.core.record import Record
 from stcs_ident.report.spectra_tables import modes_table, spectra_text
@@ -23,19 +24,20 @@ from stcs_ident.spectra.option_groups import PlaneOptions
 from stcs_ident.spectra.pipeline import NO_DIRECTIONS, analyse_record
 from stcs_ident.spectra.structural import harmonic_of, mac, shape_is_meaningful
 
-from .plane_records import make_case
-
 # ---------------------------------------------------------------------------------------------------------------
 # Channels by plane
 
 
 def _record(directions, positions=(3.0, 3.0, 5.0, 7.0), n=512, seed=0):
+    """Channels reading in-plane u and out-of-plane v at their position (columns of u, v: one per channel's
+    position in order of first appearance)."""
     rng = np.random.default_rng(seed)
-    u, v = rng.standard_normal((n, len(positions))), rng.standard_normal((n, len(positions)))
+    where = {x: j for j, x in enumerate(dict.fromkeys(positions))}
+    u, v = rng.standard_normal((n, len(where))), rng.standard_normal((n, len(where)))
     angles = [{"in": 0.0, "out": 90.0}.get(d, d) for d in directions]
     acc = np.column_stack([
-        u[:, k] * math.cos(math.radians(a)) + v[:, k] * math.sin(math.radians(a)) if d != "axial" else u[:, k]
-        for k, (d, a) in enumerate(zip(directions, angles))])
+        u[:, where[x]] * math.cos(math.radians(a)) + v[:, where[x]] * math.sin(math.radians(a))
+        if d != "axial" else u[:, where[x]] for x, d, a in zip(positions, directions, angles)])
     return Record(acceleration=acc, sampling_rate=100.0, channel_names=tuple(f"c{k}" for k in range(len(directions))),
                   channel_positions=np.array(positions), channel_directions=tuple(directions)), u, v
 
@@ -49,8 +51,8 @@ def test_a_turned_sensor_pair_is_rotated_into_in_and_out():
     assert planes["in"].names == ("c0+c1:in", "c2") and planes["out"].names == ("c0+c1:out",)
     inn, out = plane_record(record, planes["in"]), plane_record(record, planes["out"], axial)
     np.testing.assert_allclose(inn.acceleration[:, 0], u[:, 0], atol=1e-12)  # rounding only
-    np.testing.assert_allclose(out.acceleration[:, 0], v[:, 1 - 1], atol=1e-12)
-    expected = u[:, 2] + math.tan(math.radians(10)) * v[:, 2]  # the in-plane reading plus tan θ of the other
+    np.testing.assert_allclose(out.acceleration[:, 0], v[:, 0], atol=1e-12)
+    expected = u[:, 1] + math.tan(math.radians(10)) * v[:, 1]  # the in-plane reading plus tan θ of the other
     np.testing.assert_allclose(inn.acceleration[:, 1], expected, atol=1e-12)
     assert out.channel_names == ("c0+c1:out", "c3")  # the axial channel rides along
 
