@@ -127,6 +127,9 @@ class TestSpectra(PickingResult):
     def headline(self) -> str:
         """Test, modes numbered, peaks left unnumbered, channels dropped."""
         modes = f" ({_ranges(self.modes)})" if self.modes else ""
+        if self.planes is not None and self.modes:
+            per_plane = [(p, [m for m, q in zip(self.modes, self.planes) if q == p]) for p in ("in", "out")]
+            modes = " (" + "; ".join(f"{p} {_ranges(ms)}" for p, ms in per_plane if ms) + ")"
         extra = f", {len(self.unassigned)} peaks unnumbered" if self.unassigned else ""
         extra += f", {len(self.structural)} structural peaks" if self.structural else ""
         extra += f", {len(self.dropped)} channels dropped" if self.dropped else ""

@@ -1,17 +1,16 @@
 """Peaks picked and numbered per plane, and the peaks that are not the cable's (a record with channel directions).
 
 1. Channels by plane (:mod:`.channels`): in-plane and out-of-plane components, axial channels aside.
-2. Peaks per plane: :func:`.peaks.find_peaks` on each plane's channels and the axial ones, so a mode of one
-   plane is fitted with the noise of that plane's channels, a close pair (an in-plane and an out-of-plane mode
-   a few per mil apart, each in its own channels) is never fitted as one peak, and a deck mode beside a cable
-   mode is detected through the axial channels, where the cable's mode hardly shows, and fitted as a peak of
-   its own. A peak found in both planes within 3σ
+2. Peaks per plane: :func:`.peaks.find_peaks` on each plane's channels alone, so a mode of one plane is fitted
+   with the noise of that plane's channels and a close pair (an in-plane and an out-of-plane mode a few per
+   mil apart, each in its own channels) is never fitted as one peak. (Fitting the axial channels with them
+   was tried: a deck mode's broad skirt on the axial channel then pulled a cable mode 9 % away by 10σ.) A peak found in both planes within 3σ
    is one mode leaking through a misaligned sensor where the weaker plane's amplitude (rms over its
    channels) is below ``leak_ratio`` of the stronger's: it is kept in the stronger plane only. Otherwise
    both planes carry it: two peaks, never merged.
 3. Structural peaks (:mod:`.structural`): a peak at a given structural frequency or a harmonic of one, or
-   whose amplitude on the axial channels reaches ``axial_ratio`` of its transverse amplitude (the anchorage
-   moving along the chord), is set aside before numbering. Each plane's peaks are numbered against that plane's family
+   where the axial channels' amplitude (Welch, above their floor) reaches ``axial_ratio`` of the plane's
+   largest (the anchorage moving along the chord), is set aside before numbering. Each plane's peaks are numbered against that plane's family
    (:func:`.numbering.number_modes` with ``plane``); a numbered peak whose operating shape has a MAC below
    ``min_mac`` against its mode's model shape (where meaningful) is structural, and the plane is numbered
    again without it. Of the unassigned peaks, one found in both planes with the other plane's peak not a
@@ -32,6 +31,7 @@ from .channels import PlaneChannels, plane_channels, plane_record
 from .numbering import Numbering, number_modes
 from .option_groups import PlaneOptions
 from .options import PickingOptions
+from .overview import ambient_overview
 from .peak_result import PeakResult
 from .peaks import find_peaks
 from .structural import harmonic_of, mac, model_shapes, shape_is_meaningful
@@ -71,25 +71,28 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     """Peaks per plane, numbered per plane, structural ones set apart (the module's steps)."""
     channels, axial = plane_channels(record)
     fs = record.sampling_rate
-    peaks, nominal = {}, {}
+    peaks, nominal, axial_share = {}, {}, {}
     for plane, chans in channels.items():
         nominal[plane] = natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
                                              plane=plane)
         f_max = min(0.45 * fs, 1.3 * nominal[plane][-1])
-        peaks[plane] = find_peaks(plane_record(record, chans, axial), f_min=0.5 * nominal[plane][0], f_max=f_max,
-                                  overwrite=True, options=options)  # the plane's record is a copy, ours
+        sub = plane_record(record, chans, axial)
+        if axial:
+            axial_share[plane] = _axial_share(sub.acceleration, len(chans), fs, options)
+            sub = plane_record(record, chans)
+        peaks[plane] = find_peaks(sub, f_min=0.5 * nominal[plane][0], f_max=f_max, overwrite=True,
+                                  options=options)  # the plane's record is a copy, ours
     out = PlanesOutcome(channels, peaks, {}, nominal)
     kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
     structural: dict[tuple[str, int], str] = {}
     given = [(f, 0.0) for f in plane_options.structural]
     for plane, result in peaks.items():
-        n = len(channels[plane])
         for k, p in enumerate(result.peaks):
             hit = harmonic_of(p.frequency, p.uncertainty, given, plane_options.max_harmonic)
             if hit is not None:
                 structural[(plane, k)] = _harmonic_text(*hit, "given structural frequency")
-            elif len(p.amplitude) > n:  # axial channels: the anchorage moving along the chord
-                ratio = np.abs(p.amplitude[n:]).max() / max(np.abs(p.amplitude[:n]).max(), 1e-300)
+            elif plane in axial_share:  # axial channels: the anchorage moving along the chord
+                ratio = axial_share[plane](p.frequency)
                 if ratio >= plane_options.axial_ratio:
                     structural[(plane, k)] = (f"on the axial channels at {ratio:.2f} of the transverse amplitude: "
                                               "the anchorage moving")
@@ -227,3 +230,19 @@ def _unassigned_structural(out: PlanesOutcome, pairs, structural: dict, plane_op
                 structural[key] = _harmonic_text(*hit, "structural peak at")
                 changed = True
     out.unassigned[:] = [key for key in out.unassigned if key not in structural]
+
+
+def _axial_share(x: np.ndarray, n: int, fs: float, options: PickingOptions):
+    """f ↦ the largest amplitude at f on the axial channels (columns ``n`` on of ``x``) over the largest on the
+    transverse ones (the first ``n``), from their Welch spectra above their floors (the same segments for all,
+    so the ratio of the excess powers is that of the squared amplitudes)."""
+    x = x - x.mean(axis=0)
+    overview = ambient_overview(x, fs, options=options.overview, floor_options=options.floor)
+    excess = np.maximum(overview.channel_spectra - overview.channel_floor, 0.0)
+
+    def share(frequency: float) -> float:
+        k = int(np.argmin(np.abs(overview.frequency - frequency)))
+        transverse, along = excess[k, :n].max(), excess[k, n:].max()
+        return float(np.sqrt(along / transverse)) if transverse > 0 else float("inf")
+
+    return share
