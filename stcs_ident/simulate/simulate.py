@@ -30,6 +30,21 @@ Field-like disturbances (coloured loading, a drifting tension, pink noise,
 mains hum, offsets, float32 samples) are off by default and given as one
 :class:`~stcs_ident.simulate.disturbances.FieldConditions`; without them a
 record is exactly what it was before they existed.
+
+Both planes, and a cable on a bridge (off by default): ``directions`` gives
+each channel's direction (in-plane, out-of-plane, axial or an angle; a
+biaxial or triaxial sensor is two or three channels at one position), and
+:class:`~stcs_ident.simulate.bridge.BridgeConditions` the out-of-plane
+loading's level, misaligned sensors, deck and pylon modes moving an
+anchorage (a given list of frequencies and amplitudes) and traffic bursts.
+The out-of-plane motion is that of the cable without sag-extensibility
+(:func:`~stcs_ident.core.planes.plane_view`), loaded by its own independent
+ambient pressure, uncoupled from the in-plane motion; the anchorages' motion
+enters through the exact modal answer to a support motion
+(:mod:`~stcs_ident.simulate.anchorage`). The truth says, per record, the
+in-plane and out-of-plane frequencies and damping, the structural
+frequencies, the misalignments and the crossings. Without these options
+the record is exactly what it was before them.
 """
 
 from __future__ import annotations
@@ -127,6 +142,21 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
         were; a coloured loading or a drift makes another signal.
     progress : callable(done, total), optional
         Called after each block of samples.
+    directions : sequence or None
+        One per entry of ``positions``: ``"in"`` (in-plane transverse),
+        ``"out"`` (out-of-plane transverse), ``"axial"`` (along the chord)
+        or an angle in degrees from in-plane towards out-of-plane. A
+        position may repeat: a biaxial sensor is two entries at one x
+        (``"in"``, ``"out"``), a triaxial one three. The record carries
+        them (``Record.channel_directions``). None: every channel
+        in-plane, and the record states no directions (as before they
+        existed). When a channel reads out-of-plane motion, the
+        out-of-plane modes are simulated too (:mod:`.two_planes`).
+    bridge : BridgeConditions or None
+        A cable on a bridge (:mod:`~stcs_ident.simulate.bridge`): the
+        out-of-plane loading's level, misaligned sensors, deck and pylon
+        modes moving an anchorage, traffic. None: none of it. A moving
+        anchorage is an excitation by itself (no blow or ambient needed).
 
     Returns
     -------
@@ -166,7 +196,10 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
     model's frequencies and damping ratios (with dampers, the complex
     modes' |s|/2π and −Re(s)/|s|) and, under a tension drift, the relative tension at
     every sample, each mode's sensitivity to it, the instantaneous and the
-    time-averaged frequencies.
+    time-averaged frequencies. With ``directions`` or ``bridge`` it also
+    gives the out-of-plane modes' truth (``out``, ``frequencies_out``,
+    ``damping_out``; ``frequencies`` are the in-plane ones), the structural
+    modes, each channel's misalignment and the traffic's crossing times.
     """
     fs, n_samples = check_timing(duration, sampling_rate)
     impulses = check_impulses(impulses)
