@@ -131,3 +131,56 @@ def _oscillator(rng, n: int, fs: float, frequency: float, zeta: float) -> np.nda
     burn = int(10 / (zeta * frequency) * fs / (2 * math.pi)) + 1
     x = lfilter([1.0], a, rng.standard_normal(n + burn))[burn:]
     return x
+
+
+def make_bridge_case(kind: str, seed: int, *, layout: str = "triaxial", near: float | None = None,
+                     traffic: bool = True, misalignment: float = 1.5, snr_db: float = 30.0) -> PlaneCase:
+    """One record from the project's simulator with a bridge (:class:`~stcs_ident.simulate.BridgeConditions`):
+    both planes under independent wind, sensors misaligned by N(0, ``misalignment``°), two deck modes moving
+    anchorage A (the exact dynamic answer of the cable to a support motion, so a deck mode beside a cable
+    mode drives it), one within 0.5–2 % (``near``) of a cable mode of its plane, one elsewhere in the band,
+    each with a second harmonic at a tenth, and vehicles crossing (``traffic``)."""
+    from stcs_ident.forward import natural_frequencies
+    from stcs_ident.simulate.bridge import BridgeConditions, StructuralMode, Traffic
+    from stcs_ident.simulate.simulate import simulate_record
+
+    k = KINDS[kind]
+    rng = np.random.default_rng(seed)
+    tension_true = k.tension * rng.uniform(0.93, 1.07)
+    positions = np.array(k.positions) * k.cable.length
+    fs = k.sampling_rate
+    xs = [x for x in positions for _ in ("in", "out")]
+    directions = [d for _ in positions for d in ("in", "out")]
+    if layout == "triaxial":
+        xs.append(positions[0])
+        directions.append("axial")
+    kw = {"duration": k.duration, "sampling_rate": fs, "damping": rng.uniform(0.003, 0.008),
+          "ambient": Ambient(rms_pressure=rng.uniform(5.0, 15.0)), "snr_db": snr_db, "seed": int(rng.integers(2**31))}
+    quiet = simulate_record(k.cable, k.attachments, tension_true, xs, directions=directions, **kw)
+    level = float(np.std(quiet.acceleration[:, [i for i, d in enumerate(directions) if d != "axial"]]))
+    top = 0.45 * fs
+    nominal = {p: natural_frequencies(k.cable, k.attachments, tension_true, 12, plane=p) for p in ("in", "out")}
+    plane = "in" if rng.random() < 0.6 else "out"
+    mode = int(rng.integers(1, min(6, int(np.sum(nominal[plane] < top)))))
+    offset = near if near is not None else rng.uniform(0.005, 0.02)
+    f1 = nominal[plane][mode] * (1 + offset * rng.choice([-1.0, 1.0]))
+    f2 = rng.uniform(1.2 * nominal["in"][0], 0.5 * top)
+    way = {"in": (0.8, 0.1, 0.6), "out": (0.15, 0.95, 0.3)}  # vertical deck motion; lateral (a pylon's sway)
+    decks = [StructuralMode(f, rng.uniform(0.3, 1.0) * level * scale, damping=rng.uniform(0.01, 0.02), end="A",
+                            direction=way[p], harmonics=(0.1,))
+             for f, p, scale in ((f1, plane, 1.0), (f2, "in" if plane == "out" else "out", 0.7))]
+    bridge = BridgeConditions(
+        out_of_plane_ratio=rng.uniform(0.5, 1.0),
+        misalignment=tuple(float(v) for v in rng.normal(0.0, misalignment, len(xs))) if misalignment else None,
+        anchorage_motion=tuple(decks), traffic=Traffic(rng.uniform(20.0, 60.0)) if traffic else None)
+    record, truth = simulate_record_with_truth(k.cable, k.attachments, tension_true, xs, directions=directions,
+                                               bridge=bridge, **kw)
+    names = [f"{d}{1 + i // 2}" if d != "axial" else "ax1" for i, d in enumerate(directions)]
+    record = Record(acceleration=record.acceleration, sampling_rate=fs, channel_names=tuple(names),
+                    channel_positions=record.channel_positions, channel_directions=record.channel_directions)
+    setup = Setup("s", k.attachments)
+    test = Test("t", "s", k.tension)
+    campaign = Campaign("c", k.cable, (setup,), (test,))
+    truths = {"in": np.asarray(truth.frequencies, float), "out": np.asarray(truth.out.frequencies, float)}
+    deck_list = [(d.frequency, p) for d, p in zip(decks, (plane, "in" if plane == "out" else "out"))]
+    return PlaneCase(record, campaign, test, truths, deck_list, [d.frequency * h for d in decks for h in (1, 2)])
