@@ -134,7 +134,8 @@ def _oscillator(rng, n: int, fs: float, frequency: float, zeta: float) -> np.nda
 
 
 def make_bridge_case(kind: str, seed: int, *, layout: str = "triaxial", near: float | None = None,
-                     traffic: bool = True, misalignment: float = 1.5, snr_db: float = 30.0) -> PlaneCase:
+                     traffic: bool = True, misalignment: float = 1.5, snr_db: float = 30.0,
+                     deck: bool = True) -> PlaneCase:
     """One record from the project's simulator with a bridge (:class:`~stcs_ident.simulate.BridgeConditions`):
     both planes under independent wind, sensors misaligned by N(0, ``misalignment``°), two deck modes moving
     anchorage A (the exact dynamic answer of the cable to a support motion, so a deck mode beside a cable
@@ -172,7 +173,7 @@ def make_bridge_case(kind: str, seed: int, *, layout: str = "triaxial", near: fl
     bridge = BridgeConditions(
         out_of_plane_ratio=rng.uniform(0.5, 1.0),
         misalignment=tuple(float(v) for v in rng.normal(0.0, misalignment, len(xs))) if misalignment else None,
-        anchorage_motion=tuple(decks), traffic=Traffic(rng.uniform(20.0, 60.0)) if traffic else None)
+        anchorage_motion=tuple(decks) if deck else (), traffic=Traffic(rng.uniform(20.0, 60.0)) if traffic else None)
     record, truth = simulate_record_with_truth(k.cable, k.attachments, tension_true, xs, directions=directions,
                                                bridge=bridge, **kw)
     names = [f"{d}{1 + i // 2}" if d != "axial" else "ax1" for i, d in enumerate(directions)]
@@ -182,5 +183,5 @@ def make_bridge_case(kind: str, seed: int, *, layout: str = "triaxial", near: fl
     test = Test("t", "s", k.tension)
     campaign = Campaign("c", k.cable, (setup,), (test,))
     truths = {"in": np.asarray(truth.frequencies, float), "out": np.asarray(truth.out.frequencies, float)}
-    deck_list = [(d.frequency, p) for d, p in zip(decks, (plane, "in" if plane == "out" else "out"))]
-    return PlaneCase(record, campaign, test, truths, deck_list, [d.frequency * h for d in decks for h in (1, 2)])
+    deck_list = [(d.frequency, p) for d, p in zip(decks, (plane, "in" if plane == "out" else "out"))] if deck else []
+    return PlaneCase(record, campaign, test, truths, deck_list, [f * h for f, _ in deck_list for h in (1, 2)])

@@ -473,8 +473,9 @@ class PlaneOptions(OptionGroup):
     min_mac : float
         A numbered peak whose operating shape has a modal assurance criterion below this against the
         model's shape of its mode, where that is meaningful (two positions or more in the plane, the model's
-        shape not at a node of them all), is structural (0.5: sensor noise and the model's error leave a
-        cable mode's MAC near 0.9 or above at the simulated SNRs).
+        shape not at a node of them all), is structural (0.9: on simulated bridge records, 3 positions,
+        30 dB, a correctly numbered cable mode's MAC was above 0.955 in 99.9 % of 860 modes, median 0.99994;
+        a deck mode numbered at 8 % from the cable mode it replaced had 0.86).
     axial_ratio : float
         A peak whose largest amplitude on the axial channels reaches this fraction of its largest transverse
         amplitude moves the anchorage (structural; 0.3: a cable's own mode moves a sensor along the chord by
@@ -485,7 +486,7 @@ class PlaneOptions(OptionGroup):
 
     structural: tuple[float, ...] = ()
     leak_ratio: float = 0.15
-    min_mac: float = 0.5
+    min_mac: float = 0.9
     axial_ratio: float = 0.3
     max_harmonic: int = 5
 

@@ -9,7 +9,7 @@
    channels) is below ``leak_ratio`` of the stronger's: it is kept in the stronger plane only. Otherwise
    both planes carry it: two peaks, never merged.
 3. Structural peaks (:mod:`.structural`): a peak at a given structural frequency or a harmonic of one, or
-   where the axial channels' amplitude (Welch, above their floor) reaches ``axial_ratio`` of the plane's
+   where the axial channels' amplitude (fine Welch spectra) reaches ``axial_ratio`` of the plane's
    largest (the anchorage moving along the chord), is set aside before numbering. Each plane's peaks are numbered against that plane's family
    (:func:`.numbering.number_modes` with ``plane``); a numbered peak whose operating shape has a MAC below
    ``min_mac`` against its mode's model shape (where meaningful) is structural, and the plane is numbered
@@ -31,7 +31,6 @@ from .channels import PlaneChannels, plane_channels, plane_record
 from .numbering import Numbering, number_modes
 from .option_groups import PlaneOptions
 from .options import PickingOptions
-from .overview import ambient_overview
 from .peak_result import PeakResult
 from .peaks import find_peaks
 from .structural import harmonic_of, mac, model_shapes, shape_is_meaningful
@@ -72,15 +71,16 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     channels, axial = plane_channels(record)
     fs = record.sampling_rate
     peaks, nominal, axial_share = {}, {}, {}
-    for plane, chans in channels.items():
+    for plane in channels:
         nominal[plane] = natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
                                              plane=plane)
-        f_max = min(0.45 * fs, 1.3 * nominal[plane][-1])
+    bands = {plane: (0.5 * nominal[plane][0], min(0.45 * fs, 1.3 * nominal[plane][-1])) for plane in channels}
+    for plane, chans in channels.items():
         sub = plane_record(record, chans, axial)
         if axial:
             axial_share[plane] = _axial_share(sub.acceleration, len(chans), fs, options)
             sub = plane_record(record, chans)
-        peaks[plane] = find_peaks(sub, f_min=0.5 * nominal[plane][0], f_max=f_max, overwrite=True,
+        peaks[plane] = find_peaks(sub, *bands[plane], overwrite=True,
                                   options=options)  # the plane's record is a copy, ours
     out = PlanesOutcome(channels, peaks, {}, nominal)
     kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
@@ -234,15 +234,19 @@ def _unassigned_structural(out: PlanesOutcome, pairs, structural: dict, plane_op
 
 def _axial_share(x: np.ndarray, n: int, fs: float, options: PickingOptions):
     """f ↦ the largest amplitude at f on the axial channels (columns ``n`` on of ``x``) over the largest on the
-    transverse ones (the first ``n``), from their Welch spectra above their floors (the same segments for all,
-    so the ratio of the excess powers is that of the squared amplitudes)."""
-    x = x - x.mean(axis=0)
-    overview = ambient_overview(x, fs, options=options.overview, floor_options=options.floor)
-    excess = np.maximum(overview.channel_spectra - overview.channel_floor, 0.0)
+    transverse ones (the first ``n``), from fine Welch spectra (4 segments: a resolution of a quarter of the
+    record's, a few times a lightly damped cable mode's half-power width on the usual records, so a sharp
+    cable mode stands above a broad deck mode a per cent away; the overview's 16 segments smeared the
+    cable's peak and a cable mode 1 % from a deck mode took the deck's axial share). ``options``: unused,
+    the spectra's tuning is fixed here."""
+    from scipy.signal import welch
 
-    def share(frequency: float) -> float:
-        k = int(np.argmin(np.abs(overview.frequency - frequency)))
-        transverse, along = excess[k, :n].max(), excess[k, n:].max()
+    segment = max(256, x.shape[0] // 4)
+    frequency, power = welch(x - x.mean(axis=0), fs, nperseg=min(segment, x.shape[0]), axis=0)
+
+    def share(f: float) -> float:
+        k = int(np.argmin(np.abs(frequency - f)))
+        transverse, along = power[k, :n].max(), power[k, n:].max()
         return float(np.sqrt(along / transverse)) if transverse > 0 else float("inf")
 
     return share
