@@ -23,6 +23,7 @@ from ..core import kinds
 from ..core.errors import ComputationError, InputError, ModelError
 from ..core.model import Campaign, Test, has_dampers
 from ..core.parameters import Parameter, overrides_for
+from ..core.planes import PLANE_NAMES, PLANES
 from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
 
@@ -68,6 +69,10 @@ class Measurement:
         Whether a :class:`Problem` of these measurements takes the damping
         ratios as data (the diagnosis decides it once for every hypothesis);
         None: with a damper in the model.
+    planes : ndarray of str or None
+        The plane of each mode, ``"in"`` or ``"out"`` (given in the order of
+        ``modes``; None: all in-plane). Mode numbers are distinct within a
+        plane; the modes are kept in-plane first, each plane by mode number.
     """
 
     test: Test
@@ -78,6 +83,7 @@ class Measurement:
     damping: np.ndarray | None = None
     damping_uncertainty: np.ndarray | None = None
     damping_is_data: bool | None = None
+    planes: np.ndarray | None = None
 
     def __post_init__(self):
         where = f"test[{self.test.name}]"
@@ -86,13 +92,21 @@ class Measurement:
         unc = np.broadcast_to(np.asarray(self.uncertainty, float), freqs.shape).copy()
         if modes.ndim != 1 or modes.shape != freqs.shape or modes.size == 0:
             raise InputError("modes and frequencies must be non-empty lists of one length", field=f"{where}.modes")
-        if np.any(modes < 1) or len(set(modes.tolist())) != modes.size:
-            raise InputError("mode numbers must be distinct integers >= 1", field=f"{where}.modes")
+        planes = np.array(["in"] * modes.size if self.planes is None else list(self.planes), dtype="<U3")
+        if planes.shape != modes.shape:
+            raise InputError(f"has {planes.size} entries but modes has {modes.size}", field=f"{where}.planes")
+        for p in planes:
+            if p not in PLANES:
+                raise InputError(f'must be "in" or "out", got {str(p)!r}', field=f"{where}.planes")
+        if np.any(modes < 1) or len(set(zip(planes.tolist(), modes.tolist()))) != modes.size:
+            raise InputError("mode numbers must be distinct integers >= 1" + (" within each plane" if "out" in planes
+                                                                               else ""), field=f"{where}.modes")
         if not np.all(np.isfinite(freqs) & (freqs > 0)):
             raise InputError("must be finite and > 0", field=f"{where}.frequencies")
         if not np.all(np.isfinite(unc) & (unc > 0)):
             raise InputError("frequency uncertainties must be finite and > 0", field=f"{where}.uncertainty")
-        order = np.argsort(modes)
+        order = np.lexsort((modes, planes == "out"))
+        object.__setattr__(self, "planes", planes[order])
         object.__setattr__(self, "modes", modes[order])
         object.__setattr__(self, "frequencies", freqs[order])
         object.__setattr__(self, "uncertainty", unc[order])
@@ -116,6 +130,23 @@ class Measurement:
     def name(self) -> str:
         return self.test.name
 
+    def labels(self) -> list[str]:
+        """A name per mode: ``mode 3`` in-plane, ``mode 3 out-of-plane``."""
+        return [mode_label(int(k), str(p)) for k, p in zip(self.modes, self.planes)]
+
+    def subset(self, keep: np.ndarray) -> Measurement:
+        """The measurement of the modes where ``keep`` (a mask by mode) is True."""
+        keep = np.asarray(keep, bool)
+        damping = None if self.damping is None else (self.damping[keep], self.damping_uncertainty[keep])
+        return Measurement(self.test, self.modes[keep], self.frequencies[keep], self.uncertainty[keep], self.source,
+                           None if damping is None else damping[0], None if damping is None else damping[1],
+                           self.damping_is_data, self.planes[keep])
+
+
+def mode_label(mode: int, plane: str = "in") -> str:
+    """``mode 3`` (in-plane) or ``mode 3 out-of-plane``."""
+    return f"mode {mode}" + ("" if plane == "in" else f" {PLANE_NAMES[plane]}")
+
 
 def printed_step(values: Sequence[float]) -> float:
     """Resolution a list of numbers was printed with: 0.01 for (7.24, 44.4)."""
@@ -136,15 +167,16 @@ def table_measurement(test: Test) -> Measurement:
     rounding of the table as uncertainty (and the source says which)."""
     if test.uncertainty is not None:
         return Measurement(test, np.array(test.modes), np.array(test.frequencies), np.array(test.uncertainty),
-                           "stated uncertainty")
+                           "stated uncertainty", planes=test.planes)
     step = printed_step(test.frequencies)
     return Measurement(test, np.array(test.modes), np.array(test.frequencies), step / math.sqrt(12),
-                       f"table rounding ({step:g} Hz / sqrt 12)")
+                       f"table rounding ({step:g} Hz / sqrt 12)", planes=test.planes)
 
 
 def as_measurement(test: Test, picked) -> Measurement:
     """A :class:`Measurement` from picked spectra (anything with ``modes``,
-    ``frequencies`` and ``uncertainty``, as :class:`~stcs_ident.spectra.pipeline.TestSpectra`)."""
+    ``frequencies`` and ``uncertainty``, as :class:`~stcs_ident.spectra.pipeline.TestSpectra`; the plane of
+    each mode from its ``mode_planes``, else ``planes``, else all in-plane)."""
     if isinstance(picked, Measurement):
         return picked
     modes = getattr(picked, "modes", None)
@@ -158,7 +190,18 @@ def as_measurement(test: Test, picked) -> Measurement:
     if zeta is None or zeta_unc is None:
         zeta = zeta_unc = None
     return Measurement(test, np.array(modes), np.array(freqs), np.array(unc), "spectra",
-                       None if zeta is None else np.array(zeta, float), None if zeta is None else np.array(zeta_unc, float))
+                       None if zeta is None else np.array(zeta, float), None if zeta is None else np.array(zeta_unc, float),
+                       planes=picked_planes(picked))
+
+
+def picked_planes(picked) -> tuple[str, ...] | None:
+    """The plane of each picked mode: ``mode_planes`` (:class:`~stcs_ident.spectra.pipeline.TestSpectra`), else
+    ``planes``, else None (all in-plane)."""
+    for key in ("mode_planes", "planes"):
+        value = getattr(picked, key, None)
+        if value is not None:
+            return tuple(value)
+    return None
 
 
 def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
@@ -314,26 +357,40 @@ class Problem:
                 continue
             sub = {key: v[ok] for key, v in ov.items()}
             tension = sub.pop("tension")
-            n_modes = max(int(self.measurements[i].modes.max()) for i in group)
-            damped = self.use_damping and any(self._zeta_used[i].any() for i in group)
-            try:
-                F, Z = self._solve(self._atts[first.name], tension, n_modes, sub, damped)
-            except ModelError as err:
-                raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
-            full = np.full((ok.size, n_modes), np.nan)
-            full[ok] = F
-            if damped:
-                full_zeta = np.full((ok.size, n_modes), np.nan)
-                full_zeta[ok] = Z
-            for j, i in enumerate(group):
-                m = self.measurements[i]
-                out[i] = full[j * k:(j + 1) * k, m.modes - 1]
-                if damped:
-                    zeta[i] = full_zeta[j * k:(j + 1) * k, m.modes[self._zeta_used[i]] - 1]
+            for plane in PLANES:  # each plane's modes from its own model (out-of-plane: no sag-extensibility)
+                members = [i for i in group if np.any(self.measurements[i].planes == plane)]
+                if members:
+                    self._predict_plane(plane, group, members, k, ok, tension, sub, out, zeta)
         F = np.concatenate(out + [z for z in zeta if z.shape[1]], axis=1)
         if self.n_data > self.n_frequencies:
             F[:, self.n_frequencies:] += self._own_damping(F[:, self.n_frequencies:])
         return F[0] if single else F
+
+    def _predict_plane(self, plane: str, group: list[int], members: list[int], k: int, ok: np.ndarray,
+                       tension: np.ndarray, sub: dict, out: list, zeta: list) -> None:
+        """Fill ``out`` and ``zeta`` (in place) for the modes in ``plane`` of the measurements ``members`` of one
+        setup's ``group`` (rows ``ok`` of the group's stacked overrides ``sub``)."""
+        first = self.measurements[group[0]]
+        n_modes = max(int(self.measurements[i].modes[self.measurements[i].planes == plane].max()) for i in members)
+        damped = self.use_damping and any((self._zeta_used[i] & (self.measurements[i].planes == plane)).any()
+                                          for i in members)
+        try:
+            F, Z = self._solve(self._atts[first.name], tension, n_modes, sub, damped, plane)
+        except ModelError as err:
+            raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
+        full = np.full((ok.size, n_modes), np.nan)
+        full[ok] = F
+        if damped:
+            full_zeta = np.full((ok.size, n_modes), np.nan)
+            full_zeta[ok] = Z
+        for j, i in enumerate(group):
+            if i not in members:
+                continue
+            m, used = self.measurements[i], self._zeta_used[i]
+            here = m.planes == plane
+            out[i][:, here] = full[j * k:(j + 1) * k, m.modes[here] - 1]
+            if damped and (used & here).any():
+                zeta[i][:, here[used]] = full_zeta[j * k:(j + 1) * k, m.modes[used & here] - 1]
 
     def damping_columns(self, before: np.ndarray, after: np.ndarray) -> list[dict[str, np.ndarray]]:
         """Per measurement, the measured damping ratios, their σ and the model's ``before`` and ``after`` (two
@@ -361,21 +418,22 @@ class Problem:
         return np.maximum(own, 0.0)
 
     def _solve(self, atts, tension: np.ndarray, n_modes: int, overrides: dict,
-               damped: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
-        """Frequencies (and, when ``damped``, damping ratios) on many rows; a row whose roots do not converge
-        (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
+               damped: bool = False, plane: str = "in") -> tuple[np.ndarray, np.ndarray | None]:
+        """Frequencies (and, when ``damped``, damping ratios) in ``plane`` on many rows; a row whose roots do not
+        converge (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
         cable = self.campaign.cable
         try:
             if damped or _dashpots(atts, overrides):  # the fit's trial points: uncertified (see FIT_CERTIFY)
                 s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                        certify=FIT_CERTIFY, **overrides)
+                                        certify=FIT_CERTIFY, plane=plane, **overrides)
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
             return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                     **overrides), None
+                                     plane=plane, **overrides), None
         except ComputationError:
             if tension.size == 1:
                 return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
-        rows = [self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()}, damped)
+        rows = [self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()}, damped,
+                            plane)
                 for i in range(tension.size)]
         return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows]) if damped else None
 
