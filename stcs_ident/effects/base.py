@@ -240,6 +240,11 @@ class UnmodeledAttachment(Effect):
         monotonically needs no other)."""
         return ()
 
+    def attachment(self, name: str, position: float, amount: float = 0.0) -> Attachment:
+        """The attachment the effect adds (the diagnosis's at amplitude 0, the simulator's at ``amount``): a
+        point with ``amount`` as its ``amount_kind``, acting in both planes."""
+        return Attachment(name, position, **{self.amount_kind: amount})
+
     def unmodeled_parameters(self, campaign: Campaign, tests: Sequence[Test], slots: tuple[tuple[str, int], ...],
                              x0: float, fixed: bool) -> list[Parameter]:
         """The amplitude (and, unless ``fixed``, the position) of the added attachment."""
@@ -276,7 +281,7 @@ class UnmodeledAttachment(Effect):
     def apply_truth(self, truth, value):
         amount, position = value
         name = f"({self.truth_key.replace('_', ' ')})"
-        truth.attachments.append(Attachment(name, position, **{self.amount_kind: amount}))
+        truth.attachments.append(self.attachment(name, position, amount))
         truth.origin[name] = f"effects.{self.truth_key}"
 
     def truth_json(self, value):
