@@ -242,8 +242,9 @@ class UnmodeledAttachment(Effect):
 
     def attachment(self, name: str, position: float, amount: float = 0.0) -> Attachment:
         """The attachment the effect adds (the diagnosis's at amplitude 0, the simulator's at ``amount``): a
-        point with ``amount`` as its ``amount_kind``, acting in both planes."""
-        return Attachment(name, position, **{self.amount_kind: amount})
+        point with ``amount`` as its ``amount_kind`` (none at 0: an amplitude the point cannot hold, a dashpot, is
+        the fit's override), acting in both planes."""
+        return Attachment(name, position, **({self.amount_kind: amount} if amount else {}))
 
     def unmodeled_parameters(self, campaign: Campaign, tests: Sequence[Test], slots: tuple[tuple[str, int], ...],
                              x0: float, fixed: bool) -> list[Parameter]:
