@@ -50,11 +50,11 @@ def write_report(result, out: str | Path | None = None) -> Path:
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     """The records table (``records.parquet``) with plain cells for CSV.
 
-    The per-record lists (``modes``, ``frequencies``, ``frequency_sigma``) become their values joined by
+    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``) become their values joined by
     ``;`` and ``start_time`` an ISO 8601 string; every other column is as in the Parquet table.
     """
     plain = table.copy()
-    for name, cast in (("modes", int), ("frequencies", float), ("frequency_sigma", float)):
+    for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float)):
         if name in plain:  # str of a float is its shortest round-trip form
             plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
     if "start_time" in plain:
