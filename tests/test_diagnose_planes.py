@@ -101,6 +101,11 @@ def test_one_plane_effects_need_both_planes():
     in_only = picked(planes=("in",))
     with pytest.raises(InputError, match="both planes"):
         diagnose(campaign(), effects="support_in_plane", picked=in_only, workers=1, max_effects=1)
+    # not asked for: left out quietly (no note on every one-plane diagnosis), unmodeled_support still fitted
+    d = diagnose(campaign(), effects=None, picked=in_only, workers=1, max_effects=1, tests=["T1"])
+    fitted = {e for key in d.fits for e in key}
+    assert "unmodeled_support" in fitted and not fitted & {"support_in_plane", "support_out_of_plane"}
+    assert not any("both planes" in str(n) for n in d.notes)
 
 
 @pytest.mark.slow

@@ -127,7 +127,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
             usable.append(e)
         elif requested:
             raise InputError(why, field="effects")
-        else:
+        elif not registry.get(e).quiet:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
     if check_plausibility:  # after the options' checks (an unknown or inapplicable effect is named first)
         plausible(campaign, measurements, settings.tension_model)

@@ -135,6 +135,9 @@ class Effect:
     #: Considered by the diagnosis when asked for by name even where :meth:`applicable` gives a reason
     #: (a reason why it is not considered by default).
     opt_in: ClassVar[bool] = False
+    #: Left out without a note where :meth:`applicable` gives a reason and the effect was not asked for (a
+    #: refinement of another effect that only some data can tell apart: a support acting in one plane).
+    quiet: ClassVar[bool] = False
 
     def __repr__(self) -> str:
         return f"<effect {self.name}>"

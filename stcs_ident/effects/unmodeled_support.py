@@ -56,6 +56,7 @@ class OnePlaneSupport(UnmodeledSupport):
     #: The plane the spring acts in.
     plane: ClassVar[str] = "in"
     option = None
+    quiet = True  # on one plane's modes (most campaigns) it is unmodeled_support: no note each time
 
     def attachment(self, name, position, amount=0.0):
         angle = 0.0 if self.plane == "in" else math.pi / 2
