@@ -246,7 +246,8 @@ def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], 
     for m in measurements:
         test = campaign.test(m.name)
         table = dict(zip(test.modes or (), test.frequencies or ()))
-        if m.name not in given and any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies)):
+        differ = any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies))
+        if m.name not in given and (differ or "out" in m.planes):  # the comparison's table: in-plane modes only
             given[m.name] = _in_plane(m.modes, m.frequencies, m.planes)
     return compare_forward(campaign, names, None, settings.tension_model, picked=given)
 
