@@ -21,6 +21,7 @@ import textwrap
 
 import numpy as np
 
+from ..identify.measurement import mode_label
 from .plots import Drawn, new_figure, save_figure
 
 
@@ -49,6 +50,8 @@ def _mode_indices(sweep, modes, test):
     found = []
     for k in modes:
         label = f"{test} mode {k}"
+        if label not in labels and f"{label} out-of-plane" in labels:  # an out-of-plane mode alone by that number
+            label = f"{label} out-of-plane"
         if label not in labels:
             raise ValueError(f"{label!r} is not among the measured frequencies")
         found.append(labels.index(label))
@@ -268,7 +271,7 @@ def _most_sensitive_test(result):
     sweep = result.sweep
     best, spread = result.tests[0], -1.0
     for t in result.tests:
-        idx = [sweep.labels.index(f"{t.name} mode {k}") for k in t.modes]
+        idx = [sweep.labels.index(f"{t.name} {mode_label(k, p)}") for k, p in zip(t.modes, t.mode_planes)]
         Z = sweep.surfaces[..., idx]
         s = float(np.nanmax((np.nanmax(Z, axis=(0, 1)) - np.nanmin(Z, axis=(0, 1))) / t.measured))
         if s > spread:
