@@ -62,7 +62,7 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
     lines: dict[str, list] = {key: [] for key in models}
     bands = []
     for i, (m, ax) in enumerate(zip(d.measurements, axes)):
-        k, ticks = mode_axis(m.modes, m.planes)  # out-of-plane modes after the in-plane ones
+        k, ticks = mode_axis(m.modes, getattr(m, "planes", None))  # out-of-plane modes after the in-plane ones
         u = m.uncertainty / m.frequencies * 100.0
         edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
         bands.append(ax.stairs(u, edges, baseline=-u, fill=True, color="0.85", lw=0,

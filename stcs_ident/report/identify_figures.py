@@ -214,7 +214,7 @@ def plot_errors(result, fig=None) -> Drawn:
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     before, after, errorbars = [], [], []
     for i, (t, ax) in enumerate(zip(tests, axes)):
-        x, ticks = mode_axis(t.modes, t.mode_planes)
+        x, ticks = mode_axis(t.modes, getattr(t, "mode_planes", None))
         sigma = np.asarray(t.uncertainty, float) / np.asarray(t.measured, float) * 100.0
         for errors, dx, colour, bars in ((t.before_error, -0.2, "tab:gray", before),
                                          (t.after_error, 0.2, "tab:blue", after)):
