@@ -65,8 +65,9 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
 
 
 def _record_format_table(options: tuple[tuple[str, Any], ...]) -> dict[str, Any]:
-    """Reader options as TOML values: rows as a list, numbers as they were read (floats)."""
-    return {key: list(value) if isinstance(value, tuple) else value for key, value in options}
+    """Reader options as TOML values: rows as a list, ``axes`` as a table, numbers as they were read (floats)."""
+    return {key: dict(value) if key == "axes" else list(value) if isinstance(value, tuple) else value
+            for key, value in options}
 
 
 def _cable_table(cable: Cable) -> dict[str, Any]:
