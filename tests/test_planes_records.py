@@ -203,6 +203,9 @@ def test_an_angle_is_kept(triaxial, tmp_path):
     with h5py.File(path, "a") as h5:
         h5.attrs["channel_direction"] = ["30", "-45.5", "axial", "in", "90", "360"]
     assert read_record(path).channel_directions == (30.0, -45.5, "axial", "in", "out", "in")
+    with h5py.File(path, "a") as h5:
+        h5.attrs["channel_direction"] = np.array([30, -45, 0, 90, 180, 270], dtype=np.int64)  # numbers: degrees
+    assert read_record(path).channel_directions == (30.0, -45.0, "in", "out", 180.0, -90.0)
 
 
 # ---------------------------------------------------------------- refusals, one line each

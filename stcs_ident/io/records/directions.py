@@ -24,6 +24,8 @@ import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from ...core.errors import InputError, ModelError, RecordWarning
 from ...core.planes import check_direction, direction_text
 
@@ -104,6 +106,8 @@ def file_directions(values: Sequence[Any], names: Sequence[str], *, axes: Any = 
     for name, value in zip(names, values):
         if isinstance(value, bytes):
             value = value.decode("utf-8", "replace")
+        if isinstance(value, np.generic):  # an HDF5 or TDMS number: an angle
+            value = value.item()
         if value is None or (isinstance(value, str) and not value.strip()):
             out.append(None)
             continue
