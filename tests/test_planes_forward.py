@@ -6,6 +6,7 @@ sag-extensibility; a spring acts with its ``stiffness_out``, a damper at angle �
 agree to 1e-6 on random cables; a taut string reproduces Irvine's in-plane/out-of-plane split of mode 1.
 """
 
+import json
 import math
 from dataclasses import replace
 
@@ -13,9 +14,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from stcs_ident.core.model import Attachment, Cable, Damper
+from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.core.planes import PLANE_NAMES
 from stcs_ident.forward import natural_frequencies
+from stcs_ident.forward.compare import compare_forward
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.forward.fem import fe_frequencies
 from stcs_ident.forward.fem_damped import fe_complex_modes
@@ -236,7 +238,7 @@ def test_an_attachment_s_out_of_plane_stiffness_is_honoured(k_in, k_out):
     for plane, k in (("in", k_in), ("out", k_out)):
         got = natural_frequencies(cable, [spring], tension, 6, plane=plane)
         np.testing.assert_allclose(got, spring_string_frequencies(length, m, tension, k, a, 6), rtol=1e-9)
-        fe = fe_frequencies(cable, [spring], tension, 6, n_elements=400, plane=plane)
+        fe = fe_frequencies(cable, [spring], tension, 6, n_elements=400, solver="sparse", plane=plane)
         np.testing.assert_allclose(fe, got, rtol=1e-7)  # a string's FE error ~h⁶ is ~1e-10 at 400 elements
     # stiffness_out=None: the in-plane stiffness in both planes
     same = Attachment("S", a, 0.0, k_in)
@@ -257,9 +259,97 @@ def test_out_of_plane_frequencies_do_not_depend_on_ea():
         for EA in (cable.EA * 1e3, None):
             other = replace(cable, EA=EA)
             np.testing.assert_allclose(natural_frequencies(other, atts, H, 8, plane="out"), base, rtol=1e-11)
-            np.testing.assert_allclose(fe_frequencies(other, atts, H, 8, n_elements=200, plane="out"),
-                                       fe_frequencies(cable, atts, H, 8, n_elements=200, plane="out"),
+            np.testing.assert_allclose(fe_frequencies(other, atts, H, 8, n_elements=200, solver="sparse", plane="out"),
+                                       fe_frequencies(cable, atts, H, 8, n_elements=200, solver="sparse", plane="out"),
                                        rtol=1e-12)  # the same matrices: rounding only
         stiff = natural_frequencies(replace(cable, EA=cable.EA * 1e3), atts, H, 8, plane="in")
         moved += np.abs(stiff / natural_frequencies(cable, atts, H, 8, plane="in") - 1).max() > 1e-3
     assert moved >= 5
+
+
+# ---------------------------------------------------------- the forward comparison
+
+def two_plane_campaign():
+    """A sagging cable (λ² ≈ 3.5, so mode 1 differs by ~5 % between the planes) with a spring whose
+    out-of-plane stiffness is three times its in-plane one; test T measured modes 1 and 2 in-plane and mode 1
+    out-of-plane (0.1 % and 0.2 % off the model), with a reference column equal to each plane's model to its
+    printed 0.0001 Hz; test U (setup D) has a light damper at 60° and no frequencies."""
+    cable = Cable(length=100.0, mass_per_length=50.0, EI=2e4, EA=2e9, inclination=0.4)
+    plain = Setup("S", (Attachment("W", 30.0, 20.0, 1e4, stiffness_out=3e4),))
+    damped = Setup("D", (Damper("DA", 2.0, coefficient=5e4, angle=math.radians(60)),))
+    H = 2e6
+    f_in = natural_frequencies(cable, plain.attachments, H, 2, plane="in")
+    f_out = natural_frequencies(cable, plain.attachments, H, 1, plane="out")
+    test = Test("T", "S", H, frequencies=(f_in[0] * 1.001, f_in[1] * 1.001, f_out[0] * 0.998), modes=(1, 2, 1),
+                planes=("in", "in", "out"),
+                reference=(("paper", tuple(round(f, 4) for f in (f_in[0], f_in[1], f_out[0]))),))
+    campaign = Campaign("planes", cable, (plain, damped), (test, Test("U", "D", H)))
+    return campaign, f_in, f_out
+
+
+def test_forward_compares_each_measured_frequency_with_the_mode_of_its_own_plane():
+    campaign, f_in, f_out = two_plane_campaign()
+    assert abs(f_out[0] / f_in[0] - 1) > 0.01  # comparing with the other plane's mode would show
+    result = compare_forward(campaign)  # default: both, T has an out-of-plane frequency
+    assert result.planes == ("in", "out")
+    t_in, t_out = result.test("T"), result.test("T", plane="out")
+    np.testing.assert_allclose(t_in.dsm[:2], f_in, rtol=1e-12)
+    np.testing.assert_allclose(t_out.dsm[:1], f_out, rtol=1e-12)
+    np.testing.assert_allclose(t_in.error("dsm")[:2], [100 * (1 / 1.001 - 1)] * 2, rtol=1e-9)
+    assert t_out.error("dsm")[0] == pytest.approx(100 * (1 / 0.998 - 1), rel=1e-9)
+    assert t_in.modes == (1, 2) and t_out.modes == (1,)  # each plane shows its measured modes
+    check = result.reference_checks[0]  # each reference value against its own plane's model
+    assert check.reproduced
+    assert check.max_nominal <= 5e-5  # rounded to 0.0001 Hz: half a step at most
+    # the damper at 60°: a quarter of its dashpot in-plane, three quarters out of plane
+    u_in, u_out = result.test("U"), result.test("U", plane="out")
+    assert len(u_in.modes) == len(u_out.modes) == 6  # not measured: the first 6 of each plane
+    # a light damper (η₁ = 0.08 in-plane, 0.24 out of plane): ζ nearly ∝ its share, 3 times more out of plane
+    # for mode 1 (measured 3.0), less as η_n = n η₁ nears Krenk's optimum
+    assert np.all(u_out.damping[:3] > 2 * u_in.damping[:3])
+    table = result.tables()["frequencies"]
+    assert list(table.columns[:3]) == ["test", "plane", "mode"] and set(table["plane"]) == {"in", "out"}
+
+
+def test_forward_json_keeps_the_in_plane_keys_and_adds_the_out_of_plane_family():
+    campaign, f_in, f_out = two_plane_campaign()
+    both = compare_forward(campaign, ["T"]).summary()
+    entry = both["tests"][0]
+    assert both["planes"] == ["in", "out"]
+    assert set(entry) >= {"name", "setup", "tension", "modes", "frequencies", "measured", "errors", "reference",
+                          "out_of_plane"}
+    assert entry["measured"][:2] == pytest.approx([f * 1.001 for f in f_in], rel=1e-12)
+    assert entry["out_of_plane"]["measured"][0] == pytest.approx(f_out[0] * 0.998, rel=1e-12)
+    assert entry["out_of_plane"]["reference"]["paper"][0] == round(f_out[0], 4)
+    only_in = compare_forward(campaign, ["T"], plane="in").summary()
+    assert only_in["planes"] == ["in"] and "out_of_plane" not in only_in["tests"][0]
+    assert only_in["tests"][0]["measured"][:2] == entry["measured"][:2]
+    assert only_in["reference_checks"][0]["reproduced"]  # the in-plane values alone
+    only_out = compare_forward(campaign, ["T"], plane="out").summary()
+    assert only_out["planes"] == ["out"] and "modes" not in only_out["tests"][0]
+    assert only_out["tests"][0]["out_of_plane"] == entry["out_of_plane"]
+    # a campaign without out-of-plane frequencies: the in-plane family only, as before the planes
+    plain = replace(campaign, tests=(replace(campaign.test("T"), frequencies=(f_in[0],), modes=(1,), planes=None,
+                                             reference=()),))
+    result = compare_forward(plain)
+    assert result.planes == ("in",) and not result.out_of_plane
+    assert "plane" not in result.tables()["frequencies"].columns
+
+
+def test_forward_command_plane_option(tmp_path, capsys):
+    from stcs_ident.cli.main import main
+    from stcs_ident.io.campaign_toml import campaign_to_toml
+
+    campaign, _, f_out = two_plane_campaign()
+    (tmp_path / "campaign.toml").write_text(campaign_to_toml(campaign), encoding="utf-8")
+    assert main(["forward", str(tmp_path), "--test", "T", "--plane", "both", "--json", "-"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["tests"][0]["out_of_plane"]["frequencies"]["dsm"][0] == pytest.approx(f_out[0], rel=1e-12)
+    assert main(["forward", str(tmp_path), "--test", "T"]) == 0  # default: both (T measured out of plane)
+    text = capsys.readouterr().out
+    assert "Test T (setup S, tension 2000.0 kN), in-plane" in text and "out-of-plane" in text
+    assert main(["forward", str(tmp_path), "--test", "T", "--plane", "in"]) == 0
+    assert "out-of-plane" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as refused:  # argparse refuses a bad choice, as the console script exits
+        main(["forward", str(tmp_path), "--plane", "sideways"])
+    assert refused.value.code == 2 and "--plane" in capsys.readouterr().err
