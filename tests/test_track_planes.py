@@ -45,7 +45,7 @@ class FakeRecord:
 
 def spec(tmp_path, directions=()) -> CableSpec:
     campaign = Campaign("stay", CABLE, (Setup("S"),), (Test("T1", "S", 3.8e6, channel_directions=directions),))
-    return CableSpec("stay", str(tmp_path), campaign, "S", 3.8e6)
+    return CableSpec("stay", str(tmp_path), campaign, "S", 3.8e6, directions=tuple(dict(directions).items()))
 
 
 def test_a_row_lists_the_planes_and_the_tension_comes_from_both(tmp_path, monkeypatch):

@@ -242,23 +242,14 @@ def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], 
     the table (its reference columns then checked as well).
     """
     names = [m.name for m in measurements]
-    given = {name: _in_plane(p.modes, p.frequencies, picked_planes(p)) for name, p in picked.items() if name in names}
+    given = {name: (p.modes, p.frequencies, picked_planes(p)) for name, p in picked.items() if name in names}
     for m in measurements:
         test = campaign.test(m.name)
-        table = dict(zip(test.modes or (), test.frequencies or ()))
-        differ = any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies))
-        if m.name not in given and (differ or "out" in m.planes):  # the comparison's table: in-plane modes only
-            given[m.name] = _in_plane(m.modes, m.frequencies, m.planes)
+        table = dict(zip(zip(test.planes or ("in",) * len(test.modes or ()), test.modes or ()), test.frequencies or ()))
+        if m.name not in given and any(table.get((str(p), int(k))) != float(f)
+                                       for p, k, f in zip(m.planes, m.modes, m.frequencies)):
+            given[m.name] = (m.modes, m.frequencies, tuple(map(str, m.planes)))
     return compare_forward(campaign, names, None, settings.tension_model, picked=given)
-
-
-def _in_plane(modes, frequencies, planes) -> tuple[np.ndarray, np.ndarray]:
-    """The in-plane modes and frequencies (the ``forward`` comparison is of the in-plane model)."""
-    modes, frequencies = np.asarray(modes), np.asarray(frequencies)
-    if planes is None:
-        return modes, frequencies
-    here = np.asarray(planes) == "in"
-    return modes[here], frequencies[here]
 
 
 def as_measured(m: Measurement) -> Test:
