@@ -234,6 +234,7 @@ def test_damping_ratios_are_predicted_in_their_plane():
     np.testing.assert_allclose(problem.residuals(problem.start), 0.0, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_out_of_plane_coverage_holds_with_a_wrong_EA(record_property):
     """EA 30 % above the truth, 200 noisy records of modes 1-3 (σ 0.5 mHz): out-of-plane fits cover the truth
     in ~68 % (58-78 %: 3 binomial sd) with a mean z within 3/√200 of 0; the in-plane fits of the same records
