@@ -17,8 +17,10 @@ import stcs_ident
 from stcs_ident import effects
 from stcs_ident.cli.main import build_parser
 from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
+from stcs_ident.core.planes import PLANES
 from stcs_ident.diagnose import diagnose
 from stcs_ident.effects.base import Effect, Option, Quantity, Truth, positive_ratio
+from stcs_ident.effects.unmodeled_support import OnePlaneSupport
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify.problem import Measurement
 from stcs_ident.simulate.effects import Effects, true_model
@@ -113,6 +115,8 @@ SAMPLES = {
     "attachment_mass": ({"W1": 17.0}, {"W1": -2.0}),
     "unmodeled_mass": ((2.0, 5.0), (-2.0, 5.0)),
     "unmodeled_support": ((1e4, 5.0), (1e4, math.nan)),
+    "support_in_plane": ((1e4, 5.0), (-1e4, 5.0)),
+    "support_out_of_plane": ((1e4, 5.0), (1e4, math.inf)),
     "end_restraint": ((1e5, math.inf), (1.0,)),
     "length": (1.01, 0.0),
     "damper": ((1e4, 5.0), (-1.0, 5.0)),
@@ -143,8 +147,9 @@ def test_every_effect_changes_the_true_model_and_round_trips_to_json(name):
     nominal = true_model(CABLE, _points(name), 4e5, None)
     true = true_model(CABLE, _points(name), 4e5, hidden)
     assert true != nominal
-    f0 = batch_frequencies(*nominal, 4)
-    f1 = batch_frequencies(*true, 4)
+    # both planes: an effect may act in one plane only (support_out_of_plane)
+    f0 = np.concatenate([batch_frequencies(*nominal, 4, plane=p) for p in PLANES])
+    f1 = np.concatenate([batch_frequencies(*true, 4, plane=p) for p in PLANES])
     assert not np.allclose(f0, f1, rtol=1e-9)
     assert json.loads(json.dumps(hidden.to_dict())) == json.loads(json.dumps({effect.truth_key: effect.truth_json(
         effect.check_truth(good, "x"))}))
@@ -157,9 +162,14 @@ def test_every_effect_changes_the_true_model_and_round_trips_to_json(name):
 def test_every_effect_frees_parameters_and_reports_them_in_its_own_units(name):
     points = _points(name)
     campaign = Campaign("c", CABLE, (Setup("S", tuple(points)),), (Test("T1", "S", 4e5), Test("T2", "S", 5e5)))
+    # an effect of one plane is considered with both planes' modes only
+    planes = PLANES if isinstance(effects.get(name), OnePlaneSupport) else ("in",)
     d = diagnose(campaign, effects=name, max_effects=1, workers=1,
-                 picked={t.name: Measurement(t, np.arange(1, 7), batch_frequencies(CABLE, points, t.tension, 6),
-                                             1e-4 * np.ones(6), "given") for t in campaign.tests})
+                 picked={t.name: Measurement(t, np.tile(np.arange(1, 7), len(planes)),
+                                             np.concatenate([batch_frequencies(CABLE, points, t.tension, 6, plane=p)
+                                                             for p in planes]),
+                                             1e-4, "given", planes=[p for p in planes for _ in range(6)])
+                         for t in campaign.tests})
     fit = d.fits[(name,)]
     values, sigmas = d.parameters(fit)
     assert set(values[name]) >= {q.key for q in effects.get(name).quantities}

@@ -21,6 +21,9 @@ def add_parser(sub) -> None:
     parser.add_argument("--EA", metavar="N", help="axial stiffness, N, for sag-extensibility (default: ignored)")
     parser.add_argument("--inclination", default="0", metavar="DEG", help="chord angle from horizontal, degrees")
     parser.add_argument("--boundary", choices=("clamped", "pinned"), default="clamped", help="both ends")
+    parser.add_argument("--plane", choices=("in", "out"), default="in",
+                        help="plane of the measured modes: in (in-plane, with sag-extensibility when --EA is given) "
+                             "or out (out-of-plane: no sag-extensibility, --EA unused); default in")
     parser.add_argument("--uncertainty", metavar="HZ", help="1σ of the frequencies, Hz, one for all or one each "
                                                             "(default: their printed rounding / sqrt 12)")
     parser.add_argument("--EI-tolerance", metavar="REL", help="relative 1σ of a given --EI, carried into the "
@@ -64,7 +67,7 @@ def tension_text(result) -> str:
     sigma_text = f"{sigma[0]:.3g} Hz" if len(set(sigma)) == 1 else ", ".join(f"{s:.3g}" for s in sigma) + " Hz"
     lines = [(f"length {inputs['length']:g} m, mass {inputs['mass']:g} kg/m, modes "
               f"{', '.join(map(str, inputs['modes']))}, {inputs['boundary']} ends, inclination "
-              f"{inputs['inclination']:g} deg"),
+              f"{inputs['inclination']:g} deg" + (", out-of-plane modes" if inputs.get("plane") == "out" else "")),
              f"frequency 1σ: {sigma_text}, {inputs['uncertainty_source']}",
              "",
              f"{'method':<13} {'tension (kN)':>14} {'1σ (kN)':>10}"]
@@ -101,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
                            boundary=args.boundary, uncertainty=uncertainty if len(uncertainty) > 1 else uncertainty[0],
                            uncertainty_source=source, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
                            length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
-                           mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"))
+                           mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"), plane=args.plane)
     if args.json:
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":

@@ -21,13 +21,13 @@ import numpy as np
 
 from ..core import kinds
 from ..core.errors import InputError
-from ..core.model import Campaign, has_dampers
+from ..core.model import Campaign, Test, has_dampers
 from ..core.notes import Note
 from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
 from ..identify.plausibility import check_plausibility as plausible
-from ..identify.problem import Measurement, gather_measurements
+from ..identify.problem import Measurement, gather_measurements, mode_label, picked_planes
 from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
@@ -118,15 +118,16 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     picked, excluded = _without_doubtful(campaign, given)
     measurements, skipped = gather_measurements(campaign, tests, picked)
     measured_tests = [m.test for m in measurements]
+    seen = [as_measured(m) for m in measurements]  # the tests with the modes (and planes) measured
     notes: list[Note] = list(excluded)
     usable = []
     for e in names:
-        why = applicable(campaign, measured_tests, e)
+        why = applicable(campaign, seen, e)
         if why is None or (requested and registry.get(e).opt_in and registry.tolerance(campaign, e) != 0):
             usable.append(e)
         elif requested:
             raise InputError(why, field="effects")
-        else:
+        elif not registry.get(e).quiet:
             notes.append(Note.make("not_considered", "not considered: {reason}", reason=why))
     if check_plausibility:  # after the options' checks (an unknown or inapplicable effect is named first)
         plausible(campaign, measurements, settings.tension_model)
@@ -138,7 +139,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     measurements = [replace(m, damping_is_data=with_damping) for m in measurements]
     n = data(campaign, measurements, settings.tension_model).n_data  # the frequencies (and damping ratios)
     sizes = {e: len(build(campaign, measured_tests, (e,)).parameters) for e in usable}
-    baseline = tuple(e for e in BASELINE if applicable(campaign, measured_tests, e) is None)
+    baseline = tuple(e for e in BASELINE if applicable(campaign, seen, e) is None)
     for e in baseline:  # fitted as the reference of the gain even when not among the effects considered
         sizes.setdefault(e, len(build(campaign, measured_tests, (e,)).parameters))
     smallest = min(sizes[e] for e in usable) if usable else 0
@@ -241,13 +242,21 @@ def nominal_comparison(campaign: Campaign, measurements: Sequence[Measurement], 
     the table (its reference columns then checked as well).
     """
     names = [m.name for m in measurements]
-    given = {name: (p.modes, p.frequencies) for name, p in picked.items() if name in names}
+    given = {name: (p.modes, p.frequencies, picked_planes(p)) for name, p in picked.items() if name in names}
     for m in measurements:
         test = campaign.test(m.name)
-        table = dict(zip(test.modes or (), test.frequencies or ()))
-        if m.name not in given and any(table.get(int(k)) != float(f) for k, f in zip(m.modes, m.frequencies)):
-            given[m.name] = (m.modes, m.frequencies)
+        table = dict(zip(zip(test.planes or ("in",) * len(test.modes or ()), test.modes or ()), test.frequencies or ()))
+        if m.name not in given and any(table.get((str(p), int(k))) != float(f)
+                                       for p, k, f in zip(m.planes, m.modes, m.frequencies)):
+            given[m.name] = (m.modes, m.frequencies, tuple(map(str, m.planes)))
     return compare_forward(campaign, names, None, settings.tension_model, picked=given)
+
+
+def as_measured(m: Measurement) -> Test:
+    """``m``'s test holding the modes, frequencies and planes measured (picked from a record, or the table), for
+    what an effect asks of the tests (an effect of one plane needs modes of both)."""
+    return replace(m.test, frequencies=tuple(map(float, m.frequencies)), modes=tuple(map(int, m.modes)),
+                   planes=tuple(map(str, m.planes)), uncertainty=None, reference=())
 
 
 def _seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
@@ -279,9 +288,13 @@ def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple
         keep = ~doubtful
         test = campaign.test(name)
         if keep.any():
+            planes = picked_planes(spectra)
             out[name] = Measurement(test, np.asarray(spectra.modes)[keep], np.asarray(spectra.frequencies)[keep],
-                                    np.asarray(spectra.uncertainty)[keep], "spectra")
-        lost = ", ".join(str(m) for m in np.asarray(spectra.modes)[doubtful])
+                                    np.asarray(spectra.uncertainty)[keep], "spectra",
+                                    planes=None if planes is None else np.asarray(planes)[keep])
+        labels = np.array([mode_label(int(k), str(p))[5:] for k, p in
+                           zip(spectra.modes, picked_planes(spectra) or ("in",) * len(spectra.modes))])
+        lost = ", ".join(labels[doubtful])
         notes.append(Note.make("doubtful_modes", "{test}: modes {modes} left out (their numbers are doubtful)",
                                test=name, modes=lost))
     return out, notes

@@ -1,6 +1,6 @@
 """Cross-validated prediction errors of a fitted hypothesis.
 
-Leave-one-mode-out: for each mode number, the frequencies of that mode are
+Leave-one-mode-out: for each mode number (of each plane), the frequencies of that mode are
 removed from every test, the hypothesis is refitted (started from the
 full-data estimate) and the removed frequencies are predicted. A parameter
 with no data left in a fold (the tension of a test whose only mode was
@@ -35,13 +35,15 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
     nf = full.n_frequencies  # the frequencies (the damping ratios, when data, follow them)
     measured = full.measured[:nf]
     modes = np.concatenate([m.modes for m in measurements])
+    planes = np.concatenate([m.planes for m in measurements])
     predicted = np.full(measured.size, np.nan)
-    for mode in np.unique(modes):
+    for plane, mode in sorted(set(zip(planes.tolist(), modes.tolist()))):  # a mode of one plane at a time
         kept = []
         for m in measurements:
-            keep = m.modes != mode
+            keep = (m.modes != mode) | (m.planes != plane)
             if keep.any():
-                kept.append(Measurement(m.test, m.modes[keep], m.frequencies[keep], m.uncertainty[keep], m.source))
+                kept.append(Measurement(m.test, m.modes[keep], m.frequencies[keep], m.uncertainty[keep], m.source,
+                                        planes=m.planes[keep]))
         used = [j for j, p in enumerate(hyp.parameters) if any(p.applies_to(m.test) for m in kept)]
         x = full.start.copy()
         n_kept = sum(m.modes.size for m in kept)
@@ -50,7 +52,7 @@ def cross_validate(fit: HypothesisFit, measurements: Sequence[Measurement], tens
         sub = hypothesis_problem(hyp, kept, tension_model, [hyp.parameters[j] for j in used])
         x_sub, _ = quietly(lambda sub=sub, used=used: local_fit(sub, x_full[used], max_nfev, TOL), [])
         x[used] = x_sub
-        left = modes == mode
+        left = (modes == mode) & (planes == plane)
         predicted[left] = full.predict(x)[:nf][left]
     if not np.all(np.isfinite(predicted)):
         return None

@@ -248,12 +248,16 @@ def rms_percent(predicted: np.ndarray, measured: np.ndarray) -> float:
 
 
 def nominal_prediction(campaign: Campaign, measurements: Sequence[Measurement], tension_model: str) -> np.ndarray:
-    """Frequencies of the nominal model at every measured mode."""
+    """Frequencies of the nominal model at every measured mode, each in its plane."""
     out = []
     for m in measurements:
         atts = campaign.setup(m.test.setup).attachments
-        f = batch_frequencies(campaign.cable, atts, m.test.tension, int(m.modes.max()), tension_model=tension_model)
-        out.append(np.asarray(f)[m.modes - 1])
+        f = np.full(m.modes.size, np.nan)
+        for plane in set(m.planes.tolist()):  # each plane's modes from its own model
+            here = m.planes == plane
+            f[here] = np.asarray(batch_frequencies(campaign.cable, atts, m.test.tension, int(m.modes[here].max()),
+                                                   tension_model=tension_model, plane=plane))[m.modes[here] - 1]
+        out.append(f)
     return np.concatenate(out)
 
 

@@ -136,7 +136,8 @@ def build(campaign: Campaign, tests: Sequence[Test], effects: Sequence[str],
     extra = [e for e in effects if registry.get(e).unmodeled]
     used = {t.setup for t in tests}
     if extra:
-        new = {e: Attachment(unmodeled_name(e), clear_position(campaign, tests, positions.get(e, cable.length / 3)))
+        new = {e: registry.get(e).attachment(unmodeled_name(e),
+                                             clear_position(campaign, tests, positions.get(e, cable.length / 3)))
                for e in extra}
         if len(new) == 2 and abs(new[extra[0]].position - new[extra[1]].position) < CLEARANCE * cable.length / 2:
             a = new[extra[1]]

@@ -167,6 +167,7 @@ class Diagnosis(Result):
             parts["baseline"] = self.per_test(baseline)
         for i, m in enumerate(self.measurements):
             entry = {"name": m.name, "setup": m.test.setup, "modes": [int(k) for k in m.modes],
+                     "planes": [str(p) for p in m.planes],
                      "measured": m.frequencies.tolist(), "uncertainty": m.uncertainty.tolist(), "source": m.source}
             for label, values in parts.items():
                 entry[label] = values[i].tolist()

@@ -92,7 +92,8 @@ def ranking_table(diagnosis) -> pd.DataFrame:
 
 
 def frequency_table(diagnosis) -> pd.DataFrame:
-    """Per test and mode: measured (with uncertainty), nominal, baseline, corrected (Hz) and errors (%)."""
+    """Per test and mode: measured (with uncertainty), nominal, baseline, corrected (Hz) and errors (%), the source
+    and the mode's plane."""
     d = diagnosis
     models = {"nominal": d.nominal, "baseline": d.baseline, "corrected": d.corrected}
     split = {key: (d.per_test(fit) if fit is not None else None) for key, fit in models.items()}
@@ -105,6 +106,7 @@ def frequency_table(diagnosis) -> pd.DataFrame:
         for key in models:
             data[f"{key}_error_%"] = percent_error(data[f"{key}_Hz"], m.frequencies)
         data["source"] = m.source
+        data["plane"] = [str(p) for p in m.planes]
         frames.append(pd.DataFrame(data))
     return pd.concat(frames, ignore_index=True)
 

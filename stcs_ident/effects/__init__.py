@@ -24,6 +24,8 @@ from . import (
     damper_coefficient,
     end_restraint,
     length,
+    support_in_plane,
+    support_out_of_plane,
     tension,
     unmodeled_mass,
     unmodeled_support,
@@ -44,7 +46,7 @@ from .registry import (
 )
 
 for _module in (tension, bending_stiffness, attachment_position, attachment_mass, unmodeled_mass, unmodeled_support,
-                end_restraint, length, damper, damper_coefficient):
+                support_in_plane, support_out_of_plane, end_restraint, length, damper, damper_coefficient):
     register(_module.EFFECT)
 
 __all__ = [

@@ -135,6 +135,9 @@ class Effect:
     #: Considered by the diagnosis when asked for by name even where :meth:`applicable` gives a reason
     #: (a reason why it is not considered by default).
     opt_in: ClassVar[bool] = False
+    #: Left out without a note where :meth:`applicable` gives a reason and the effect was not asked for (a
+    #: refinement of another effect that only some data can tell apart: a support acting in one plane).
+    quiet: ClassVar[bool] = False
 
     def __repr__(self) -> str:
         return f"<effect {self.name}>"
@@ -240,6 +243,12 @@ class UnmodeledAttachment(Effect):
         monotonically needs no other)."""
         return ()
 
+    def attachment(self, name: str, position: float, amount: float = 0.0) -> Attachment:
+        """The attachment the effect adds (the diagnosis's at amplitude 0, the simulator's at ``amount``): a
+        point with ``amount`` as its ``amount_kind`` (none at 0: an amplitude the point cannot hold, a dashpot, is
+        the fit's override), acting in both planes."""
+        return Attachment(name, position, **({self.amount_kind: amount} if amount else {}))
+
     def unmodeled_parameters(self, campaign: Campaign, tests: Sequence[Test], slots: tuple[tuple[str, int], ...],
                              x0: float, fixed: bool) -> list[Parameter]:
         """The amplitude (and, unless ``fixed``, the position) of the added attachment."""
@@ -276,7 +285,7 @@ class UnmodeledAttachment(Effect):
     def apply_truth(self, truth, value):
         amount, position = value
         name = f"({self.truth_key.replace('_', ' ')})"
-        truth.attachments.append(Attachment(name, position, **{self.amount_kind: amount}))
+        truth.attachments.append(self.attachment(name, position, amount))
         truth.origin[name] = f"effects.{self.truth_key}"
 
     def truth_json(self, value):

@@ -95,6 +95,10 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     -----
     IdentifiabilityWarning
         When parameters are not identifiable from the data.
+
+    Each measured mode is predicted by the model of its plane (a test's ``planes``, or the picked spectra's
+    ``mode_planes``; in-plane by default): out of plane without sag-extensibility, so a fit of out-of-plane
+    modes alone does not depend on EA.
     """
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")

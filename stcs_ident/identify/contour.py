@@ -294,7 +294,7 @@ def _sweep(problem: Problem, axes, F: np.ndarray, sigma: np.ndarray, centre: np.
     extent = np.array([(axes[0][ii].max() - axes[0][ii].min()), (axes[1][jj].max() - axes[1][jj].min())]) / 2
     extent = np.maximum(extent, cells / 2)
     centroid = np.array([axes[0][ii].mean(), axes[1][jj].mean()])
-    names = [f"{m.name} mode {k}" for m in problem.measurements for k in m.modes]
+    names = [f"{m.name} {label}" for m in problem.measurements for label in m.labels()]
     return ContourSweep(problem.parameters, axes, F, problem.measured, sigma, names, M, level, region,
                         np.asarray(centre, float), extent, centroid)
 

@@ -140,10 +140,12 @@ def finish(problem: Problem, x: np.ndarray, chi2: float, method: str, *, scale_r
     for i, m in enumerate(problem.measurements):
         sl = slice(k, k + m.modes.size)
         k += m.modes.size
-        reference = {label: np.array([dict(zip(m.test.modes or (), values)).get(int(k), np.nan) for k in m.modes])
+        keys = list(zip(m.test.planes or ("in",) * len(m.test.modes or ()), m.test.modes or ()))
+        reference = {label: np.array([dict(zip(keys, values)).get((str(p), int(k)), np.nan)
+                                      for p, k in zip(m.planes, m.modes)])
                      for label, values in m.test.reference}
         tests.append(TestFit(m.name, m.test.setup, tuple(int(v) for v in m.modes), m.frequencies, m.uncertainty,
-                             m.source, before[sl], after[sl], reference, damping[i]))
+                             m.source, before[sl], after[sl], reference, damping[i], tuple(str(p) for p in m.planes)))
     result = IdentificationResult(
         method=method, parameters=problem.parameters, estimate=np.asarray(x, float),
         uncertainty=sigma if uncertainty is None else uncertainty,

@@ -78,10 +78,11 @@ class Finding:
 def _nominal(campaign: Campaign, m: Measurement, mode: int, tension_model: str, tension: float | None = None,
              cable=None) -> float:
     """The nominal model's frequency of ``mode`` for the test of ``m`` (Hz), optionally with another tension
-    or cable."""
+    or cable; in the plane of the first measured ``mode`` (in-plane first, as :func:`_lowest` picks it)."""
     atts = campaign.setup(m.test.setup).attachments
+    plane = str(m.planes[m.modes == mode][0]) if np.any(m.modes == mode) else "in"
     f = batch_frequencies(cable or campaign.cable, atts, m.test.tension if tension is None else tension, mode,
-                          tension_model=tension_model)
+                          tension_model=tension_model, plane=plane)
     return float(np.asarray(f).ravel()[mode - 1])
 
 

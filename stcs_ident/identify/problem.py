@@ -1,9 +1,7 @@
 """The identification problem: measured frequencies, their uncertainties and the model.
 
-:class:`Measurement` holds one test's measured modes with a standard
-uncertainty per mode: from the spectra of a record, given by the caller,
-or, for a table of frequencies, the rounding of the table (a value printed
-to 0.01 Hz is uniform within ±0.005 Hz: standard uncertainty 0.01/√12 Hz).
+:class:`~stcs_ident.identify.measurement.Measurement` (:mod:`.measurement`, re-exported here) holds one
+test's measured modes with a standard uncertainty and a plane per mode.
 
 :class:`Problem` ties measurements and free parameters to the forward
 solver. :meth:`Problem.predict` evaluates the model at many parameter
@@ -14,17 +12,26 @@ multi-start scan and the contour grids all go through it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
 from ..core import kinds
 from ..core.errors import ComputationError, InputError, ModelError
-from ..core.model import Campaign, Test, has_dampers
+from ..core.model import Campaign, has_dampers
 from ..core.parameters import Parameter, overrides_for
+from ..core.planes import PLANES
 from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
+from .measurement import (  # noqa: F401 (re-exported: the measurements' home before the planes)
+    Measurement,
+    as_measurement,
+    gather_measurements,
+    mode_label,
+    picked_planes,
+    printed_step,
+    table_measurement,
+)
 
 #: Relative step of the numerical Jacobian (the solver is accurate to 1e-12).
 JACOBIAN_STEP = 1e-6
@@ -44,163 +51,6 @@ FIT_CERTIFY = False
 #: profiled out), while a cable's own damping varies from mode to mode by a few 1e-4 (aerodynamic
 #: damping ∝ 1/f, friction at the anchorages).
 DAMPING_SPREAD = 3e-4
-
-
-@dataclass(frozen=True)
-class Measurement:
-    """Measured natural frequencies of one test.
-
-    Attributes
-    ----------
-    test : Test
-    modes : ndarray of int
-    frequencies : ndarray
-        Hz, ordered by ``modes``.
-    uncertainty : ndarray
-        Standard uncertainty of each frequency, Hz (> 0).
-    source : str
-        Where the uncertainty comes from: ``"spectra"``, ``"table rounding
-        (0.01 Hz / sqrt 12)"`` or ``"given"``.
-    damping, damping_uncertainty : ndarray or None
-        Measured damping ratios and their 1σ, ordered by ``modes`` (NaN
-        where not measured); used with a damper in the model.
-    damping_is_data : bool or None
-        Whether a :class:`Problem` of these measurements takes the damping
-        ratios as data (the diagnosis decides it once for every hypothesis);
-        None: with a damper in the model.
-    """
-
-    test: Test
-    modes: np.ndarray
-    frequencies: np.ndarray
-    uncertainty: np.ndarray
-    source: str
-    damping: np.ndarray | None = None
-    damping_uncertainty: np.ndarray | None = None
-    damping_is_data: bool | None = None
-
-    def __post_init__(self):
-        where = f"test[{self.test.name}]"
-        modes = np.asarray(self.modes, int)
-        freqs = np.asarray(self.frequencies, float)
-        unc = np.broadcast_to(np.asarray(self.uncertainty, float), freqs.shape).copy()
-        if modes.ndim != 1 or modes.shape != freqs.shape or modes.size == 0:
-            raise InputError("modes and frequencies must be non-empty lists of one length", field=f"{where}.modes")
-        if np.any(modes < 1) or len(set(modes.tolist())) != modes.size:
-            raise InputError("mode numbers must be distinct integers >= 1", field=f"{where}.modes")
-        if not np.all(np.isfinite(freqs) & (freqs > 0)):
-            raise InputError("must be finite and > 0", field=f"{where}.frequencies")
-        if not np.all(np.isfinite(unc) & (unc > 0)):
-            raise InputError("frequency uncertainties must be finite and > 0", field=f"{where}.uncertainty")
-        order = np.argsort(modes)
-        object.__setattr__(self, "modes", modes[order])
-        object.__setattr__(self, "frequencies", freqs[order])
-        object.__setattr__(self, "uncertainty", unc[order])
-        if (self.damping is None) != (self.damping_uncertainty is None):
-            raise InputError("damping ratios need their uncertainties", field=f"{where}.damping")
-        if self.damping is not None:
-            zeta = np.broadcast_to(np.asarray(self.damping, float), freqs.shape)[order]
-            zeta_unc = np.broadcast_to(np.asarray(self.damping_uncertainty, float), freqs.shape)[order]
-            object.__setattr__(self, "damping", zeta)
-            object.__setattr__(self, "damping_uncertainty", zeta_unc)
-
-    @property
-    def damping_used(self) -> np.ndarray:
-        """Which modes have a usable damping ratio (finite, with a finite σ > 0)."""
-        if self.damping is None:
-            return np.zeros(self.modes.size, bool)
-        with np.errstate(invalid="ignore"):
-            return np.isfinite(self.damping) & np.isfinite(self.damping_uncertainty) & (self.damping_uncertainty > 0)
-
-    @property
-    def name(self) -> str:
-        return self.test.name
-
-
-def printed_step(values: Sequence[float]) -> float:
-    """Resolution a list of numbers was printed with: 0.01 for (7.24, 44.4)."""
-    decimals = 0
-    for v in values:
-        text = repr(float(v))
-        if "e" in text or "E" in text:
-            mantissa, exponent = text.lower().split("e")
-            digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
-            decimals = max(decimals, digits - int(exponent))
-        elif "." in text:
-            decimals = max(decimals, len(text.split(".")[1].rstrip("0")))
-    return 10.0 ** (-decimals)
-
-
-def table_measurement(test: Test) -> Measurement:
-    """A test's tabulated frequencies, with their stated uncertainty (``test.uncertainty``), else the
-    rounding of the table as uncertainty (and the source says which)."""
-    if test.uncertainty is not None:
-        return Measurement(test, np.array(test.modes), np.array(test.frequencies), np.array(test.uncertainty),
-                           "stated uncertainty")
-    step = printed_step(test.frequencies)
-    return Measurement(test, np.array(test.modes), np.array(test.frequencies), step / math.sqrt(12),
-                       f"table rounding ({step:g} Hz / sqrt 12)")
-
-
-def as_measurement(test: Test, picked) -> Measurement:
-    """A :class:`Measurement` from picked spectra (anything with ``modes``,
-    ``frequencies`` and ``uncertainty``, as :class:`~stcs_ident.spectra.pipeline.TestSpectra`)."""
-    if isinstance(picked, Measurement):
-        return picked
-    modes = getattr(picked, "modes", None)
-    freqs = getattr(picked, "frequencies", None)
-    unc = getattr(picked, "uncertainty", None)
-    if modes is None or freqs is None or unc is None:
-        raise InputError("picked frequencies need modes, frequencies and uncertainty", field=f"test[{test.name}]")
-    if len(modes) == 0:
-        raise InputError("no mode was picked from the record", field=f"test[{test.name}].record")
-    zeta, zeta_unc = getattr(picked, "damping", None), getattr(picked, "damping_uncertainty", None)
-    if zeta is None or zeta_unc is None:
-        zeta = zeta_unc = None
-    return Measurement(test, np.array(modes), np.array(freqs), np.array(unc), "spectra",
-                       None if zeta is None else np.array(zeta, float), None if zeta is None else np.array(zeta_unc, float))
-
-
-def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
-                        picked: Mapping[str, object] | None = None) -> tuple[list[Measurement], list[tuple[str, str]]]:
-    """The measurements of the selected tests, and the tests skipped with why.
-
-    A test is measured by ``picked[name]`` when given (spectra or a
-    :class:`Measurement`), else by its table of frequencies, else by the
-    spectra of its record (computed here). A test with none of these is
-    skipped when all tests are used, and is an error when it was selected
-    by name.
-
-    Raises
-    ------
-    InputError
-        For a test name that does not exist, a selected test without
-        frequencies or record, or when no test is left.
-    """
-    picked = dict(picked or {})
-    known = [t.name for t in campaign.tests]
-    for name in list(tests or []) + list(picked):
-        if name not in known:
-            raise InputError(f"no test named {name!r} (known: {', '.join(known)})", field="test")
-    selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
-    out, skipped = [], []
-    for test in selected:
-        if test.name in picked:
-            out.append(as_measurement(test, picked[test.name]))
-        elif test.frequencies is not None:
-            out.append(table_measurement(test))
-        elif test.record is not None:
-            from ..spectra.pipeline import analyse_test  # lazily: reads the record
-
-            out.append(as_measurement(test, analyse_test(campaign, test)))
-        elif tests:
-            raise InputError("has neither measured frequencies nor a record: nothing to identify from",
-                             field=f"test[{test.name}].frequencies")
-        else:
-            skipped.append((test.name, "no measured frequencies and no record"))
-    if not out:
-        raise InputError("no selected test has measured frequencies or a record", field="test")
-    return out, skipped
 
 
 class Problem:
@@ -314,26 +164,40 @@ class Problem:
                 continue
             sub = {key: v[ok] for key, v in ov.items()}
             tension = sub.pop("tension")
-            n_modes = max(int(self.measurements[i].modes.max()) for i in group)
-            damped = self.use_damping and any(self._zeta_used[i].any() for i in group)
-            try:
-                F, Z = self._solve(self._atts[first.name], tension, n_modes, sub, damped)
-            except ModelError as err:
-                raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
-            full = np.full((ok.size, n_modes), np.nan)
-            full[ok] = F
-            if damped:
-                full_zeta = np.full((ok.size, n_modes), np.nan)
-                full_zeta[ok] = Z
-            for j, i in enumerate(group):
-                m = self.measurements[i]
-                out[i] = full[j * k:(j + 1) * k, m.modes - 1]
-                if damped:
-                    zeta[i] = full_zeta[j * k:(j + 1) * k, m.modes[self._zeta_used[i]] - 1]
+            for plane in PLANES:  # each plane's modes from its own model (out-of-plane: no sag-extensibility)
+                members = [i for i in group if np.any(self.measurements[i].planes == plane)]
+                if members:
+                    self._predict_plane(plane, group, members, k, ok, tension, sub, out, zeta)
         F = np.concatenate(out + [z for z in zeta if z.shape[1]], axis=1)
         if self.n_data > self.n_frequencies:
             F[:, self.n_frequencies:] += self._own_damping(F[:, self.n_frequencies:])
         return F[0] if single else F
+
+    def _predict_plane(self, plane: str, group: list[int], members: list[int], k: int, ok: np.ndarray,
+                       tension: np.ndarray, sub: dict, out: list, zeta: list) -> None:
+        """Fill ``out`` and ``zeta`` (in place) for the modes in ``plane`` of the measurements ``members`` of one
+        setup's ``group`` (rows ``ok`` of the group's stacked overrides ``sub``)."""
+        first = self.measurements[group[0]]
+        n_modes = max(int(self.measurements[i].modes[self.measurements[i].planes == plane].max()) for i in members)
+        damped = self.use_damping and any((self._zeta_used[i] & (self.measurements[i].planes == plane)).any()
+                                          for i in members)
+        try:
+            F, Z = self._solve(self._atts[first.name], tension, n_modes, sub, damped, plane)
+        except ModelError as err:
+            raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
+        full = np.full((ok.size, n_modes), np.nan)
+        full[ok] = F
+        if damped:
+            full_zeta = np.full((ok.size, n_modes), np.nan)
+            full_zeta[ok] = Z
+        for j, i in enumerate(group):
+            if i not in members:
+                continue
+            m, used = self.measurements[i], self._zeta_used[i]
+            here = m.planes == plane
+            out[i][:, here] = full[j * k:(j + 1) * k, m.modes[here] - 1]
+            if damped and (used & here).any():
+                zeta[i][:, here[used]] = full_zeta[j * k:(j + 1) * k, m.modes[used & here] - 1]
 
     def damping_columns(self, before: np.ndarray, after: np.ndarray) -> list[dict[str, np.ndarray]]:
         """Per measurement, the measured damping ratios, their σ and the model's ``before`` and ``after`` (two
@@ -361,21 +225,22 @@ class Problem:
         return np.maximum(own, 0.0)
 
     def _solve(self, atts, tension: np.ndarray, n_modes: int, overrides: dict,
-               damped: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
-        """Frequencies (and, when ``damped``, damping ratios) on many rows; a row whose roots do not converge
-        (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
+               damped: bool = False, plane: str = "in") -> tuple[np.ndarray, np.ndarray | None]:
+        """Frequencies (and, when ``damped``, damping ratios) in ``plane`` on many rows; a row whose roots do not
+        converge (an extreme trial point of a fit) becomes NaN instead of failing the whole batch."""
         cable = self.campaign.cable
         try:
             if damped or _dashpots(atts, overrides):  # the fit's trial points: uncertified (see FIT_CERTIFY)
                 s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                        certify=FIT_CERTIFY, **overrides)
+                                        certify=FIT_CERTIFY, plane=plane, **overrides)
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
             return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                     **overrides), None
+                                     plane=plane, **overrides), None
         except ComputationError:
             if tension.size == 1:
                 return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
-        rows = [self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()}, damped)
+        rows = [self._solve(atts, tension[i:i + 1], n_modes, {k: v[i:i + 1] for k, v in overrides.items()}, damped,
+                            plane)
                 for i in range(tension.size)]
         return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows]) if damped else None
 

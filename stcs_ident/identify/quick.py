@@ -14,7 +14,7 @@
 - ``exact``: the exact dynamic-stiffness model (sag-extensibility with EA, inclination, the chosen
   ends), fitted by :func:`stcs_ident.identify.api.identify` to the frequencies: the tension alone when
   EI is given (or with one frequency, where EI is taken as 0), the tension and EI with two modes or more
-  and no EI.
+  and no EI; ``plane="out"`` fits the out-of-plane family (no sag-extensibility: EA plays no part).
 
 Uncertainty: every formula's σ is the frequency σ propagated through dT/df (first order); with several
 modes the per-mode estimates are averaged and the σ of the mean combines that propagation with their
@@ -37,6 +37,7 @@ from ..core import kinds
 from ..core.errors import ComputationError, InputError
 from ..core.model import finite_number, frequency, in_band, mode_number
 from ..core.notes import Note
+from ..core.planes import PLANES
 from ..core.result import Result
 from .problem import printed_step
 
@@ -368,7 +369,8 @@ def _EI_start(length, mass, freqs, modes, tension) -> float:
     return float(guess) if guess > 0 and math.isfinite(guess) else fallback
 
 
-def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance) -> MethodEstimate:
+def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance,
+           plane: str = "in") -> MethodEstimate:
     from ..core.model import Boundary, Cable, Campaign, Setup, Test
     from .api import identify
 
@@ -377,7 +379,7 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
     end = Boundary.clamped() if boundary == "clamped" else Boundary.pinned()
     cable = Cable(length, mass, EI_nominal, EA, math.radians(inclination), boundary_a=end, boundary_b=end)
     test = Test("quick", "quick", start, tuple(map(float, freqs)), tuple(map(int, modes)),
-                uncertainty=tuple(map(float, sigma)))
+                uncertainty=tuple(map(float, sigma)), planes=(plane,) * freqs.size)
     campaign = Campaign("quick-tension", cable, (Setup("quick"),), (test,), tolerance=tuple(tolerance.items()))
     params = "tension,EI" if fit_EI else "tension"
     bounds = {"tension": (0.05, 2.0), **({"EI": (1e-3, 1e3)} if fit_EI else {})}
@@ -415,7 +417,8 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
                   EI: float | None = None, EA: float | None = None, inclination: float = 0.0,
                   boundary: str = "clamped", uncertainty: float | Sequence[float] | None = None, *,
                   uncertainty_source: str | None = None, EI_tolerance: float | None = None,
-                  length_tolerance: float | None = None, mass_tolerance: float | None = None) -> QuickTensionResult:
+                  length_tolerance: float | None = None, mass_tolerance: float | None = None,
+                  plane: str = "in") -> QuickTensionResult:
     """A cable's tension from its length, mass and measured frequencies, by several methods side by side.
 
     Parameters
@@ -447,6 +450,9 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
         Relative 1σ of a given EI, of the length and of the mass per length (default: a campaign's defaults,
         30 %, 0.2 % and 1 %). Every method's σ includes them where the value is held fixed
         (docs/uncertainty.md); 0 says exact.
+    plane : {"in", "out"}
+        The plane the frequencies were measured in: the exact model fits the in-plane family (with
+        sag-extensibility when EA is given) or the out-of-plane one (no sag-extensibility, EA unused).
 
     Returns
     -------
@@ -458,8 +464,10 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     ------
     InputError
         Naming the argument (``length``, ``mass``, ``frequencies``, ``modes``, ``EI``, ``EA``,
-        ``inclination``, ``boundary``, ``uncertainty``).
+        ``inclination``, ``boundary``, ``uncertainty``, ``plane``).
     """
+    if plane not in PLANES:
+        raise InputError(f'must be "in" or "out", got {plane!r}', field="plane")
     length, mass, freqs, modes, EI, EA, inclination, boundary, sigma = _check(
         length, mass, frequencies, modes, EI, EA, inclination, boundary, uncertainty)
     if sigma is None:
@@ -477,7 +485,7 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
             tolerance[key] = float(value)
     inputs = {"length": length, "mass": mass, "frequencies": freqs.tolist(), "modes": modes.tolist(), "EI": EI,
               "EA": EA, "inclination": inclination, "boundary": boundary, "uncertainty": sigma.tolist(),
-              "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance}
+              "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance, "plane": plane}
     held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "mass_per_length", "EI")}
     taut = _with_tolerances(_taut, length, mass, freqs, modes, sigma, EI, boundary, held)
     methods = {
@@ -485,6 +493,6 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
         "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
         **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
         "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
-                        float(np.mean(taut.per_mode)), tolerance),
+                        float(np.mean(taut.per_mode)), tolerance, plane),
     }
     return QuickTensionResult(inputs, methods)

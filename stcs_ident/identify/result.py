@@ -53,6 +53,8 @@ class TestFit:
         ``uncertainty``, ``before`` and ``after`` ratios per mode (NaN where
         not measured; the model's include the fitted own damping of the
         cable). Empty otherwise.
+    planes : tuple of str
+        The plane of each mode, ``"in"`` or ``"out"`` (empty: all in-plane).
     """
 
     __test__ = False
@@ -67,6 +69,12 @@ class TestFit:
     after: np.ndarray
     reference: dict[str, np.ndarray] = field(default_factory=dict)
     damping: dict[str, np.ndarray] = field(default_factory=dict)
+    planes: tuple[str, ...] = ()
+
+    @property
+    def mode_planes(self) -> tuple[str, ...]:
+        """The plane of each mode (all ``"in"`` when none was given)."""
+        return tuple(self.planes) if self.planes else ("in",) * len(self.modes)
 
     def reference_error(self, label: str) -> np.ndarray:
         """(reference − measured) / measured × 100 for one reference column."""
@@ -304,7 +312,8 @@ class IdentificationResult(Result):
             "values": _nest(self.parameters, self.values, by="kind"),
             "value_uncertainty": _nest(self.parameters, self.value_uncertainty, by="kind"),
             "tests": [
-                {"name": t.name, "setup": t.setup, "modes": list(t.modes), "measured": _floats(t.measured),
+                {"name": t.name, "setup": t.setup, "modes": list(t.modes), "planes": list(t.mode_planes),
+                 "measured": _floats(t.measured),
                  "before": _floats(t.before), "after": _floats(t.after),
                  "before_error": _floats(t.before_error), "after_error": _floats(t.after_error),
                  "uncertainty": _floats(t.uncertainty), "uncertainty_source": t.source,
@@ -345,7 +354,8 @@ class IdentificationResult(Result):
         Columns ``test``, ``mode``, ``measured_Hz``, ``before_Hz``,
         ``before_error_abs_%``, ``corrected_Hz``, ``corrected_error_abs_%``
         (errors |computed − measured| / measured × 100), and for each of
-        :attr:`shown_references` ``<label>_Hz`` and ``<label>_error_abs_%``.
+        :attr:`shown_references` ``<label>_Hz`` and ``<label>_error_abs_%``; last, ``plane`` (``in`` or
+        ``out``, the plane of the mode).
         """
         frames = []
         labels = self.shown_references
@@ -359,6 +369,7 @@ class IdentificationResult(Result):
                 values = t.reference.get(label, np.full(len(t.modes), np.nan))
                 data[f"{label}_Hz"] = values
                 data[f"{label}_error_abs_%"] = np.abs(percent_error(values, t.measured))
+            data["plane"] = list(t.mode_planes)
             frames.append(pd.DataFrame(data))
         return pd.concat(frames, ignore_index=True)
 

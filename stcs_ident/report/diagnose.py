@@ -27,6 +27,7 @@ from .diagnose_tables import (
     nominal_comparison,
     ranking_table,
 )
+from .plots import mode_axis
 
 
 def diagnosis_text(diagnosis) -> str:
@@ -88,7 +89,7 @@ def _data_section(d, spectra) -> list[str]:
     for m in d.measurements:
         where = f"record {os.path.basename(records[m.name].record)}" if m.name in records else "campaign table"
         rows.append({"test": m.name, "setup": m.test.setup, "tension_kN": m.test.tension / 1e3,
-                     "modes": " ".join(str(int(k)) for k in m.modes), "frequencies": where,
+                     "modes": " ".join(mode_axis(m.modes, getattr(m, "planes", None))[1]), "frequencies": where,
                      "uncertainty_Hz": f"{m.uncertainty.min():.2g} – {m.uncertainty.max():.2g}"
                      if m.uncertainty.min() != m.uncertainty.max() else f"{m.uncertainty[0]:.2g}",
                      "uncertainty from": m.source})

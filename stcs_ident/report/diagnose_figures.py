@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .. import effects as registry
-from .plots import Drawn, new_figure
+from .plots import Drawn, mode_axis, new_figure
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {
@@ -62,7 +62,7 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
     lines: dict[str, list] = {key: [] for key in models}
     bands = []
     for i, (m, ax) in enumerate(zip(d.measurements, axes)):
-        k = m.modes.astype(float)
+        k, ticks = mode_axis(m.modes, getattr(m, "planes", None))  # out-of-plane modes after the in-plane ones
         u = m.uncertainty / m.frequencies * 100.0
         edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
         bands.append(ax.stairs(u, edges, baseline=-u, fill=True, color="0.85", lw=0,
@@ -73,7 +73,7 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
             err = (per_test[key][i] - m.frequencies) / m.frequencies * 100.0
             lines[key].append(ax.plot(k + dx, err, marker=marker, color=colour, lw=0.8, ms=5, label=label)[0])
         ax.set_title(f"{m.name} (setup {m.test.setup}, {m.test.tension / 1e3:.4g} kN)", fontsize=9)
-        ax.set_xticks(m.modes)
+        ax.set_xticks(k, ticks)
         ax.set_xlim(k[0] - 0.6, k[-1] + 0.6)
         ax.grid(True, axis="y", lw=0.3, alpha=0.6)
         if i % ncols == 0:

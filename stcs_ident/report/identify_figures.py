@@ -21,7 +21,8 @@ import textwrap
 
 import numpy as np
 
-from .plots import Drawn, new_figure, save_figure
+from ..identify.measurement import mode_label
+from .plots import Drawn, mode_axis, new_figure, save_figure
 
 
 def parameter_label(p) -> str:
@@ -49,6 +50,8 @@ def _mode_indices(sweep, modes, test):
     found = []
     for k in modes:
         label = f"{test} mode {k}"
+        if label not in labels and f"{label} out-of-plane" in labels:  # an out-of-plane mode alone by that number
+            label = f"{label} out-of-plane"
         if label not in labels:
             raise ValueError(f"{label!r} is not among the measured frequencies")
         found.append(labels.index(label))
@@ -211,7 +214,7 @@ def plot_errors(result, fig=None) -> Drawn:
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     before, after, errorbars = [], [], []
     for i, (t, ax) in enumerate(zip(tests, axes)):
-        x = np.asarray(t.modes, float)
+        x, ticks = mode_axis(t.modes, getattr(t, "mode_planes", None))
         sigma = np.asarray(t.uncertainty, float) / np.asarray(t.measured, float) * 100.0
         for errors, dx, colour, bars in ((t.before_error, -0.2, "tab:gray", before),
                                          (t.after_error, 0.2, "tab:blue", after)):
@@ -220,7 +223,7 @@ def plot_errors(result, fig=None) -> Drawn:
             errorbars.append(ax.errorbar(x + dx, errors, yerr=sigma, fmt="none", ecolor="k", elinewidth=0.8,
                                          capsize=2))
         ax.axhline(0.0, color="0.4", lw=0.6)
-        ax.set_xticks(t.modes)
+        ax.set_xticks(x, ticks)
         ax.set_title(f"{t.name}: rms {t.rms_before:.2f} % before, {t.rms_after:.2f} % corrected", fontsize=8)
         ax.grid(True, axis="y", lw=0.3, alpha=0.6)
         if i % ncols == 0:
@@ -268,7 +271,7 @@ def _most_sensitive_test(result):
     sweep = result.sweep
     best, spread = result.tests[0], -1.0
     for t in result.tests:
-        idx = [sweep.labels.index(f"{t.name} mode {k}") for k in t.modes]
+        idx = [sweep.labels.index(f"{t.name} {mode_label(k, p)}") for k, p in zip(t.modes, t.mode_planes)]
         Z = sweep.surfaces[..., idx]
         s = float(np.nanmax((np.nanmax(Z, axis=(0, 1)) - np.nanmin(Z, axis=(0, 1))) / t.measured))
         if s > spread:

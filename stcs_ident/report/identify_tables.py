@@ -41,7 +41,7 @@ def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
     digits = min(4, max(2, round(-math.log10(printed_step(t.measured)))))
     measured = f"{{:.{digits}f}}"
     for i, k in enumerate(t.modes):
-        row = [str(k), number(t.measured[i], measured), number(t.before[i]), number(abs(t.before_error[i]), "{:.2f}"),
+        row = [_mode(k, t.mode_planes[i]), number(t.measured[i], measured), number(t.before[i]), number(abs(t.before_error[i]), "{:.2f}"),
                number(t.after[i]), number(abs(t.after_error[i]), "{:.2f}")]
         for label in labels:
             row += [number(t.reference[label][i], "{:.2f}"), number(abs(t.reference_error(label)[i]), "{:.2f}")]
@@ -53,9 +53,14 @@ def _rows(result, t) -> tuple[list[str], list[list[str]], list[str]]:
     return head, rows, labels
 
 
+def _mode(k: int, plane: str) -> str:
+    """A mode's name in a table: ``3`` in-plane, ``3 out`` out-of-plane."""
+    return str(k) if plane == "in" else f"{k} out"
+
+
 def _damping_rows(t) -> list[list[str]]:
     z = t.damping
-    return [[str(k)] + [number(100 * z[key][i], "{:.3f}") for key in ("measured", "uncertainty", "before", "after")]
+    return [[_mode(k, t.mode_planes[i])] + [number(100 * z[key][i], "{:.3f}") for key in ("measured", "uncertainty", "before", "after")]
             for i, k in enumerate(t.modes) if math.isfinite(z["measured"][i])]
 
 

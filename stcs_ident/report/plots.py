@@ -109,6 +109,18 @@ def _nominal_markers(ax, spectra, f):
                    transform=ax.get_xaxis_transform(), label="nominal model's frequencies")[0]
 
 
+def mode_axis(modes, planes=None) -> tuple[np.ndarray, list[str]]:
+    """Where a figure puts each mode along its x axis, and the tick labels: an in-plane mode at its number,
+    the out-of-plane ones after a gap past the highest in-plane mode (labelled ``3 out``), as measurements
+    list them (in-plane first)."""
+    k = np.asarray(modes, float)
+    out = np.zeros(k.size, bool) if planes is None else np.asarray(planes) == "out"
+    shift = (k[~out].max() + 1.0) if (~out).any() and out.any() else 0.0
+    x = np.where(out, k + shift, k)
+    labels = [f"{int(m)} out" if o else f"{int(m)}" for m, o in zip(k, out)]
+    return x, labels
+
+
 def save_figure(fig, path) -> None:
     """Save a PNG whole or not at all, with the permissions of any other output
     (:func:`stcs_ident.core.files.write_figure`)."""

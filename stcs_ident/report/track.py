@@ -50,11 +50,11 @@ def write_report(result, out: str | Path | None = None) -> Path:
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     """The records table (``records.parquet``) with plain cells for CSV.
 
-    The per-record lists (``modes``, ``frequencies``, ``frequency_sigma``) become their values joined by
+    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``) become their values joined by
     ``;`` and ``start_time`` an ISO 8601 string; every other column is as in the Parquet table.
     """
     plain = table.copy()
-    for name, cast in (("modes", int), ("frequencies", float), ("frequency_sigma", float)):
+    for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float)):
         if name in plain:  # str of a float is its shortest round-trip form
             plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
     if "start_time" in plain:
@@ -70,7 +70,7 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
     spec : the cable's specification in the run (``name``, ``campaign``, ``reference_tension``)
     table : DataFrame
         One row per record (``start_time``, ``tension``, ``tension_sigma``,
-        ``level``, ``temperature``, ``modes``, ``frequencies``).
+        ``level``, ``temperature``, ``modes``, ``planes``, ``frequencies``).
     rows : the labels of this cable's rows in ``table``
     history : the cable's tension history (``normalised``, ``mean_temperature``, ``events``)
     fig : matplotlib.figure.Figure, optional
@@ -78,7 +78,8 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
     Returns
     -------
     dict with the figure, the three axes (``axes``: tension, temperature, frequency) and the frequency
-    panel's lines by mode (``modes``: {mode: Line2D}); past mode 10 the colours repeat with another marker.
+    panel's lines by mode (``modes``: {mode: Line2D}, an out-of-plane mode under ``"<mode> out"``); past mode 10
+    the colours repeat with another marker.
     """
     data = table.loc[rows]
     if not data["tension"].notna().any():  # every record failed: say so; the reasons are in report.md
@@ -110,16 +111,18 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
     if data["temperature"].notna().any():
         middle.plot(t, data["temperature"], "-", color="tab:green", lw=0.8)
     middle.set_ylabel("temperature (°C)")
-    modes = sorted({m for ms in data["modes"] for m in ms})
+    planes = data["planes"] if "planes" in data else [["in"] * len(ms) for ms in data["modes"]]
+    keyed = [dict(zip(zip(ps, ms), f)) for ms, ps, f in zip(data["modes"], planes, data["frequencies"])]
+    modes = sorted({key for k in keyed for key in k}, key=lambda key: (key[0] != "in", key[1]))
     colours = [f"C{i}" for i in range(10)]
     drawn = {}
-    for i, mode in enumerate(modes):
-        pairs = [(time, f[list(ms).index(mode)]) for time, ms, f in zip(t, data["modes"], data["frequencies"])
-                 if mode in list(ms)]
+    for i, (plane, mode) in enumerate(modes):
+        pairs = [(time, k[(plane, mode)]) for time, k in zip(t, keyed) if (plane, mode) in k]
         times, freq = zip(*pairs)
         marker = MODE_MARKERS[(i // 10) % len(MODE_MARKERS)]
-        drawn[mode] = bottom.plot(times, np.asarray(freq) / mode, marker, color=colours[i % 10],
-                                  ms=2 if marker == "." else 3, mew=0.6, label=f"mode {mode}")[0]
+        key = mode if plane == "in" else f"{mode} out"  # the out-of-plane modes: their own lines
+        drawn[key] = bottom.plot(times, np.asarray(freq) / mode, marker, color=colours[i % 10],
+                                 ms=2 if marker == "." else 3, mew=0.6, label=f"mode {key}")[0]
     bottom.set_ylabel("frequency / mode number (Hz)")
     bottom.set_xlabel("time (UTC)")
     if modes:

@@ -13,8 +13,9 @@ records are simply not known: they are processed again.
 
 ``records.parquet`` is the table, rewritten whole at the end of each run,
 for the user to open (pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps
-the types (times, lists of modes and frequencies) and is read column by
-column. The files are written and read by :mod:`~stcs_ident.io.tables`;
+the types (times, lists of modes, planes and frequencies) and is read column
+by column. A part written before the ``planes`` column reads with every mode
+in-plane (what it was processed as). The files are written and read by :mod:`~stcs_ident.io.tables`;
 this module keeps the rows' types, the parts' names and their order.
 """
 
@@ -90,6 +91,8 @@ def read_parts(out: str | os.PathLike) -> tuple[pd.DataFrame, list[Path], list[P
     frames, unreadable = read_parquet_files([directory / n for n in names])
     read = []
     for path, frame in frames:
+        if "planes" not in frame and "modes" in frame:  # a part written before the planes: every mode in-plane
+            frame = frame.assign(planes=[["in"] * len(m) for m in frame["modes"]])
         missing = [c for c in ROW_COLUMNS if c not in frame]
         cables = set(frame["cable"].map(cable_key)) if "cable" in frame else set()
         if missing or cables - {PART.match(path.name)["cable"]}:
