@@ -19,7 +19,7 @@ import pandas as pd
 from ..core.errors import InputError
 from ..core.model import Campaign, Test
 from ..core.notes import Note
-from ..core.planes import PLANE_NAMES
+from ..core.planes import NO_DIRECTIONS_NOTE, PLANE_NAMES, directions_note
 from ..core.record import Record
 from ..forward import natural_frequencies
 from ..io.records import read_record
@@ -35,8 +35,8 @@ from .structural import mac, model_shapes, shape_is_meaningful
 #: Modes searched by default: enough for identification, few enough that a
 #: long stay cable's hundreds of modes below Nyquist are not all numbered.
 DEFAULT_MAX_MODES = 30
-#: Said of a record whose channels have no directions.
-NO_DIRECTIONS = "no channel directions given: every channel read as in-plane"
+#: Said of a record whose channels have no directions (:func:`~stcs_ident.core.planes.directions_note`).
+NO_DIRECTIONS = NO_DIRECTIONS_NOTE
 
 
 @dataclass(frozen=True, repr=False)
@@ -249,7 +249,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
-        plane_options=plane_options, plane_notes=(Note.plain("directions", NO_DIRECTIONS),),
+        plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),),
     )
 
 
