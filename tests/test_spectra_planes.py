@@ -15,13 +15,13 @@ import warnings
 import numpy as np
 import pytest
 
-from benchmarks.plane_records import make_case
+from benchmarks.plane_records import make_bridge_case, make_case
 from stcs_ident.core.errors import InputError
 from stcs_ident.core.record import Record
 from stcs_ident.report.spectra_tables import modes_table, spectra_text
 from stcs_ident.spectra.channels import plane_channels, plane_record
-from stcs_ident.spectra.option_groups import PlaneOptions
 from stcs_ident.spectra.pipeline import NO_DIRECTIONS, analyse_record
+from stcs_ident.spectra.plane_options import PlaneOptions
 from stcs_ident.spectra.structural import harmonic_of, mac, shape_is_meaningful
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -180,23 +180,28 @@ def test_given_structural_frequencies_are_never_numbered():
 
 
 # ---------------------------------------------------------------------------------------------------------------
-# Acceptance (slow): no deck mode numbered, 1σ coverage per plane, on held-out seeds.
+# Acceptance (slow): no deck mode numbered, 1σ coverage per plane, on held-out seeds, on the project's simulator
+# with a bridge (benchmarks/plane_records.make_bridge_case: two deck modes at anchorage A, one within 0.5–2 % of
+# a cable mode, second harmonics, traffic, sensors misaligned by N(0, 1.5°), independent wind per plane).
 
-HELD_OUT = 10_000  # tuned on seeds 0-99; these were not looked at before the test was written
+HELD_OUT = 10_000  # the constants were set on seeds 0-99; these seeds were first run for this test
 
 
 def _score(kind, seeds, layout):
     z = {"in": [], "out": []}
     numbered_deck = []
     for seed in seeds:
-        case = make_case(kind, seed, layout=layout)
+        case = make_bridge_case(kind, seed, layout=layout)
         r = _analyse(case)
         for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
+            if mode > len(case.truth[plane]):  # a number beyond the simulated modes: not a cable mode
+                numbered_deck.append((kind, seed, plane, mode, f))
+                continue
             true = case.truth[plane][mode - 1]
             z[plane].append((f - true) / u)
-            # A deck mode numbered as a cable mode: the numbered peak is off its mode beyond 3σ and nearer a
-            # structural frequency (a deck mode or harmonic) than the mode's true frequency.
-            if abs(f - true) > 3 * u and any(abs(f - s) < abs(f - true) for s in case.structural):
+            # A deck mode numbered as a cable mode: the numbered peak is off its mode beyond 3σ and on a
+            # structural frequency (a deck mode or its harmonic) within 3σ.
+            if abs(f - true) > 3 * u and any(abs(f - s) <= 3 * u for s in case.structural):
                 numbered_deck.append((kind, seed, plane, mode, f))
     return z, numbered_deck
 

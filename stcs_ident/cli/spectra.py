@@ -46,8 +46,8 @@ def run(args: argparse.Namespace) -> int:
 
     campaign, file, tests = prepare(args)
     if args.structural:
-        from ..spectra.option_groups import PlaneOptions
         from ..spectra.pipeline import analyse_campaign
+        from ..spectra.plane_options import PlaneOptions
 
         results = analyse_campaign(campaign, tests, progress=progress_line,
                                    plane_options=PlaneOptions(structural=args.structural))

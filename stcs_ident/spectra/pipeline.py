@@ -25,11 +25,11 @@ from ..forward import natural_frequencies
 from ..io.records import read_record
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from .numbering import Numbering, number_modes
-from .option_groups import PlaneOptions
 from .options import PickingOptions
 from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes
+from .plane_options import PlaneOptions
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -193,7 +193,7 @@ def analyse_test(campaign: Campaign, test: Test, *, max_modes: int = DEFAULT_MAX
 
     ``options`` tunes the picking and the numbering (default: the
     calibrated values); the result records them. ``plane_options``: the planes and the structural peaks
-    (:class:`.option_groups.PlaneOptions`; used for a record whose channels have directions).
+    (:class:`.plane_options.PlaneOptions`; used for a record whose channels have directions).
     """
     path = record_path(campaign, test)
     positions, reading = campaign.record_reading(test)
@@ -278,10 +278,13 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
     unassigned = [peaks[plane].peaks[k] for plane, k in outcome.unassigned]
     notes = tuple(Note.plain("leak", f"{PLANE_NAMES[plane]} peak at {peaks[plane].peaks[k].frequency:.4f} Hz "
                                      f"set aside: {reason}") for plane, k, reason in outcome.leaks)
+    notes += tuple(Note.plain("overlap", f"{PLANE_NAMES[m.plane]} mode {m.mode}: 1σ widened by its own half-power "
+                                         f"half-width, a structural resonance at {m.overlapped_by:.4f} Hz "
+                                         "overlaps it") for m in outcome.modes if m.overlapped_by is not None)
     return TestSpectra(
         name=test.name, record=path, modes=tuple(m.mode for m in outcome.modes),
         frequencies=np.array([p.frequency for p in chosen], float),
-        uncertainty=np.array([p.uncertainty for p in chosen], float),
+        uncertainty=np.array([m.uncertainty for m in outcome.modes], float),
         damping=np.array([np.nan if p.damping is None else p.damping for p in chosen], float),
         channels=tuple(tuple(p.channels) for p in chosen), doubtful=tuple(m.doubtful for m in outcome.modes),
         unassigned=tuple((float(p.frequency), float(p.uncertainty)) for p in unassigned),

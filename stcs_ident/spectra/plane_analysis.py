@@ -20,7 +20,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -29,10 +29,10 @@ from ..core.record import Record
 from ..forward import natural_frequencies
 from .channels import PlaneChannels, plane_channels, plane_record
 from .numbering import Numbering, number_modes
-from .option_groups import PlaneOptions
 from .options import PickingOptions
 from .peak_result import PeakResult
 from .peaks import find_peaks
+from .plane_options import PlaneOptions
 from .structural import harmonic_of, mac, model_shapes, shape_is_meaningful
 
 __all__ = ["PlaneMode", "PlanesOutcome", "analyse_planes"]
@@ -48,6 +48,8 @@ class PlaneMode:
     doubtful: bool
     mac: float  # NaN where not meaningful
     shape: tuple[tuple[str, float], ...]
+    uncertainty: float  # the peak's 1σ, widened where a structural resonance overlaps it (Hz)
+    overlapped_by: float | None = None  # that resonance's frequency (Hz)
 
 
 @dataclass(frozen=True)
@@ -135,10 +137,18 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
                 amplitude = result.peaks[k].amplitude[:len(names)]
                 out.modes.append(PlaneMode(plane, mode, k, bool(numbering.doubtful[pos]),
                                            value if meaningful else float("nan"),
-                                           tuple((n, float(a)) for n, a in zip(names, amplitude))))
+                                           tuple((n, float(a)) for n, a in zip(names, amplitude)),
+                                           float(result.peaks[k].uncertainty)))
             else:
                 out.unassigned.append((plane, k))
     _unassigned_structural(out, pairs, structural, plane_options)
+    resonances = [(peaks[pl].peaks[k].frequency, peaks[pl].peaks[k].damping) for pl, k in structural]
+    resonances += [(order * f, None) for f in plane_options.structural
+                   for order in range(1, plane_options.max_harmonic + 1)]
+    if axial:
+        resonances += _axial_resonances(record, axial, bands, axial_share, options, plane_options)
+    resonances += [(2 * f, zeta) for f, zeta in resonances[:] if zeta is not None]  # the structure's 2nd harmonic
+    out.modes[:] = [_overlapped(m, peaks[m.plane].peaks[m.index], resonances) for m in out.modes]
     out.structural.extend((plane, k, reason) for (plane, k), reason in structural.items())
     out.structural.sort(key=lambda s: peaks[s[0]].peaks[s[1]].frequency)
     out.modes.sort(key=lambda m: (m.plane != "in", m.mode))
@@ -250,3 +260,54 @@ def _axial_share(x: np.ndarray, n: int, fs: float, options: PickingOptions):
         return float(np.sqrt(along / transverse)) if transverse > 0 else float("inf")
 
     return share
+
+
+#: A structural resonance overlaps a cable mode within this many of its half-power half-widths ζ_s f_s.
+OVERLAP_WIDTHS = 3.0
+#: Damping ratio taken for a resonance whose damping is not known (a given structural frequency; 2 %: a deck
+#: or pylon mode's is 0.5–2 %, the wider the more cable modes it is said to overlap).
+STRUCTURAL_DAMPING = 0.02
+#: A peak of the axial channels alone is the anchorage's, for widening the 1σ of the cable modes it
+#: overlaps, where the axial share reaches this (0.1: a sensor turned by 5.7° reads that much of a cable
+#: mode along the chord; lower than ``axial_ratio``, since a deck mode merged with a cable mode shares the
+#: transverse channels with it, and a widened 1σ costs little where a missed one costs coverage).
+AXIAL_RESONANCE_SHARE = 0.1
+#: Damping ratio taken for a cable mode whose fit gave none (0.5 %).
+CABLE_DAMPING = 0.005
+
+
+def _overlapped(mode: PlaneMode, peak, resonances) -> PlaneMode:
+    """``mode`` with its 1σ widened where a structural resonance overlaps it.
+
+    The fit of a cable mode takes the background under it as flat; a deck's or pylon's resonance a per cent
+    away is not (the anchorage's narrow-band motion drives the cable there), and the fitted maximum moves
+    by up to about the cable mode's own half-power half-width ζ f. On simulated bridge records (a deck mode
+    within 0.5–2 % of a cable mode, the cable's exact dynamic answer to the support's motion) the modes
+    beyond 3σ were nearly all within 2 % of a deck mode or its harmonic, by 0.2–0.5 % of f with ζ of
+    0.3–0.8 %. So the 1σ gains, in quadrature, that of a uniform error over ± ζ f: ζ f / √3.
+    """
+    f = peak.frequency
+    zeta = peak.damping if peak.damping is not None and np.isfinite(peak.damping) else CABLE_DAMPING
+    for f_s, zeta_s in resonances:
+        zeta_s = STRUCTURAL_DAMPING if zeta_s is None or not np.isfinite(zeta_s) else zeta_s
+        if abs(f - f_s) <= max(OVERLAP_WIDTHS * zeta_s * f_s, 3 * mode.uncertainty):
+            sigma = float(np.hypot(mode.uncertainty, zeta * f / np.sqrt(3.0)))
+            return replace(mode, uncertainty=sigma, overlapped_by=float(f_s))
+    return mode
+
+
+def _axial_resonances(record: Record, axial, bands: dict, axial_share: dict, options: PickingOptions,
+                      plane_options: PlaneOptions) -> list[tuple[float, float | None]]:
+    """(frequency, damping) of the peaks of the axial channels alone where they are the anchorage's (the
+    axial share at least :data:`AXIAL_RESONANCE_SHARE` in a plane): a deck mode beside a cable mode, which the
+    plane's picking sees merged with the cable's, stands alone there. (``plane_options``: unused here.)"""
+    low, high = min(b[0] for b in bands.values()), max(b[1] for b in bands.values())
+    x = record.acceleration[:, list(axial)]
+    along = Record(acceleration=x - x.mean(axis=0), sampling_rate=record.sampling_rate,
+                   channel_names=tuple(record.channel_names[k] for k in axial),
+                   channel_positions=record.channel_positions[list(axial)])
+    out = []
+    for p in find_peaks(along, low, high, overwrite=True, options=options).peaks:
+        if any(share(p.frequency) >= AXIAL_RESONANCE_SHARE for share in axial_share.values()):
+            out.append((p.frequency, p.damping))
+    return out
