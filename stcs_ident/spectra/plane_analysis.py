@@ -148,7 +148,6 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     if axial:
         resonances += _axial_resonances(record, axial, bands, axial_share, options, plane_options)
     resonances += [(2 * f, zeta) for f, zeta in resonances[:] if zeta is not None]  # the structure's 2nd harmonic
-    resonances += _broad_peaks(out)
     out.modes[:] = [_overlapped(m, peaks[m.plane].peaks[m.index], resonances) for m in out.modes]
     out.structural.extend((plane, k, reason) for (plane, k), reason in structural.items())
     out.structural.sort(key=lambda s: peaks[s[0]].peaks[s[1]].frequency)
@@ -313,23 +312,3 @@ def _axial_resonances(record: Record, axial, bands: dict, axial_share: dict, opt
             out.append((p.frequency, p.damping))
     return out
 
-
-#: A numbered peak this many times more damped than the median of its plane's is taken as a cable mode
-#: merged with a structural resonance beside it (2: a cable's damping changes gradually from mode to mode).
-BROAD_PEAK = 2.0
-
-
-def _broad_peaks(out: PlanesOutcome) -> list[tuple[float, float | None]]:
-    """(frequency, damping) of the numbered peaks whose damping is ``BROAD_PEAK`` times their plane's median
-    (three modes or more): without axial channels, a deck mode within a per cent of a cable mode shows only
-    as a broader peak, the two fitted as one."""
-    found = []
-    for plane, result in out.peaks.items():
-        own = [result.peaks[m.index] for m in out.modes if m.plane == plane]
-        zetas = [p.damping for p in own if p.damping is not None and np.isfinite(p.damping)]
-        if len(zetas) < 3:
-            continue
-        median = float(np.median(zetas))
-        found += [(p.frequency, p.damping) for p in own
-                  if p.damping is not None and p.damping > BROAD_PEAK * median]
-    return found
