@@ -113,10 +113,14 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
             weak, strong = (("in", i), "out") if sa < sb else (("out", j), "in")
             kept[weak[0]].discard(weak[1])
             out.leaks.append((*weak, f"the {PLANE_NAMES[strong]} mode leaking through a sensor's misalignment"))
-    for plane, result in peaks.items():
+    numbering_options = options.numbering
+    order = sorted(peaks, key=lambda pl: -sum((pl, k) not in structural for k in kept[pl]))  # the richer first
+    for plane in order:
+        result = peaks[plane]
         candidates = [k for k in sorted(kept[plane]) if (plane, k) not in structural]
         for attempt in range(4):  # numbered, then again without the peaks whose shape is not their mode's
-            numbering = _number(result, candidates, cable, attachments, tension, tension_model, options, plane)
+            numbering = _number(result, candidates, cable, attachments, tension, tension_model, numbering_options,
+                                plane)
             shapes = _shapes(result, channels[plane], candidates, numbering, cable, attachments, tension,
                              tension_model, plane)
             rejected = [k for k, (value, meaningful, mode) in shapes.items()
@@ -128,7 +132,13 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
             if not rejected:
                 break
             candidates = [k for k in candidates if k not in rejected]
+            if np.sum(numbering.modes > 0) >= 2:  # numbered again near the family just found
+                numbering_options = _near(numbering_options, numbering)
         out.numbering[plane] = numbering
+        if np.sum(numbering.modes > 0) >= 2:
+            # The planes share the tension and the bending stiffness: the next plane's family is searched
+            # near this one's (the planes' models differ by sag and attachments, which they model).
+            numbering_options = _near(options.numbering, numbering)
         names = channels[plane].names
         for pos, k in enumerate(candidates):
             mode = int(numbering.modes[pos])
@@ -155,11 +165,29 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     return out
 
 
-def _number(result: PeakResult, candidates, cable, attachments, tension, tension_model, options, plane) -> Numbering:
+def _number(result: PeakResult, candidates, cable, attachments, tension, tension_model, options,
+            plane) -> Numbering:
     f = np.array([result.peaks[k].frequency for k in candidates], float)
     u = np.array([result.peaks[k].uncertainty for k in candidates], float)
-    return number_modes(f, u, cable, attachments, tension, options=options.numbering, tension_model=tension_model,
+    return number_modes(f, u, cable, attachments, tension, options=options, tension_model=tension_model,
                         plane=plane)
+
+
+#: The second plane's family is searched within these factors of the first plane's fitted tension and
+#: bending-stiffness ratios (3 %: twice the spread of the two planes' fitted tensions on simulated bridge
+#: records... and about ten model tolerances; EI within 1.5 times, as it is poorly determined by few modes).
+NEAR_TENSION, NEAR_EI = 1.03, 1.5
+
+
+def _near(options, numbering: Numbering):
+    """``options`` (NumberingOptions) with the ranges narrowed around ``numbering``'s fitted ratios (within the
+    original ranges)."""
+    def around(value, factor, bounds):
+        low, high = max(value / factor, bounds[0]), min(value * factor, bounds[1])
+        return (low, high) if low < high else bounds
+
+    return replace(options, tension_range=around(numbering.tension_ratio, NEAR_TENSION, options.tension_range),
+                   EI_range=around(numbering.EI_ratio, NEAR_EI, options.EI_range))
 
 
 def _shapes(result, chans: PlaneChannels, candidates, numbering, cable, attachments, tension, tension_model,
