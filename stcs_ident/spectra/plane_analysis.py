@@ -174,8 +174,8 @@ def _number(result: PeakResult, candidates, cable, attachments, tension, tension
 
 
 #: The second plane's family is searched within these factors of the first plane's fitted tension and
-#: bending-stiffness ratios (3 %: twice the spread of the two planes' fitted tensions on simulated bridge
-#: records... and about ten model tolerances; EI within 1.5 times, as it is poorly determined by few modes).
+#: bending-stiffness ratios (3 %: ten model tolerances, since the planes' models differ only by what they
+#: model, sag and attachments; EI within 1.5 times, as a few modes determine it poorly).
 NEAR_TENSION, NEAR_EI = 1.03, 1.5
 
 
