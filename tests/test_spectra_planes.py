@@ -223,3 +223,34 @@ def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane():
         # The band: 68 ± 7 % within 1σ (the binomial spread of 400 pairs is ± 2.3 %), ≥ 98 % within 3σ.
         assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
         assert np.mean(a <= 3) >= 0.98, (plane, np.mean(a <= 3))
+
+
+def test_structural_frequencies_on_the_command_line():
+    import argparse
+
+    from stcs_ident.cli.spectra import _frequencies
+
+    assert _frequencies("1.23,2.5") == (1.23, 2.5)
+    for bad in ("1.2,x", "-1", "", "inf"):
+        with pytest.raises(argparse.ArgumentTypeError, match="frequencies in Hz"):
+            _frequencies(bad)
+
+
+def test_a_campaign_record_with_directions_is_analysed_per_plane(tmp_path):
+    from dataclasses import replace
+
+    from stcs_ident.io.records.hdf5 import write_record
+    from stcs_ident.spectra.pipeline import analyse_test
+
+    case = make_case("hanger", 8, layout="triaxial")
+    path = tmp_path / "rec.h5"
+    write_record(case.record, path)
+    test = replace(case.test, record=str(path))
+    campaign = replace(case.campaign, tests=(test,))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = analyse_test(campaign, test, plane_options=PlaneOptions(structural=(case.deck[1][0],)))
+    assert set(r.mode_planes) == {"in", "out"}  # the file's directions were read
+    assert all(n.kind != "directions" for n in r.notes)
+    assert r.plane_options.structural == (case.deck[1][0],)
+    assert r.summary()["plane_options"]["structural"] == [case.deck[1][0]]
