@@ -226,21 +226,21 @@ def _coverage(acceptance, layouts):
 @pytest.mark.slow
 def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
     """With an axial channel (the anchorage's motion seen alone): 68 ± 7 % within 1σ per plane. Measured on
-    these seeds: stay 63 / 68 %, hanger 65 / 65 % (in / out); within 3σ 96–98 % (the issue asks ≥ 98 %: the
-    deck modes within 2 % of a cable mode pull it through the support beyond the widened 1σ, see the
-    strict test below)."""
+    these seeds (in / out): 1σ 68.7 / 69.6 %, 3σ 97.6 / 99.2 % (stay 96.8 / 99.1, hanger 98.3 / 99.3); the
+    issue's 98 % within 3σ is the strict test's below."""
     for plane, a in _coverage(acceptance, ("triaxial",)).items():
         assert a.size >= 400
         # 68 ± 7 %: the issue's band (the binomial spread of 400 pairs is ± 2.3 %)
         assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
-        # 95 %: a guard below the 96–98 % measured (the issue's 98 % is the strict test's)
-        assert np.mean(a <= 3) >= 0.95, (plane, np.mean(a <= 3))
+        # 96 %: a guard below the 97.6 % measured for the in-plane modes, 1.6 % under the issue's 98 % (the
+        # strict test's)
+        assert np.mean(a <= 3) >= 0.96, (plane, np.mean(a <= 3))
 
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="not yet met: without an axial channel a deck mode within 2 % of a cable "
-                   "mode merges with it unseen (3σ coverage 91–93 %, 1σ 56–59 % on biaxial records), and a few "
-                   "merged peaks sit nearer the deck than the cable's mode (3 in 240 held-out records)")
+                   "mode merges with it unseen (biaxial: 3σ coverage 91–93 %, 1σ 55–60 %), and a merged peak "
+                   "can sit nearer the deck than the cable's mode (3 peaks in 2 of the 200 records)")
 def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane(acceptance):
     numbered_deck = [d for _, (_, dk) in acceptance.items() for d in dk]
     assert numbered_deck == []
