@@ -84,6 +84,16 @@ def test_harmonics_within_three_sigma():
     assert harmonic_of(12.0, 0.01, [(2.0, 0.0)], 5) is None  # order 6 beyond max_harmonic
 
 
+def test_a_record_of_axial_channels_only_is_refused():
+    case = make_case("hanger", 1, layout="triaxial")
+    record = case.record
+    axial = Record(acceleration=record.acceleration[:, -1:].copy(), sampling_rate=record.sampling_rate,
+                   channel_names=("ax1",), channel_positions=record.channel_positions[-1:],
+                   channel_directions=("axial",), source="rec.h5")
+    with pytest.raises(InputError, match=r"rec.h5: field 'channel_direction': every channel is axial"):
+        analyse_record(case.campaign, case.test, axial, "rec.h5")
+
+
 def test_plane_options_are_checked():
     with pytest.raises(InputError, match="planes.structural"):
         PlaneOptions(structural=(1.0, -2.0))

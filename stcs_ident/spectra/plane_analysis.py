@@ -24,6 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..core.errors import InputError
 from ..core.planes import PLANE_NAMES
 from ..core.record import Record
 from ..forward import natural_frequencies
@@ -71,6 +72,9 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
                    options: PickingOptions, plane_options: PlaneOptions) -> PlanesOutcome:
     """Peaks per plane, numbered per plane, structural ones set apart (the module's steps)."""
     channels, axial = plane_channels(record)
+    if not channels:
+        raise InputError("every channel is axial: the cable's transverse modes need an in-plane or out-of-plane "
+                         "channel", field="channel_direction", file=record.source)
     fs = record.sampling_rate
     peaks, nominal, axial_share = {}, {}, {}
     for plane in channels:
