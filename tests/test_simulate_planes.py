@@ -302,3 +302,29 @@ def test_two_hundred_ten_minute_biaxial_records_in_about_a_minute():
         elapsed = time.perf_counter() - start
     assert rec.n_samples == 30000
     assert elapsed < 90.0, f"{elapsed:.1f} s for 200 records"
+
+
+def test_command_line_makes_a_triaxial_campaign_with_a_deck_mode(tmp_path, capsys):
+    import json
+    from pathlib import Path
+
+    from stcs_ident.cli.main import main
+    from stcs_ident.io.records.hdf5 import read_record
+
+    han = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
+    out = tmp_path / "sim"
+    assert main(["simulate", str(han), "--out", str(out), "--test", "case1-L4", "--duration", "20", "--ambient", "2",
+                 "--sensors", "0.3,0.6", "--triaxial", "--deck-modes", "1.9:0.05", "--traffic", "60:0.02",
+                 "--misalignment", "3"]) == 0
+    record = read_record(out / "records" / "case1-L4.h5")
+    assert record.channel_directions == ("in", "out", "axial") * 2
+    assert record.channel_positions[0] == record.channel_positions[2] != record.channel_positions[3]
+    truth = json.loads((out / "truth.json").read_text())["tests"][0]
+    assert truth["structural_frequencies"] == [1.9] and truth["misalignment"] == [3.0] * 6
+    assert len(truth["frequencies_out"]) == len(truth["modes_out"]) > 0
+    # a bad value is one line naming the option
+    capsys.readouterr()
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--deck-modes", "1.9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--deck-modes" in err[0]
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--triaxial", "--directions", "in"]) == 2

@@ -137,7 +137,7 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
     truth = replace(sig_in.truth, out=None if sig_out is None else sig_out.truth,
                     structural=bridge.anchorage_motion,
-                    misalignment=None if bridge.misalignment is None else np.degrees(delta),
+                    misalignment=None if bridge.misalignment is None else bridge.misalignment_per_channel(n_ch),
                     channel_directions=directions, crossings=None if motion is None else motion.crossings)
     return Record(signal, fs, names, x, channel_directions=directions), truth
 
