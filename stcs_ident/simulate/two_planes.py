@@ -36,8 +36,19 @@ from ..core.record import Record
 from .anchorage import anchorage_motion, axial_response, transverse_response
 from .bridge import BridgeConditions
 from .conditions import FieldConditions, RecordTruth
+from .damped_modes import damped_modes
 from .disturbances import apply_sensor_disturbances, field_rng
-from .excitation import Ambient, Impulse, PlaneSignal, Progress, modal_basis, modal_damping, plane_model, plane_signal
+from .excitation import (
+    NYQUIST_FRACTION,
+    Ambient,
+    Impulse,
+    PlaneSignal,
+    Progress,
+    modal_basis,
+    modal_damping,
+    plane_model,
+    plane_signal,
+)
 
 __all__ = ["check_channel_directions", "planes_record"]
 
@@ -84,9 +95,6 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
                                     or n_modes < 1):
             raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
         modal_damping(damping, 1)  # its checks before any work
-        if bridge.moves_anchorages:
-            raise ModelError("moving anchorages are simulated for cables without dampers only (their complex "
-                             "modes' answer to a support motion is not modelled yet)", field="bridge.anchorage_motion")
 
     rng = np.random.default_rng(seed)
     own_rng = field_rng(rng) if field is not None else None
@@ -109,7 +117,7 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         sig_out = plane_signal(*model_out, tension, x, fs, n_samples, damping=damping,
                                impulses=_plane_impulses(impulses, "out"), ambient=ambient_out, n_modes=n_modes,
                                rng=out_rng, own_rng=out_field_rng, field=field)
-    elif not has_dampers(model_out[1]):  # no channel reads it: its modes only, for the truth and the anchorages
+    else:  # no channel reads it: its modes only, for the truth
         sig_out = _modes_only(model_out, tension, fs, n_samples, damping, n_modes)
 
     clean = np.zeros((n_samples, n_ch))
@@ -154,9 +162,13 @@ def _plane_impulses(impulses: Sequence[Impulse], plane: str) -> list[Impulse]:
 
 
 def _modes_only(model, tension: float, fs: float, n_samples: int, damping, n_modes) -> PlaneSignal:
-    """The out-of-plane modes of a cable without dampers (for the truth and the anchorages' answer) when no
-    channel reads that plane."""
+    """The out-of-plane modes (for the truth) when no channel reads that plane."""
     cable, atts = model
+    if has_dampers(atts):
+        modes = damped_modes(cable, atts, tension, fs, n_modes, lambda n: modal_damping(damping, n),
+                             NYQUIST_FRACTION)
+        return PlaneSignal(None, RecordTruth(modes.frequencies, tension, fs, n_samples, damping=modes.damping),
+                           complex_modes=modes)
     shapes = modal_basis(cable, atts, tension, fs, n_modes)
     zeta = modal_damping(damping, len(shapes.frequencies))
     return PlaneSignal(None, RecordTruth(np.asarray(shapes.frequencies, float), tension, fs, n_samples,
@@ -165,7 +177,8 @@ def _modes_only(model, tension: float, fs: float, n_samples: int, damping, n_mod
 
 def _anchorage_answer(motion, plane: str, sig: PlaneSignal, model, x, fs, n_samples) -> np.ndarray:
     cable, atts = model
-    return transverse_response(motion, plane, sig.shapes, sig.damping, atts, cable.length, cable.mass_per_length,
+    modes = sig.complex_modes if sig.complex_modes is not None else sig.shapes
+    return transverse_response(motion, plane, modes, sig.damping, atts, cable.length, cable.mass_per_length,
                                x, fs, n_samples)
 
 
