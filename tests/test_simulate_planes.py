@@ -356,3 +356,77 @@ def test_command_line_makes_a_triaxial_campaign_with_a_deck_mode(tmp_path, capsy
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--deck-modes" in err[0]
     assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--triaxial", "--directions", "in"]) == 2
+
+
+def test_blows_act_in_their_direction():
+    x = [61.0, 61.0]
+    kw = {"duration": 30.0, "sampling_rate": 20.0, "directions": ["in", "out"]}
+    out_blow = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0, "out")], **kw)
+    assert np.all(out_blow.acceleration[:, 0] == 0) and np.abs(out_blow.acceleration[:, 1]).max() > 0
+    in_blow = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0)], **kw)
+    assert np.all(in_blow.acceleration[:, 1] == 0)
+    tilted = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0, 30.0)], **kw)
+    # cos 30° of the blow in-plane and sin 30° out of plane: the model is linear (to round-off)
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    np.testing.assert_allclose(tilted.acceleration[:, 0], c * in_blow.acceleration[:, 0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(tilted.acceleration[:, 1], s * out_blow.acceleration[:, 1], rtol=1e-9, atol=1e-12)
+
+
+def test_out_of_plane_loading_scales_with_its_ratio():
+    x = [61.0, 61.0]
+    kw = {"duration": 30.0, "sampling_rate": 20.0, "directions": ["in", "out"], "ambient": Ambient(2.0), "seed": 4}
+    one = simulate_record(STAY, [], STAY_TENSION, x, **kw).acceleration
+    two = simulate_record(STAY, [], STAY_TENSION, x, bridge=BridgeConditions(out_of_plane_ratio=2.0), **kw).acceleration
+    none = simulate_record(STAY, [], STAY_TENSION, x, bridge=BridgeConditions(out_of_plane_ratio=0.0),
+                           **kw).acceleration
+    assert np.array_equal(one[:, 0], two[:, 0])  # the in-plane loading is its own
+    # the same draws at twice the rms (to the round-off of the covariances' square roots)
+    np.testing.assert_allclose(two[:, 1], 2 * one[:, 1], rtol=1e-8, atol=1e-12 * np.abs(one[:, 1]).max())
+    assert np.all(none[:, 1] == 0)
+    # and the out-of-plane pressure is independent of the in-plane one: their correlation is small
+    # (|r| of two independent series with ~60 effective samples (30 s / 0.5 s) is below 3/√60 = 0.4)
+    r = np.corrcoef(one[:, 0], one[:, 1])[0, 1]
+    assert abs(r) < 0.4
+
+
+def test_a_drift_moves_both_planes_alike():
+    from stcs_ident.simulate import FieldConditions, TensionDrift
+
+    field = FieldConditions(drift=TensionDrift(amplitude=2e-3, period=20.0, walk=1e-4))
+    _, truth = simulate_record_with_truth(STAY, [], STAY_TENSION, [61.0, 61.0], directions=["in", "out"],
+                                          duration=30.0, sampling_rate=20.0, ambient=Ambient(2.0), field=field)
+    assert truth.out.drifts and np.array_equal(truth.out.relative_tension, truth.relative_tension)
+    # each plane's modes follow it with their own sensitivities (mode 1 in-plane is stiffened by the sag,
+    # whose share falls as the tension rises: its sensitivity differs from the out-of-plane string's 1/2)
+    assert truth.out.sensitivities[0] == pytest.approx(0.5, abs=0.01)  # a string's, to the bending's 1 %
+    assert abs(truth.sensitivities[0] - truth.out.sensitivities[0]) > 0.01
+
+
+def test_misaligned_axial_channel_reads_in_plane_motion():
+    delta = 5.0
+    rec = simulate_record(STAY, [], STAY_TENSION, [61.0, 61.0], directions=["in", "axial"],
+                          bridge=BridgeConditions(misalignment=(0.0, delta)), duration=30.0, sampling_rate=20.0,
+                          ambient=Ambient(2.0))
+    # no anchorage motion: the axial channel is sin δ of the in-plane motion alone (exactly, to round-off)
+    np.testing.assert_allclose(rec.acceleration[:, 1], math.sin(math.radians(delta)) * rec.acceleration[:, 0],
+                               rtol=1e-12, atol=1e-15)
+
+
+def test_structural_motion_has_its_rms_and_its_harmonics():
+    from stcs_ident.simulate.anchorage import anchorage_motion
+
+    fs, n = 20.0, 200_000
+    mode = StructuralMode(1.0, 0.03, damping=0.05, end="A", direction=(0.0, 0.0, 1.0), harmonics=(0.5,))
+    motion = anchorage_motion(BridgeConditions(anchorage_motion=[mode]), n, fs, np.random.default_rng(1))
+    assert set(motion.acceleration) == {"A"}
+    axial = motion.component("A", "axial")
+    assert not np.any(motion.component("A", "in"))
+    # rms² = fundamental² + harmonic² = (1 + 0.5²) A²: the harmonic r·A(t)cos 2θ has the fundamental's rms.
+    # Its envelope's time constant 1/(ζω) = 3.2 s gives ~1500 independent variance estimates in 10000 s:
+    # ±2.6 % (1σ) on the variance; 10 % is ~4σ
+    assert np.mean(axial**2) == pytest.approx(1.25 * mode.amplitude**2, rel=0.1)
+    f, p = welch(axial, fs, nperseg=4096)
+    peaks = f[np.argsort(p)[::-1]]
+    assert abs(peaks[0] - 1.0) < 0.02  # the fundamental, within its band (ζ f = 0.05 Hz half-width)
+    near_2 = (f > 1.8) & (f < 2.2)
+    assert abs(f[near_2][np.argmax(p[near_2])] - 2.0) < 0.1  # the 2nd harmonic, twice the band's width

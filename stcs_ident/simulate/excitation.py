@@ -87,7 +87,11 @@ class Impulse:
         if self.direction == "out":
             return self.magnitude if plane == "out" else 0.0
         angle = direction_angle(self.direction)
-        return self.magnitude * (math.cos(angle) if plane == "in" else math.sin(angle))
+        if self.direction % 90.0 == 0.0:  # ±180°, -90°: exact, as "in" and "out" are
+            c, s = round(math.cos(angle)), round(math.sin(angle))
+        else:
+            c, s = math.cos(angle), math.sin(angle)
+        return self.magnitude * (c if plane == "in" else s)
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable, has_dampers
-from ..core.planes import check_direction, direction_angle
+from ..core.planes import check_direction
 from ..core.record import Record
 from .anchorage import anchorage_motion, axial_response, transverse_response
 from .bridge import BridgeConditions
@@ -84,12 +84,14 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         raise ModelError(f"must be a BridgeConditions or None, got {type(bridge).__name__}", field="bridge")
     n_ch = len(x)
     stated = directions if directions is not None else ("in",) * n_ch
-    delta = np.radians(bridge.misalignment_per_channel(n_ch))
-    angles = [direction_angle(d) for d in stated]  # None: axial
-    true = [None if a is None else a + float(dl) for a, dl in zip(angles, delta)]
-    reads_in = [a is not None and math.cos(a) != 0.0 or a is None and dl != 0.0 for a, dl in zip(true, delta)]
-    reads_out = [a is not None and math.sin(a) != 0.0 for a in true]
-    axial = [a is None for a in true]
+    delta_deg = bridge.misalignment_per_channel(n_ch)
+    delta = np.radians(delta_deg)
+    # each transverse channel's true axis as (cos, sin) from in-plane; exact at multiples of 90° (an "out"
+    # channel reads nothing of the in-plane motion, not cos(π/2) = 6e-17 of it)
+    axes = [None if d == "axial" else _cos_sin(_degrees(d) + float(dl)) for d, dl in zip(stated, delta_deg)]
+    axial = [a is None for a in axes]
+    reads_in = [a[0] != 0.0 if a is not None else dl != 0.0 for a, dl in zip(axes, delta)]
+    reads_out = [a is not None and a[1] != 0.0 for a in axes]
     if has_dampers(attachments):
         if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
                                     or n_modes < 1):
@@ -136,10 +138,10 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
             if reads_in[c]:
                 clean[:, c] += math.sin(delta[c]) * transverse_in[:, c]
             continue
-        a = true[c]
-        clean[:, c] = math.cos(a) * transverse_in[:, c] if reads_in[c] else 0.0
+        cos_a, sin_a = axes[c]
+        clean[:, c] = cos_a * transverse_in[:, c] if reads_in[c] else 0.0
         if reads_out[c]:
-            clean[:, c] += math.sin(a) * transverse_out[:, c]
+            clean[:, c] += sin_a * transverse_out[:, c]
     signal = _noisy(clean, snr_db, rng, axial)
     if field is not None:
         signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
@@ -148,6 +150,19 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
                     misalignment=None if bridge.misalignment is None else bridge.misalignment_per_channel(n_ch),
                     channel_directions=directions, crossings=None if motion is None else motion.crossings)
     return Record(signal, fs, names, x, channel_directions=directions), truth
+
+
+def _degrees(direction) -> float:
+    """A transverse direction in degrees from in-plane."""
+    return {"in": 0.0, "out": 90.0}.get(direction, direction) if isinstance(direction, str) else float(direction)
+
+
+def _cos_sin(degrees: float) -> tuple[float, float]:
+    """(cos, sin) of an angle in degrees, exact at multiples of 90°."""
+    quarter, rest = divmod(degrees, 90.0)
+    if rest == 0.0:
+        return ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[int(quarter) % 4]
+    return math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
 
 
 def _plane_impulses(impulses: Sequence[Impulse], plane: str) -> list[Impulse]:
