@@ -58,6 +58,7 @@ __all__ = ["AnchorageMotion", "anchorage_motion", "axial_response", "chord_weigh
 
 #: Components of a motion, in the order of StructuralMode.direction.
 COMPONENTS = ("in", "out", "axial")
+_FREQUENCY_BLOCK = 2048  # frequency bins per block of the modal gains (bounds memory to BLOCK × n_modes)
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,11 +138,19 @@ def transverse_response(motion: AnchorageMotion, plane: str, shapes: ModeShapes 
 
 def _modal_gain(shapes: ModeShapes, damping: np.ndarray, end: str, masses, length: float, mass_per_length: float,
                 x: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Σ_k φ_k(x) Γ_k ω² / (ω_k² − ω² + 2iζ_kω_kω), (n_f, n_ch)."""
+    """Σ_k φ_k(x) Γ_k ω² / (ω_k² − ω² + 2iζ_kω_kω), (n_f, n_ch): in real arithmetic, a block of frequencies
+    at a time (the (n_f, n_modes) complex gains of a long record at a high rate would be hundreds of MB)."""
     wk = 2 * math.pi * np.asarray(shapes.frequencies, float)
-    gain = omega[:, None] ** 2 / (wk**2 - omega[:, None] ** 2 + 2j * damping * wk * omega[:, None])
-    gamma = _participation(shapes, end, masses, length, mass_per_length)
-    return gain @ (gamma[:, None] * shapes(x).T)
+    read = _participation(shapes, end, masses, length, mass_per_length)[:, None] * shapes(x).T  # (N, n_ch)
+    out = np.empty((len(omega), len(x)), dtype=complex)
+    for start in range(0, len(omega), _FREQUENCY_BLOCK):
+        w = omega[start:start + _FREQUENCY_BLOCK, None]
+        real = wk**2 - w**2
+        imag = 2 * damping * wk * w
+        scale = w**2 / (real**2 + imag**2)
+        out[start:start + len(w)].real = (scale * real) @ read
+        out[start:start + len(w)].imag = -(scale * imag) @ read
+    return out
 
 
 def _complex_modal_gain(modes: DampedModes, end: str, masses, length: float, mass_per_length: float,
@@ -161,7 +170,11 @@ def _complex_modal_gain(modes: DampedModes, end: str, masses, length: float, mas
     def g(w):
         return -(1j * w[:, None] / (1j * w[:, None] - s[None, :])) @ read.T
 
-    return 0.5 * (g(omega) + np.conj(g(-omega)))
+    out = np.empty((len(omega), len(x)), dtype=complex)
+    for start in range(0, len(omega), _FREQUENCY_BLOCK):
+        w = omega[start:start + _FREQUENCY_BLOCK]
+        out[start:start + len(w)] = 0.5 * (g(w) + np.conj(g(-w)))
+    return out
 
 
 def axial_response(motion: AnchorageMotion, x: np.ndarray, length: float, n_samples: int) -> np.ndarray:
