@@ -381,6 +381,9 @@ def test_command_line_makes_a_triaxial_campaign_with_a_deck_mode(tmp_path, capsy
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--deck-modes" in err[0]
     assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--triaxial", "--directions", "in"]) == 2
+    capsys.readouterr()
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--traffic", "60"]) == 2  # nothing to swell
+    assert "--deck-modes" in capsys.readouterr().err
 
 
 def test_blows_act_in_their_direction():

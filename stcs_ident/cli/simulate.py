@@ -178,6 +178,8 @@ def _bridge(args, campaign):
         flag = "--traffic"
         if args.traffic is not None:
             parts["traffic"] = traffic(args.traffic)
+            if not parts.get("anchorage_motion") and parts["traffic"].broadband == 0:
+                raise ValueError("swells the deck motion: give --deck-modes too, or a broadband level (RATE:B)")
         return BridgeConditions(**parts) if parts else None
     except (ValueError, ModelError) as err:
         raise InputError(" ".join(str(getattr(err, "message", err)).split()), field=flag) from None
