@@ -43,7 +43,8 @@ ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archi
 #: The commands, in the order ``--help`` lists them.
 COMMANDS: dict[str, Command] = {
     "forward": Command("stcs_ident.cli.forward", "nominal model against measured and published frequencies",
-                       ("stcs-ident forward campaigns/han2020 --test case1-L4 --modes 8",)),
+                       ("stcs-ident forward campaigns/han2020 --test case1-L4 --modes 8",
+                        "stcs-ident forward campaigns/han2020 --test case1-L4 --plane both --json forward.json")),
     "spectra": Command("stcs_ident.cli.spectra", "numbered modal frequencies picked from the acceleration records",
                        ("stcs-ident spectra campaigns/hanger-hidden-mass --json picked.json --plot spectra/",)),
     "simulate": Command("stcs_ident.cli.simulate",

@@ -32,6 +32,9 @@ def add_parser(sub) -> None:
     add_campaign_argument(parser)
     parser.add_argument("--modes", type=_mode_count, metavar="N", help="modes to compute (default: measured, at least 6)")
     add_tension_model_option(parser)
+    parser.add_argument("--plane", choices=("in", "out", "both"), default=None,
+                        help="families of modes: in-plane, out-of-plane or both (default: both when a test has "
+                             "out-of-plane frequencies, else in)")
     add_json_option(parser)
 
 
@@ -41,8 +44,8 @@ def run(args: argparse.Namespace) -> int:
     from ..report.forward import forward_text, to_json
 
     campaign, file, tests = prepare(args)
-    picked = {r.name: (r.modes, r.frequencies) for r in picked_spectra(campaign, tests, file)}
-    result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked)
+    picked = {r.name: (r.modes, r.frequencies, r.mode_planes) for r in picked_spectra(campaign, tests, file)}
+    result = compare_forward(campaign, tests, args.modes, args.tension_model, picked=picked, plane=args.plane)
     text = forward_text(result)
     if args.json:
         write_output(args.json, to_json(result.summary()))
@@ -56,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
 
 def plausibility_warning(campaign, tests, picked, tension_model: str) -> str | None:
     """What ``identify`` and ``diagnose`` would refuse the campaign for (a unit slip, most likely), or None:
-    ``forward`` only says it."""
+    ``forward`` only says it. ``picked``: {test: (modes, frequencies, planes)}; the in-plane frequencies are
+    assessed."""
     import numpy as np
 
     from ..identify.plausibility import assess
@@ -66,7 +70,10 @@ def plausibility_warning(campaign, tests, picked, tension_model: str) -> str | N
     for t in campaign.tests:
         if tests and t.name not in tests:
             continue
-        modes, freqs = picked.get(t.name, (t.modes, t.frequencies))
+        modes, freqs, planes = picked.get(t.name, (t.modes, t.frequencies, t.planes))
+        if freqs is not None and planes is not None:  # the in-plane ones: what identify checks
+            kept = [i for i, p in enumerate(planes) if p == "in"]
+            modes, freqs = [modes[i] for i in kept], [freqs[i] for i in kept]
         if freqs is not None and len(freqs):
             measurements.append(Measurement(t, np.asarray(modes, int), np.asarray(freqs, float),
                                             np.ones(len(freqs)), "measured"))

@@ -88,6 +88,16 @@ def direction_text(direction: str | float) -> str:
     return direction if isinstance(direction, str) else f"{direction:g}"
 
 
+#: What results say of a record whose channels have no direction, neither from its file nor from the campaign.
+NO_DIRECTIONS_NOTE = "no channel directions given: every channel read as in-plane"
+
+
+def directions_note(record) -> str | None:
+    """The note for ``record``'s channel directions: :data:`NO_DIRECTIONS_NOTE` when neither its file nor the
+    campaign gave any (``channel_directions`` is None, every channel read as in-plane), else None."""
+    return NO_DIRECTIONS_NOTE if getattr(record, "channel_directions", None) is None else None
+
+
 def plane_share(attachment, plane: str) -> float:
     """The share of an attachment's spring, dashpot and moving mass that acts in ``plane``: cos²α in-plane and
     sin²α out-of-plane for a damper at ``angle`` α; 1 for an attachment's mass (its spring: :func:`plane_view`)."""

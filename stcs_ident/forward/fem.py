@@ -14,6 +14,12 @@ into a left and a right unknown there (the elements stay C1 inside a
 segment, where the exact shape is smooth); a string carries no moment,
 so the rotational end restraints are ignored.
 
+Both planes of transverse motion (``plane="in"`` or ``"out"``): out of
+the cable's plane there is no sag-extensibility term, a spring acts with
+its ``stiffness_out`` and a damper with sin²α of its values (cos²α in
+plane); the attachments are mapped by
+:func:`~stcs_ident.core.planes.plane_view`, the matrices built here.
+
 The mesh and dof numbering are in :mod:`~stcs_ident.forward.fem_mesh`, the
 matrices in :mod:`~stcs_ident.forward.fem_assembly` (:func:`fe_matrices`);
 this module solves the eigenproblem and gives frequencies and mode shapes.
@@ -98,17 +104,19 @@ def fe_frequencies(
     tension_model: str = "uniform",
     solver: str = "dense",
     grading: float = 0.0,
+    plane: str = "in",
 ) -> np.ndarray:
     """First natural frequencies of the finite-element model, Hz, ascending.
 
-    Parameters are those of :func:`fe_matrices` and :func:`fe_eigen`.
+    Parameters are those of :func:`fe_matrices` and :func:`fe_eigen`
+    (``plane``: ``"in"``, the default, or ``"out"``).
 
     Returns
     -------
     numpy.ndarray
         Shape (n_modes,).
     """
-    model = fe_matrices(cable, attachments, tension, n_elements, tension_model, grading)
+    model = fe_matrices(cable, attachments, tension, n_elements, tension_model, grading, plane)
     lam, _ = fe_eigen(model, n_modes, solver)
     return _to_hz(lam)
 
@@ -122,10 +130,12 @@ def fe_modes(
     tension_model: str = "uniform",
     solver: str = "dense",
     grading: float = 0.0,
+    plane: str = "in",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Natural frequencies and mode shapes of the finite-element model.
 
-    Parameters are those of :func:`fe_matrices` and :func:`fe_eigen`.
+    Parameters are those of :func:`fe_matrices` and :func:`fe_eigen`
+    (``plane``: ``"in"``, the default, or ``"out"``).
 
     Returns
     -------
@@ -142,7 +152,7 @@ def fe_modes(
         (n_dof, n_modes) (displacements and rotations, see
         ``FEModel.disp_index``).
     """
-    model = fe_matrices(cable, attachments, tension, n_elements, tension_model, grading)
+    model = fe_matrices(cable, attachments, tension, n_elements, tension_model, grading, plane)
     lam, vecs = fe_eigen(model, n_modes, solver, vectors=True)
     return _to_hz(lam), model.node_x.copy(), model.nodal_displacements(vecs), vecs
 

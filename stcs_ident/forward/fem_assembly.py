@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..core.model import Attachment, Cable
+from ..core.planes import plane_view
 from .fem_mesh import Dofs, check_inputs, element_density, merge_attachments, mesh_nodes, number_dofs
 
 __all__ = ["FEModel", "fe_matrices", "upper_banded"]
@@ -139,6 +140,7 @@ def fe_matrices(
     n_elements: int = 200,
     tension_model: str = "uniform",
     grading: float = 0.0,
+    plane: str | None = None,
 ) -> FEModel:
     """Assemble the finite-element model of a cable configuration.
 
@@ -165,11 +167,21 @@ def fe_matrices(
         ``1 + grading`` and grow smoothly into the span. 0 (default) keeps
         the elements of a segment equal. ``grading=2`` lowers the error of
         the low modes of a clamped strand about tenfold at equal size.
+    plane : {"in", "out"} or None
+        The plane of the transverse motion. ``"out"``: the cable without
+        the sag-extensibility term (it is driven by the in-plane motion
+        only), springs at their ``stiffness_out`` and dampers' springs and
+        moving masses times sin²α of their angle; ``"in"``: dampers' values
+        times cos²α (:func:`~stcs_ident.core.planes.plane_view`, the table
+        of which value acts in which plane). None (default): the cable and
+        attachments as given.
 
     Returns
     -------
     FEModel
     """
+    if plane is not None:
+        cable, attachments = plane_view(cable, attachments, plane)
     tension = check_inputs(cable, tension, n_elements, tension_model, grading)
     atts = merge_attachments(cable, attachments)
     breaks = np.concatenate(([0.0], atts[:, 0], [cable.length]))

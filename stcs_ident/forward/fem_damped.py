@@ -4,7 +4,9 @@ The cable's finite-element model (:mod:`.fem_assembly`: Hermite beam elements, p
 the rank-one sag-extensibility term EA/L_e g gᵀ) gets a node at each damper; the damper's spring and
 moving mass join K and M there as an attachment's, its dashpot is the only entry of C, on the node's
 displacement. This is the independent reference of the exact solver (:mod:`.damped`): the same physics,
-another discretisation.
+another discretisation. ``plane="out"`` gives the out-of-plane modes (no sag-extensibility term, springs at
+``stiffness_out``, each damper with sin²α of its values; in-plane cos²α), the attachments mapped by
+:func:`~stcs_ident.core.planes.plane_view` and the matrices built here.
 
 How it is solved, and why so
 ----------------------------
@@ -47,6 +49,7 @@ import scipy.sparse.linalg as spla
 
 from ..core.errors import ComputationError, ModelError
 from ..core.model import Attachment, Cable, Damper
+from ..core.planes import plane_view
 from .damped import ComplexModes
 from .fem_assembly import FEModel, fe_matrices
 
@@ -59,7 +62,8 @@ _MATCH_RTOL = 1e-5
 
 
 def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: float, n_modes: int,
-                     n_elements: int = 200, tension_model: str = "uniform", grading: float = 0.0) -> ComplexModes:
+                     n_elements: int = 200, tension_model: str = "uniform", grading: float = 0.0,
+                     plane: str = "in") -> ComplexModes:
     """The lowest ``n_modes`` complex modes of the cable with its attachments and dampers (finite elements).
 
     Parameters
@@ -74,6 +78,10 @@ def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: f
     n_elements, tension_model, grading :
         As :func:`~stcs_ident.forward.fem_assembly.fe_matrices` (``grading`` refines the boundary layers
         of a taut beam at restrained ends).
+    plane : {"in", "out"}
+        The plane of the motion: a damper at angle α acts with cos²α of its dashpot, spring and moving mass
+        in-plane and sin²α out-of-plane; out-of-plane, no sag-extensibility term and springs at their
+        ``stiffness_out`` (:func:`~stcs_ident.core.planes.plane_view`).
 
     Returns
     -------
@@ -92,6 +100,7 @@ def fe_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension: f
         if isinstance(d, Damper) and not 0 < d.position < cable.length:
             raise ModelError(f"position {d.position} m is outside the span (0, {cable.length}) m",
                              field=f"damper[{d.name}].position")
+    cable, attachments = plane_view(cable, attachments, plane)
     plain = [Attachment(a.name, a.position, a.mass, a.stiffness) if isinstance(a, Damper) else a
              for a in attachments]
     model = fe_matrices(cable, plain, tension, n_elements, tension_model, grading)

@@ -65,8 +65,9 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
 
 
 def _record_format_table(options: tuple[tuple[str, Any], ...]) -> dict[str, Any]:
-    """Reader options as TOML values: rows as a list, numbers as they were read (floats)."""
-    return {key: list(value) if isinstance(value, tuple) else value for key, value in options}
+    """Reader options as TOML values: rows as a list, ``axes`` as a table, numbers as they were read (floats)."""
+    return {key: dict(value) if key == "axes" else list(value) if isinstance(value, tuple) else value
+            for key, value in options}
 
 
 def _cable_table(cable: Cable) -> dict[str, Any]:
@@ -122,11 +123,15 @@ def _test_table(test: Test) -> dict[str, Any]:
 
 
 def _channels_table(channels, directions) -> dict[str, Any]:
-    """``name = position``, or ``name = {position, direction}`` where a direction is given."""
+    """``name = position``; with a direction given, every channel as ``{position, direction}`` (a table each:
+    the writer puts plain values before tables, and the table's order is the column order of a file without
+    channel names)."""
     given = dict(directions)
-    return {name: float(position) if name not in given else
-            {"position": float(position), "direction": given[name] if isinstance(given[name], str) else
-             float(given[name])} for name, position in channels}
+    if not given:
+        return {name: float(position) for name, position in channels}
+    return {name: {"position": float(position)} | ({} if name not in given else {
+        "direction": given[name] if isinstance(given[name], str) else float(given[name])})
+        for name, position in channels}
 
 
 def _published_table(item: Published) -> dict[str, Any]:

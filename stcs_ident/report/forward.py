@@ -13,6 +13,7 @@ import os
 
 from ..core.files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
 from ..core.formatting import number, rms
+from ..core.planes import PLANE_NAMES
 from ..forward.compare import ForwardResult
 
 
@@ -21,10 +22,13 @@ def _fmt(value, digits=3, width=9) -> str:
 
 
 def forward_text(result: ForwardResult) -> str:
-    """The ``forward`` tables: per test, measured and every model with errors in %."""
+    """The ``forward`` tables: per test (and plane, when out-of-plane modes are asked for), measured and every
+    model with errors in %."""
     lines = [f"Campaign {result.campaign}: nominal model (tension model '{result.tension_model}')", ""]
-    for t in result.tests:
-        lines.append(f"Test {t.name} (setup {t.setup}, tension {t.tension / 1e3:.1f} kN)")
+    only_in = tuple(getattr(result, "planes", ("in",))) == ("in",)
+    for t in getattr(result, "comparisons", result.tests):
+        plane = "" if only_in else f", {PLANE_NAMES[t.plane]}"
+        lines.append(f"Test {t.name} (setup {t.setup}, tension {t.tension / 1e3:.1f} kN){plane}")
         head = f"{'mode':>4} {'measured':>9} {'string':>9} {'err%':>7} {'beam':>9} {'err%':>7} {'DSM':>9} {'err%':>7}"
         refs = list(t.reference)
         widths = {label: max(len(label), 9) for label in refs}

@@ -34,7 +34,8 @@ __all__ = ["CableSpec", "cable_names", "content_id", "discover", "record_paths"]
 class CableSpec:
     """One cable of an archive: its campaign, the setup its records are of, the reference tension, the
     channel positions (m from end A) of records whose files give none (the campaign's top-level ``channels``,
-    else its first test's) and the reader options (``record_format``, the first test's over the campaign's)."""
+    else its first test's), the reader options (``record_format``, the first test's over the campaign's) and the
+    channel directions of the same channel table (they replace a file's)."""
 
     name: str
     directory: str
@@ -43,6 +44,7 @@ class CableSpec:
     reference_tension: float
     channels: tuple[tuple[str, float], ...] = ()
     record_format: tuple[tuple[str, Any], ...] = ()
+    directions: tuple[tuple[str, Any], ...] = ()
     #: What shaped the cable's rows (set by the run): its rows of another version are stale.
     version: str = ""
 
@@ -70,7 +72,8 @@ def _cable(directory: Path) -> CableSpec:
     test = campaign.tests[0]
     positions, options = campaign.record_reading(test)
     return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension),
-                     tuple((positions or {}).items()), tuple(options.items()))
+                     tuple((positions or {}).items()), tuple(options.items()),
+                     tuple((campaign.record_directions(test) or {}).items()))
 
 
 def record_paths(spec: CableSpec) -> list[Path]:

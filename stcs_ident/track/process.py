@@ -45,14 +45,16 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
            "temperature": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
            "frequencies": [], "frequency_sigma": [], "tension": math.nan, "tension_sigma": math.nan}
     try:
-        record = read_record(path, positions=dict(spec.channels) or None, **dict(spec.record_format))
+        record = read_record(path, positions=dict(spec.channels) or None, directions=dict(spec.directions) or None,
+                             **dict(spec.record_format))
         row["start_time"] = record.start_time
         row["temperature"] = math.nan if record.temperature is None else float(record.temperature)
         if record.start_time is None:
             raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
         # The record as a test of the cable's campaign: its setup, the reference tension, its path in the campaign.
         test = Test(name=relative, setup=spec.setup, tension=spec.reference_tension, record=relative,
-                    channels=spec.channels, record_format=spec.record_format)
+                    channels=spec.channels, record_format=spec.record_format,
+                    channel_directions=spec.directions)
         campaign = replace(spec.campaign, tests=(test,))
         spectra = analyse_record(campaign, test, record, path, max_modes=MAX_MODES)
         if not spectra.modes:

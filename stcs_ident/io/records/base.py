@@ -167,10 +167,12 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
     directions : mapping of str to direction, optional
         By channel name, ``"in"``, ``"out"``, ``"axial"`` or degrees (the campaign's channel table); they
         replace the file's (and ``replaced`` says where they differ); a channel named in neither is in-plane.
+        With neither the file's nor these, the record's ``channel_directions`` is None (every channel read as
+        in-plane; :func:`~stcs_ident.core.planes.directions_note` says so).
     **options
         Reader options (:data:`~stcs_ident.io.records.options.OPTIONS`: ``unit``, ``sampling_rate``,
         ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``start_time``, ``temperature``,
-        ``variable``, ``group``), a campaign's ``record_format``; None values are ignored. Each reader takes
+        ``variable``, ``group``, ``axes``), a campaign's ``record_format``; None values are ignored. Each reader takes
         those of its format; ``start_time`` and ``temperature`` replace the file's in every format, and the
         record's ``replaced`` lists where a given value differs from the file's.
 

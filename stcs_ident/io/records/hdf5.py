@@ -6,7 +6,19 @@ The layout is the one of the interface contract: root attributes
 datasets ``/acceleration`` (n_samples, n_channels), ``/channel_name``,
 ``/channel_position`` (m from end A) and optional ``/channel_direction``
 (``in``, ``out``, ``axial`` or an angle in degrees, as text; without it
-every channel is in-plane). The checks every record source shares
+every channel is in-plane).
+
+The channel directions may also be given as an attribute ``channel_direction``
+(an array of strings, one per channel), on the root or on ``/acceleration``,
+as some writers keep per-channel metadata in attributes. Where several are
+given, the dataset wins, then the root attribute, then the one on
+``/acceleration``: the first found is read and the others are not (the writer
+writes the dataset only). A direction may also be an axis of the sensor
+(``X``, ``Y``, ``Z``), placed on the cable by the reader option ``axes``
+(:mod:`~stcs_ident.io.records.directions`). A wrong count or an unknown text
+is refused naming the file and ``channel_direction``.
+
+The checks every record source shares
 (and their errors) are in :mod:`~stcs_ident.io.records.validation`; dead and
 clipped channels are dropped as :mod:`~stcs_ident.io.records.screening` says.
 A file that is missing, unreadable or not HDF5 raises an
@@ -27,6 +39,7 @@ from ...core.files import atomic_path
 from ...core.planes import direction_text
 from ...core.record import Record
 from .base import RecordReader, file_head
+from .directions import file_directions
 from .validation import one_line, overridden, validated_record
 
 __all__ = ["FORMAT", "READER", "VERSION", "Hdf5Reader", "read_record", "write_record"]
@@ -51,17 +64,21 @@ class Hdf5Reader(RecordReader):
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
         """:func:`read_record`; ``positions`` is not used (the file gives every channel's); of the options,
-        ``unit`` and ``sampling_rate`` replace the file's (the others do not apply)."""
-        return read_record(path, unit=options.get("unit"), sampling_rate=options.get("sampling_rate"))
+        ``unit`` and ``sampling_rate`` replace the file's, ``axes`` places axis labels of its directions (the
+        others do not apply)."""
+        return read_record(path, unit=options.get("unit"), sampling_rate=options.get("sampling_rate"),
+                           axes=options.get("axes"))
 
 
 READER = Hdf5Reader()
 
 
-def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_rate: float | None = None) -> Record:
+def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_rate: float | None = None,
+                axes: Any = None) -> Record:
     """Read an acceleration record from its HDF5 file (the contract's layout).
 
-    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``replaced`` says so).
+    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``replaced`` says so);
+    ``axes`` places channel directions given as axes X, Y, Z on the cable (the reader option).
 
     Returns
     -------
@@ -76,14 +93,14 @@ def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_ra
     """
     file = str(path)
     try:
-        return _read(file, {"unit": unit, "sampling_rate": sampling_rate})
+        return _read(file, {"unit": unit, "sampling_rate": sampling_rate}, axes)
     except InputError:
         raise
     except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # h5py on a corrupt file
         raise InputError(f"cannot read the record (a corrupt HDF5 file?): {one_line(err)}", file=file) from None
 
 
-def _read(file: str, options: dict[str, Any]) -> Record:
+def _read(file: str, options: dict[str, Any], axes: Any = None) -> Record:
     with _open_hdf5(file) as h5:
         if (fmt := _attr(h5.attrs, "format", str, file)) != FORMAT:
             raise InputError(f"is {fmt!r}, expected {FORMAT!r}", field="format", file=file)
@@ -101,9 +118,15 @@ def _read(file: str, options: dict[str, Any]) -> Record:
         acceleration = _read_dataset(h5, "acceleration", file)
         names = _read_dataset(h5, "channel_name", file)
         positions = _read_dataset(h5, "channel_position", file)
-        directions = _read_dataset(h5, "channel_direction", file) if "channel_direction" in h5 else None
+        directions = _directions(h5, file)
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
+    if directions is not None and acceleration.ndim == 2:  # (another shape is refused as every record's)
+        if directions.size != acceleration.shape[1]:
+            raise InputError(f"must have {acceleration.shape[1]} entries, one per channel, got {directions.size}",
+                             field="channel_direction", file=file)
+        directions = file_directions(list(directions), [str(n) for n in np.ravel(names)], axes=axes, file=file,
+                                     field="channel_direction")
     return validated_record(acceleration, sampling_rate, names, positions, unit=unit, start_time=start_time,
                             source=file, temperature=temperature, replaced=replaced, directions=directions)
 
@@ -128,6 +151,24 @@ def write_record(record: Record, path: str | os.PathLike, *, float32: bool = Fal
         if record.channel_directions is not None:
             h5.create_dataset("channel_direction", data=[direction_text(d) for d in record.channel_directions],
                               dtype=h5py.string_dtype())
+
+
+def _directions(h5: h5py.File, file: str) -> np.ndarray | None:
+    """The channel directions as given (text or numbers): the dataset, else the attribute ``channel_direction``
+    of the root, else that of ``/acceleration``; None if none is given."""
+    if "channel_direction" in h5:
+        return np.asarray(_read_dataset(h5, "channel_direction", file), dtype=object).reshape(-1)
+    for node in (h5, h5.get("acceleration")):
+        attrs = getattr(node, "attrs", None)
+        if attrs is not None and "channel_direction" in attrs:
+            try:
+                value = np.asarray(attrs["channel_direction"], dtype=object).reshape(-1)
+            except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:
+                raise InputError(f"cannot read the attribute: {one_line(err)}", field="channel_direction",
+                                 file=file) from None
+            return np.asarray([v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in value],
+                              dtype=object)
+    return None
 
 
 def _open_hdf5(file: str) -> h5py.File:

@@ -9,7 +9,12 @@ the file's only matrix. Beside it the file may hold:
 - ``channel_names``: a cell array of strings (or a char matrix), one per
   column; without it the campaign's channel table names the columns in order;
 - ``unit`` (a string; the ``unit`` option replaces it; default m/s²),
-  ``start_time`` (ISO 8601 string) and ``temperature`` (°C, one number).
+  ``start_time`` (ISO 8601 string) and ``temperature`` (°C, one number);
+- ``channel_directions``: a cell array of strings, one per column: ``in``,
+  ``out``, ``axial``, an angle in degrees, or an axis of the sensor (``X``,
+  ``+Y``) that the reader option ``axes`` places on the cable
+  (:mod:`~stcs_ident.io.records.directions`); without it the campaign's
+  channel table gives the directions, else every channel is in-plane.
 
 A v7.3 file is HDF5 behind a 512-byte MATLAB header; MATLAB stores its
 arrays column-major, so a matrix is read transposed back to MATLAB's shape.
@@ -29,6 +34,7 @@ import scipy.io
 from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader, file_head
+from .directions import file_directions
 from .validation import names_from_positions, one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "MatlabReader", "record_from_mat"]
@@ -36,7 +42,7 @@ __all__ = ["READER", "MatlabReader", "record_from_mat"]
 #: Names the sampling rate goes by in the files of data loggers, in the order they are looked for.
 RATE_NAMES = ("fs", "Fs", "FS", "sampling_rate")
 #: Variables of the file that are not the record's matrix.
-_METADATA = (*RATE_NAMES, "channel_names", "unit", "start_time", "temperature")
+_METADATA = (*RATE_NAMES, "channel_names", "channel_directions", "unit", "start_time", "temperature")
 
 
 class MatlabReader(RecordReader):
@@ -49,9 +55,10 @@ class MatlabReader(RecordReader):
         return file_head(path, 128).startswith(b"MATLAB")
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_mat` with the options ``variable``, ``sampling_rate`` and ``unit``."""
+        """:func:`record_from_mat` with the options ``variable``, ``sampling_rate``, ``unit`` and ``axes``."""
         return record_from_mat(path, positions, variable=options.get("variable"),
-                               sampling_rate=options.get("sampling_rate"), unit=options.get("unit"))
+                               sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
+                               axes=options.get("axes"))
 
 
 READER = MatlabReader()
@@ -59,7 +66,7 @@ READER = MatlabReader()
 
 def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
                     variable: str | None = None, sampling_rate: float | None = None,
-                    unit: str | None = None) -> Record:
+                    unit: str | None = None, axes: Any = None) -> Record:
     """Read a record from a MATLAB file (see the module docstring).
 
     Raises
@@ -97,9 +104,17 @@ def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | No
     temperature = variables.get("temperature")
     if temperature is not None:
         temperature = _one_number(temperature, "temperature", file)
+    directions = variables.get("channel_directions")
+    if directions is not None:
+        directions = [directions] if isinstance(directions, str) else directions
+        if not isinstance(directions, list) or len(directions) != acceleration.shape[1]:
+            count = len(directions) if isinstance(directions, list) else "not a cell array of strings"
+            raise InputError(f"must be a cell array of {acceleration.shape[1]} strings, one per column, got {count}",
+                             field="channel_directions", file=file)
+        directions = file_directions(directions, list(names), axes=axes, file=file, field="channel_directions")
     return validated_record(acceleration, rate, names, channel_positions, unit=unit,
                             start_time=_text(variables, "start_time", file), source=file,
-                            temperature=temperature, replaced=replaced)
+                            temperature=temperature, replaced=replaced, directions=directions)
 
 
 def _load(file: str) -> dict[str, Any]:

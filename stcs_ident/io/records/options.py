@@ -17,6 +17,7 @@ from typing import Any
 
 from ...core.errors import InputError
 from ...core.times import instant_problem
+from .directions import axes_problem, axes_value
 from .validation import UNITS
 
 __all__ = ["OPTIONS", "check_options", "option_problem", "option_value"]
@@ -33,6 +34,8 @@ OPTIONS = {
     "temperature": "a number of degC",
     "variable": "a non-empty string (the MATLAB variable)",
     "group": "a non-empty string (the TDMS group)",
+    "axes": 'a table placing the file\'s axes on the cable, { X = "axial", Y = "in", Z = "out" } say '
+            '(UFF, TDMS, SEP005 and HDF5 channels whose direction is an axis X, Y or Z)',
 }
 
 
@@ -44,6 +47,8 @@ def option_problem(key: str, value: Any) -> str | None:
     """What is wrong with ``value`` for option ``key`` (None: nothing); an unknown key is a problem too."""
     if key not in OPTIONS:
         return f"unknown key {key!r}; expected one of: {', '.join(OPTIONS)}"
+    if key == "axes":
+        return axes_problem(value)
     must = f"must be {OPTIONS[key]}, got {value!r}"
     if key in ("sampling_rate", "temperature"):
         ok = _is_number(value) and math.isfinite(value) and (key != "sampling_rate" or value > 0)
@@ -62,9 +67,12 @@ def option_problem(key: str, value: Any) -> str | None:
 
 
 def option_value(key: str, value: Any) -> Any:
-    """``value`` (checked) as the readers take it: rows as a tuple, a TOML date-time as ISO 8601 text."""
+    """``value`` (checked) as the readers take it: rows as a tuple, a TOML date-time as ISO 8601 text, axes as
+    (axis, direction) pairs in the order X, Y, Z."""
     if key == "skip_rows":
         return tuple(int(v) for v in value)
+    if key == "axes":
+        return axes_value(value)
     if key == "start_time" and isinstance(value, datetime):
         return value.isoformat()
     if key in ("sampling_rate", "temperature"):

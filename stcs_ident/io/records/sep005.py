@@ -2,7 +2,12 @@
 
 One dict per channel, with ``data``, ``fs`` (or a uniform ``time``),
 ``name``, ``quantity`` and ``unit_str``; ``position`` (m from end A) is our
-extension. A record read from them passes the checks of every record source
+extension. SEP005 names no key for a channel's direction (it allows any
+further key), so ``direction`` is our extension too: ``"in"``, ``"out"``,
+``"axial"`` or an angle in degrees, or an axis of the sensor (``"X"``,
+``"+Y"``, ``"-Z"``) that the reader option ``axes`` places on the cable
+(:mod:`~stcs_ident.io.records.directions`). A channel without it is
+in-plane; channels none of which has it give no directions. A record read from them passes the checks of every record source
 (:mod:`~stcs_ident.io.records.validation`); its errors name no file unless
 given one (``source``).
 
@@ -21,8 +26,10 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.files import atomic_file
+from ...core.planes import direction_text
 from ...core.record import Record
 from .base import RecordReader, file_head
+from .directions import file_directions
 from .validation import (
     UNITS,
     Positions,
@@ -44,8 +51,8 @@ def to_sep005(record: Record) -> list[dict[str, Any]]:
 
     Each has ``data`` (1-D, m/s²), ``fs`` (Hz), ``name``, ``quantity``
     (``"acceleration"``), ``unit_str`` (``"m/s^2"``), ``position`` (m from
-    end A, our extension) and, when known, ``start_timestamp`` and
-    ``temperature`` (°C, our extension).
+    end A, our extension) and, when known, ``start_timestamp``,
+    ``temperature`` (°C, our extension) and ``direction`` (our extension).
     """
     channels = []
     for index, name in enumerate(record.channel_names):
@@ -61,12 +68,14 @@ def to_sep005(record: Record) -> list[dict[str, Any]]:
             channel["start_timestamp"] = record.start_time
         if record.temperature is not None:
             channel["temperature"] = record.temperature
+        if record.channel_directions is not None:
+            channel["direction"] = direction_text(record.channel_directions[index])
         channels.append(channel)
     return channels
 
 
 def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None = None, *,
-                source: str | None = None) -> Record:
+                source: str | None = None, axes: Any = None) -> Record:
     """Build a record from SDyPy SEP005 channel dicts.
 
     Parameters
@@ -75,11 +84,13 @@ def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | No
         Each with ``name``, ``data`` (1-D), ``unit_str`` (``"m/s^2"``,
         ``"m/s²"`` or ``"g"``), ``fs`` (Hz) or a uniform ``time``, and
         optionally ``quantity`` (acceleration), ``start_timestamp``,
-        ``position`` and ``temperature`` (°C). All channels share one length and sampling rate.
+        ``position``, ``temperature`` (°C) and ``direction``. All channels share one length and sampling rate.
     positions : mapping or sequence of float, optional
         Positions of the channels without a ``position`` key.
     source : str, optional
         The file the channels were read from: named in errors and warnings, and the record's ``source``.
+    axes : table of axis to direction, optional
+        The reader option ``axes``: places directions given as axes X, Y, Z on the cable.
 
     Raises
     ------
@@ -87,14 +98,15 @@ def from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | No
         As :func:`~stcs_ident.io.records.hdf5.read_record`, naming ``source`` (if given) and the channel.
     """
     try:
-        return _from_sep005(channels, positions, source)
+        return _from_sep005(channels, positions, source, axes)
     except InputError as err:
         if source is None or err.file is not None:
             raise
         raise err.with_file(source) from None
 
 
-def _from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None, source: str | None) -> Record:
+def _from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | None, source: str | None,
+                 axes: Any = None) -> Record:
     channels = list(channels)
     if not channels:
         raise InputError("no channels", field="acceleration")
@@ -110,9 +122,11 @@ def _from_sep005(channels: Iterable[Mapping[str, Any]], positions: Positions | N
     lookup.update({name: channel["position"] for name, channel in zip(names, channels) if "position" in channel})
     start_time = next((c["start_timestamp"] for c in channels if c.get("start_timestamp") is not None), None)
     temperature = next((c["temperature"] for c in channels if c.get("temperature") is not None), None)
+    directions = file_directions([channel.get("direction") for channel in channels], names, axes=axes,
+                                 file=source, field="direction")
     return validated_record(
         np.column_stack(data), rates[0], names, position_list(names, lookup, source),
-        unit="m/s^2", start_time=start_time, source=source, temperature=temperature,
+        unit="m/s^2", start_time=start_time, source=source, temperature=temperature, directions=directions,
     )
 
 
@@ -129,14 +143,15 @@ class Sep005Reader(RecordReader):
         return file_head(path).lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"["
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`read_sep005`; its channel dicts carry their rate and unit (the options do not apply)."""
-        return read_sep005(path, positions)
+        """:func:`read_sep005`; its channel dicts carry their rate and unit (of the options, only ``axes``
+        applies)."""
+        return read_sep005(path, positions, axes=options.get("axes"))
 
 
 READER = Sep005Reader()
 
 
-def read_sep005(path: str | os.PathLike, positions: Positions | None = None) -> Record:
+def read_sep005(path: str | os.PathLike, positions: Positions | None = None, *, axes: Any = None) -> Record:
     """Read a record from a JSON list of SEP005 channel dicts (:func:`from_sep005`, naming the file).
 
     Raises
@@ -155,7 +170,7 @@ def read_sep005(path: str | os.PathLike, positions: Positions | None = None) -> 
     if not isinstance(channels, list):
         raise InputError(f"must be a JSON list of SEP005 channel dicts, got a {type(channels).__name__}",
                          field="acceleration", file=file)
-    return from_sep005(channels, positions, source=file)
+    return from_sep005(channels, positions, source=file, axes=axes)
 
 
 def write_sep005(record: Record, path: str | os.PathLike) -> None:

@@ -7,6 +7,12 @@ channel's properties: ``wf_increment`` (s) gives the sampling rate,
 ``wf_start_time`` the start time, ``unit_string`` the unit; the options
 ``sampling_rate``, ``start_time`` and ``unit`` replace or stand in for them.
 Every channel must agree on the rate and the unit and have as many samples.
+
+A channel's property ``direction`` gives its direction: ``in``, ``out``,
+``axial`` or an angle in degrees (text or a number), or an axis of the
+sensor (``X``, ``+Y``, ``-Z``) that the reader option ``axes`` places on the
+cable (:mod:`~stcs_ident.io.records.directions`). A channel without it is
+in-plane; a file where no channel has it gives no directions.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from nptdms import TdmsFile
 from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader, file_head
+from .directions import file_directions
 from .validation import one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "TdmsReader", "record_from_tdms"]
@@ -40,9 +47,10 @@ class TdmsReader(RecordReader):
         return file_head(path, 4) == b"TDSm"
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_tdms` with the options ``group``, ``sampling_rate`` and ``unit``."""
+        """:func:`record_from_tdms` with the options ``group``, ``sampling_rate``, ``unit`` and ``axes``."""
         return record_from_tdms(path, positions, group=options.get("group"),
-                                sampling_rate=options.get("sampling_rate"), unit=options.get("unit"))
+                                sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
+                                axes=options.get("axes"))
 
 
 READER = TdmsReader()
@@ -50,7 +58,7 @@ READER = TdmsReader()
 
 def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
                      group: str | None = None, sampling_rate: float | None = None,
-                     unit: str | None = None) -> Record:
+                     unit: str | None = None, axes: Any = None) -> Record:
     """Read a record from a TDMS file (see the module docstring).
 
     Raises
@@ -92,8 +100,17 @@ def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | N
     start = _agreed(channels, "wf_start_time", file)
     acceleration = np.column_stack([np.asarray(channel[:], dtype=float) for channel in channels])
     channel_positions = position_list(names, positions_by_name(names, positions or {}, file), file)
+    directions = file_directions([_property(channel, "direction") for channel in channels], names, axes=axes,
+                                 file=file, field="direction")
     return validated_record(acceleration, rate, names, channel_positions, unit=unit,
-                            start_time=None if start is None else _iso_utc(start), source=file, replaced=replaced)
+                            start_time=None if start is None else _iso_utc(start), source=file, replaced=replaced,
+                            directions=directions)
+
+
+def _property(channel: Any, key: str) -> Any:
+    """The channel's property ``key`` as a Python value (numpy scalars unwrapped); None if it has none."""
+    value = channel.properties.get(key)
+    return value.item() if isinstance(value, np.generic) else value
 
 
 def _file_rate(channels: list, file: str) -> float | None:

@@ -9,6 +9,13 @@ sampling rate and the ordinate's units label the unit; the options
 prints the increment to six significant digits: where that is not the exact
 step (1/2048 s, say), give ``sampling_rate``. The file holds no start time:
 give ``start_time`` where one is needed.
+
+Each dataset's response direction (``rsp_dir``: 1, 2, 3 for +X, +Y, +Z,
+negative for -X, -Y, -Z; 0 for a scalar) is an axis of the sensor's frame:
+the reader option ``axes`` places it on the cable
+(:mod:`~stcs_ident.io.records.directions`; the sign does not change the
+plane). Without ``axes`` the channels are read as in-plane, with a warning;
+a scalar or rotational direction (0, ±4 … ±6) says nothing of the channel's.
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ import pyuff
 from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader
+from .directions import AXES, file_directions
 from .validation import one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "UffReader", "record_from_uff"]
@@ -41,15 +49,16 @@ class UffReader(RecordReader):
     suffixes = (".uff", ".unv")
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_uff` with the options ``sampling_rate`` and ``unit``."""
-        return record_from_uff(path, positions, sampling_rate=options.get("sampling_rate"), unit=options.get("unit"))
+        """:func:`record_from_uff` with the options ``sampling_rate``, ``unit`` and ``axes``."""
+        return record_from_uff(path, positions, sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
+                               axes=options.get("axes"))
 
 
 READER = UffReader()
 
 
 def record_from_uff(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
-                    sampling_rate: float | None = None, unit: str | None = None) -> Record:
+                    sampling_rate: float | None = None, unit: str | None = None, axes: Any = None) -> Record:
     """Read a record from the datasets 58 of a universal file (see the module docstring).
 
     Raises
@@ -89,8 +98,23 @@ def record_from_uff(path: str | os.PathLike, positions: Mapping[str, float] | No
     if any(np.iscomplexobj(d) for d in data):
         raise InputError("the datasets hold complex values, not a time response", field="acceleration", file=file)
     channel_positions = position_list(names, positions_by_name(names, positions or {}, file), file)
+    directions = file_directions([_axis(s, file) for s in sets], names, axes=axes, file=file, field="rsp_dir")
     return validated_record(np.column_stack(data), rate, names, channel_positions, unit=unit, start_time=None,
-                            source=file, replaced=replaced)
+                            source=file, replaced=replaced, directions=directions)
+
+
+def _axis(dataset: Mapping[str, Any], file: str) -> str | None:
+    """The dataset's response direction as an axis (``"+X"``, ``"-Z"``); None for a scalar or a rotation."""
+    value = dataset.get("rsp_dir")
+    if value is None:
+        return None
+    try:
+        code = int(value)
+    except (TypeError, ValueError):
+        raise InputError(f"must be an integer from -6 to 6, got {value!r}", field="rsp_dir", file=file) from None
+    if not 1 <= abs(code) <= 3:
+        return None
+    return ("-" if code < 0 else "+") + AXES[abs(code) - 1]
 
 
 def _name(dataset: Mapping[str, Any]) -> str:

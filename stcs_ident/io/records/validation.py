@@ -14,7 +14,7 @@ Errors
 Every problem raises :class:`~stcs_ident.core.errors.InputError` whose text is
 one line, ``"<file>: field '<field>': <what is wrong>"``. The fields are
 those of the file: ``format``, ``version``, ``sampling_rate``, ``unit``,
-``start_time``, ``acceleration``, ``channel_name``, ``channel_position``
+``start_time``, ``acceleration``, ``channel_name``, ``channel_position``, ``channel_direction``
 (and ``time`` for CSV). A file that is missing, unreadable or not HDF5 or
 CSV has no field. Non-finite samples are refused, naming the channel and
 its first bad sample (0-based index).
