@@ -320,7 +320,7 @@ def test_without_a_damper_the_complex_path_is_never_taken(monkeypatch):
         raise AssertionError("the complex path ran without a damper")
 
     monkeypatch.setattr(damped_response, "superpose_damped", refuse)
-    monkeypatch.setattr("stcs_ident.simulate.simulate.damped_record", refuse)
+    monkeypatch.setattr("stcs_ident.simulate.excitation.damped_record", refuse)
     field = FieldConditions(ambient_lowpass=LowPassLoading(3.0), drift=TensionDrift(amplitude=1e-4))
     rec, truth = simulate_record_with_truth(STAY, [PLAIN], H, SENSORS, duration=20.0, sampling_rate=FS,
                                             damping=INTRINSIC, ambient=Ambient(1.0), field=field,

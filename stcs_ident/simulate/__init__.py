@@ -4,6 +4,7 @@ The simulator builds on the forward model and writes records of the type
 :mod:`stcs_ident.spectra` reads; spectra never imports it.
 """
 
+from .bridge import BridgeConditions, StructuralMode, Traffic
 from .conditions import (
     DcOffsets,
     FieldConditions,
@@ -28,8 +29,9 @@ from .simulate import (
 from .simulate_campaign import TRUTH_FILE, simulate_campaign
 
 __all__ = [
-    "NYQUIST_FRACTION", "TRUTH_FILE", "UNCORRELATED_LENGTH", "Ambient", "DcOffsets", "Effects", "FieldConditions",
-    "Impulse", "LowPassLoading", "MainsHum", "PinkNoise", "RecordTruth", "TensionDrift", "modal_basis",
+    "NYQUIST_FRACTION", "TRUTH_FILE", "UNCORRELATED_LENGTH", "Ambient", "BridgeConditions", "DcOffsets", "Effects",
+    "FieldConditions", "Impulse", "LowPassLoading", "MainsHum", "PinkNoise", "RecordTruth", "StructuralMode",
+    "TensionDrift", "Traffic", "modal_basis",
     "modal_damping", "random_field_conditions", "simulate_campaign", "simulate_record", "simulate_record_with_truth",
     "true_model",
 ]

@@ -285,6 +285,20 @@ class RecordTruth:
         Each mode's damping ratio: the modal damping given, or, for a cable
         with dampers, the complex mode's −Re(s)/|s| (its frequency above is
         |s|/2π); at t = 0 under a drift.
+    out : RecordTruth or None
+        The out-of-plane modes' truth (the same fields, of the out-of-plane
+        model), when a channel reads out-of-plane motion or a bridge moves
+        the anchorages; None otherwise. ``frequencies`` and ``damping``
+        above are the in-plane ones.
+    structural : tuple of StructuralMode
+        The deck's and pylons' modes that moved the anchorages
+        (:mod:`~stcs_ident.simulate.bridge`).
+    misalignment : ndarray (n_channels,) or None
+        Degrees, each sensor's true axis from its stated direction.
+    channel_directions : tuple or None
+        The stated direction of each channel (None: all in-plane, none given).
+    crossings : ndarray or None
+        s, start times of the vehicles' crossings (with traffic).
     """
 
     frequencies: np.ndarray
@@ -294,10 +308,35 @@ class RecordTruth:
     relative_tension: np.ndarray | None = None
     sensitivities: np.ndarray | None = None
     damping: np.ndarray | None = None
+    out: RecordTruth | None = None
+    structural: tuple = ()
+    misalignment: np.ndarray | None = None
+    channel_directions: tuple | None = None
+    crossings: np.ndarray | None = None
 
     @property
     def drifts(self) -> bool:
         return self.relative_tension is not None
+
+    @property
+    def frequencies_in(self) -> np.ndarray:
+        """Hz, the in-plane modes' (``frequencies``)."""
+        return self.frequencies
+
+    @property
+    def frequencies_out(self) -> np.ndarray | None:
+        """Hz, the out-of-plane modes' (None when they were not simulated)."""
+        return None if self.out is None else self.out.frequencies
+
+    @property
+    def damping_out(self) -> np.ndarray | None:
+        """The out-of-plane modes' damping ratios (None when they were not simulated)."""
+        return None if self.out is None else self.out.damping
+
+    @property
+    def structural_frequencies(self) -> np.ndarray:
+        """Hz, of the structural modes that moved the anchorages (their harmonics not listed)."""
+        return np.array([m.frequency for m in self.structural], dtype=float)
 
     def instantaneous_frequencies(self, mode: int) -> np.ndarray:
         """f_k(t_n) = f_k (1 + d[n])^s_k, Hz, at every sample, of mode ``mode`` (1-based)."""

@@ -30,103 +30,62 @@ Field-like disturbances (coloured loading, a drifting tension, pink noise,
 mains hum, offsets, float32 samples) are off by default and given as one
 :class:`~stcs_ident.simulate.disturbances.FieldConditions`; without them a
 record is exactly what it was before they existed.
+
+Both planes, and a cable on a bridge (off by default): ``directions`` gives
+each channel's direction (in-plane, out-of-plane, axial or an angle; a
+biaxial or triaxial sensor is two or three channels at one position), and
+:class:`~stcs_ident.simulate.bridge.BridgeConditions` the out-of-plane
+loading's level, misaligned sensors, deck and pylon modes moving an
+anchorage (a given list of frequencies and amplitudes) and traffic bursts.
+The out-of-plane motion is that of the cable without sag-extensibility
+(:func:`~stcs_ident.core.planes.plane_view`), loaded by its own independent
+ambient pressure, uncoupled from the in-plane motion; the anchorages' motion
+enters through the exact modal answer to a support motion
+(:mod:`~stcs_ident.simulate.anchorage`). The truth says, per record, the
+in-plane and out-of-plane frequencies and damping, the structural
+frequencies, the misalignments and the crossings. Without these options
+the record is exactly what it was before them.
 """
 
 from __future__ import annotations
 
-import itertools
-import math
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable, has_dampers, real_number
 from ..core.record import Record
-from ..core.record import sampling_rate as record_sampling_rate
-from ..forward.dsm import count_below
-from ..forward.shapes import ModeShapes, mode_shapes
+from .bridge import BridgeConditions, StructuralMode, Traffic
 from .conditions import FieldConditions, RecordTruth
-from .damped_response import damped_record
-from .disturbances import (
-    apply_sensor_disturbances,
-    check_field,
-    field_rng,
-    lowpass_force_filter,
-    relative_tension,
-    tension_sensitivities,
-)
+from .disturbances import apply_sensor_disturbances, check_field, field_rng
 from .effects import Effects, true_model
-from .field_response import superpose_field
-from .modal_response import matrix_sqrt, modal_force_covariance, superpose
+from .excitation import (
+    MAX_IMPULSES,
+    MAX_SAMPLES,
+    NYQUIST_FRACTION,
+    UNCORRELATED_LENGTH,
+    Ambient,
+    Impulse,
+    Progress,
+    check_impulses,
+    check_positions,
+    check_timing,
+    modal_basis,
+    modal_damping,
+    plane_model,
+    plane_signal,
+    with_noise,
+)
+from .excitation import channel_names as named_channels
+from .two_planes import check_channel_directions, planes_record
 
 __all__ = [
-    "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "Effects", "FieldConditions", "Impulse", "RecordTruth",
-    "modal_basis", "modal_damping", "simulate_record", "simulate_record_with_truth", "true_model",
+    "MAX_IMPULSES", "MAX_SAMPLES", "NYQUIST_FRACTION", "UNCORRELATED_LENGTH", "Ambient", "BridgeConditions",
+    "Effects", "FieldConditions", "Impulse", "Progress", "RecordTruth", "StructuralMode", "Traffic",
+    "check_impulses", "check_timing", "modal_basis", "modal_damping", "simulate_record",
+    "simulate_record_with_truth", "true_model",
 ]
-
-#: Modes are kept up to this fraction of the sampling rate (just below Nyquist).
-NYQUIST_FRACTION = 0.45
-#: Uncorrelated pressure: ``rms_pressure`` is the rms of its mean over this length (m).
-UNCORRELATED_LENGTH = 1.0
-#: Most samples of one simulated record (23 h at 200 Hz; 400 MB for 3 channels as float64, and several
-#: times that while the modal responses are summed): a longer record is refused before anything is allocated.
-MAX_SAMPLES = 2**24
-#: Most hand blows in one record: each adds its free decay to every sample after it.
-MAX_IMPULSES = 1000
-
-Progress = Callable[[int, int], None]
-
-
-@dataclass(frozen=True)
-class Impulse:
-    """A hand or hammer blow: an impulse at one point of the cable.
-
-    Parameters
-    ----------
-    time : float
-        s from the start of the record (may be negative: a blow before it).
-    position : float
-        m from end A.
-    magnitude : float
-        N s, positive in the direction of sag.
-    """
-
-    time: float
-    position: float
-    magnitude: float
-
-    def __post_init__(self):
-        for name in ("time", "position", "magnitude"):
-            object.__setattr__(self, name, real_number(getattr(self, name), f"impulse.{name}"))
-
-
-@dataclass(frozen=True)
-class Ambient:
-    """Random pressure along the cable: Gaussian, white in time up to Nyquist.
-
-    Parameters
-    ----------
-    rms_pressure : float
-        N/m. With a correlation length, the pointwise rms; without one, the
-        rms of the pressure averaged over each metre of cable
-        (:data:`UNCORRELATED_LENGTH`), since a spatially white pressure has
-        no pointwise value.
-    correlation_length : float or None
-        m; spatial correlation exp(−|x − x'| / L). None: uncorrelated along
-        the cable, which loads every mode alike (∝ ∫φ_k²); a long L loads
-        mainly the symmetric modes (∝ (∫φ_k)²).
-    """
-
-    rms_pressure: float
-    correlation_length: float | None = None
-
-    def __post_init__(self):
-        object.__setattr__(self, "rms_pressure", real_number(self.rms_pressure, "ambient.rms_pressure", positive=True))
-        if self.correlation_length is not None:
-            L = real_number(self.correlation_length, "ambient.correlation_length", positive=True)
-            object.__setattr__(self, "correlation_length", L)
 
 
 def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: float, positions: Sequence[float], *,
@@ -134,7 +93,8 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
                     impulses: Sequence[Impulse] = (), ambient: Ambient | None = None, snr_db: float | None = None,
                     effects: Effects | None = None, n_modes: int | None = None,
                     seed: int | np.random.SeedSequence | None = 0, channel_names: Sequence[str] | None = None,
-                    field: FieldConditions | None = None, progress: Progress | None = None) -> Record:
+                    field: FieldConditions | None = None, progress: Progress | None = None,
+                    directions: Sequence[str | float] | None = None, bridge: BridgeConditions | None = None) -> Record:
     """Simulate a multi-channel acceleration record of one configuration.
 
     Parameters
@@ -182,6 +142,24 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
         were; a coloured loading or a drift makes another signal.
     progress : callable(done, total), optional
         Called after each block of samples.
+    directions : sequence or None
+        One per entry of ``positions``: ``"in"`` (in-plane transverse),
+        ``"out"`` (out-of-plane transverse), ``"axial"`` (along the chord)
+        or an angle in degrees from in-plane towards out-of-plane. A
+        position may repeat: a biaxial sensor is two entries at one x
+        (``"in"``, ``"out"``), a triaxial one three. The record carries
+        them (``Record.channel_directions``). None: every channel
+        in-plane, and the record states no directions (as before they
+        existed). When a channel reads out-of-plane motion, the
+        out-of-plane modes are simulated too (:mod:`.two_planes`). An
+        axial channel reads only the anchorages' axial motion (the cable's
+        transverse modes give no axial acceleration to first order); its
+        ``snr_db`` noise is at the transverse channels' mean noise level.
+    bridge : BridgeConditions or None
+        A cable on a bridge (:mod:`~stcs_ident.simulate.bridge`): the
+        out-of-plane loading's level, misaligned sensors, deck and pylon
+        modes moving an anchorage, traffic. None: none of it. A moving
+        anchorage is an excitation by itself (no blow or ambient needed).
 
     Returns
     -------
@@ -201,7 +179,8 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
     return simulate_record_with_truth(cable, attachments, tension, positions, duration=duration,
                                       sampling_rate=sampling_rate, damping=damping, impulses=impulses,
                                       ambient=ambient, snr_db=snr_db, effects=effects, n_modes=n_modes, seed=seed,
-                                      channel_names=channel_names, field=field, progress=progress)[0]
+                                      channel_names=channel_names, field=field, progress=progress,
+                                      directions=directions, bridge=bridge)[0]
 
 
 def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], tension: float,
@@ -211,7 +190,8 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
                                effects: Effects | None = None, n_modes: int | None = None,
                                seed: int | np.random.SeedSequence | None = 0,
                                channel_names: Sequence[str] | None = None, field: FieldConditions | None = None,
-                               progress: Progress | None = None) -> tuple[Record, RecordTruth]:
+                               progress: Progress | None = None, directions: Sequence[str | float] | None = None,
+                               bridge: BridgeConditions | None = None) -> tuple[Record, RecordTruth]:
     """:func:`simulate_record`'s record and what it truly holds.
 
     The parameters are :func:`simulate_record`'s. The
@@ -219,187 +199,47 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
     model's frequencies and damping ratios (with dampers, the complex
     modes' |s|/2π and −Re(s)/|s|) and, under a tension drift, the relative tension at
     every sample, each mode's sensitivity to it, the instantaneous and the
-    time-averaged frequencies.
+    time-averaged frequencies. With ``directions`` or ``bridge`` it also
+    gives the out-of-plane modes' truth (``out``, ``frequencies_out``,
+    ``damping_out``; ``frequencies`` are the in-plane ones), the structural
+    modes, each channel's misalignment and the traffic's crossing times.
     """
     fs, n_samples = check_timing(duration, sampling_rate)
     impulses = check_impulses(impulses)
     if snr_db is not None:
         snr_db = real_number(snr_db, "snr_db")
-    if not impulses and ambient is None:
-        raise ModelError("no excitation: give impulses and/or ambient", field="excitation")
+    if bridge is not None and not isinstance(bridge, BridgeConditions):
+        raise ModelError(f"must be a BridgeConditions or None, got {type(bridge).__name__}", field="bridge")
+    if not impulses and ambient is None and not (bridge is not None and bridge.moves_anchorages):
+        raise ModelError("no excitation: give impulses, ambient and/or a moving anchorage", field="excitation")
     if ambient is not None and not isinstance(ambient, Ambient):
         raise ModelError(f"must be an Ambient or None, got {type(ambient).__name__}", field="ambient")
     cable, atts, tension = true_model(cable, attachments, tension, effects)
-    x = _check_positions(positions, cable.length, "positions")
+    x = check_positions(positions, cable.length, "positions")
     for imp in impulses:
-        _check_positions([imp.position], cable.length, "impulse.position")
-    names = _channel_names(channel_names, len(x))
+        check_positions([imp.position], cable.length, "impulse.position")
+    names = named_channels(channel_names, len(x))
+    directions = check_channel_directions(directions, len(x))
+    if bridge is not None:
+        bridge.misalignment_per_channel(len(x))  # its count before any work
     if field is not None:
         check_field(field, len(x), fs, ambient is not None)
+    if directions is not None or bridge is not None or any(imp.direction != "in" for imp in impulses):
+        return planes_record(cable, atts, tension, x, fs, n_samples, names, directions, damping=damping,
+                             impulses=impulses, ambient=ambient, snr_db=snr_db, n_modes=n_modes, seed=seed,
+                             field=field, bridge=bridge, progress=progress)
+    # in-plane channels only: the record as it was before the planes
     if has_dampers(atts):
-        return _damped(cable, atts, tension, x, fs, n_samples, names, damping, impulses, ambient, snr_db, n_modes,
-                       seed, field, progress)
-    shapes = modal_basis(cable, atts, tension, fs, n_modes)
-    zeta = modal_damping(damping, len(shapes.frequencies))
-    rng = np.random.default_rng(seed)
-    own_rng = field_rng(rng) if field is not None else None
-    force_sqrt = None
-    if ambient is not None:
-        cov = modal_force_covariance(shapes, ambient.rms_pressure, ambient.correlation_length, length=cable.length,
-                                     wave_speed=math.sqrt(tension / cable.mass_per_length),
-                                     uncorrelated_length=UNCORRELATED_LENGTH)
-        force_sqrt = matrix_sqrt(cov)
-    kicks = [(imp.time, shapes([imp.position])[0] * imp.magnitude) for imp in impulses]
-    truth = RecordTruth(np.asarray(shapes.frequencies, dtype=float), tension, fs, n_samples, damping=zeta)
-    lowpass = field.ambient_lowpass if field is not None else None
-    drift = field.drift if field is not None else None
-    if lowpass is None and drift is None:
-        clean = superpose(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng, progress)
-    else:
-        if drift is not None:
-            d = relative_tension(drift, n_samples, fs, own_rng)
-            s = tension_sensitivities(cable, atts, tension, len(shapes.frequencies))
-            truth = RecordTruth(truth.frequencies, tension, fs, n_samples, d, s, damping=zeta)
-        clean = superpose_field(shapes, zeta, fs, n_samples, x, kicks, force_sqrt, rng,
-                                force_filter=None if lowpass is None else lowpass_force_filter(lowpass, fs),
-                                relative_tension=truth.relative_tension, sensitivities=truth.sensitivities,
-                                progress=progress)
-    signal = _with_noise(clean, snr_db, rng)
-    if field is not None:
-        signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
-    return Record(signal, fs, names, x), truth
-
-
-def _damped(cable, atts, tension, x, fs, n_samples, names, damping, impulses, ambient, snr_db, n_modes, seed, field,
-            progress) -> tuple[Record, RecordTruth]:
-    """simulate_record_with_truth for a cable with dampers: complex modes (:mod:`.damped_response`)."""
-    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
-                                or n_modes < 1):
-        raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
-    modal_damping(damping, 1)  # its checks before any work
-    rng = np.random.default_rng(seed)
-    own_rng = field_rng(rng) if field is not None else None
-    load = None if ambient is None else (ambient.rms_pressure, ambient.correlation_length, UNCORRELATED_LENGTH)
-    clean, truth = damped_record(cable, atts, tension, x, fs, n_samples, damping=lambda n: modal_damping(damping, n),
-                                 n_modes=n_modes, band_fraction=NYQUIST_FRACTION, impulses=impulses,
-                                 ambient_load=load, field=field, rng=rng, field_rng=own_rng, progress=progress)
-    signal = _with_noise(clean, snr_db, rng)
-    if field is not None:
-        signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
-    return Record(signal, fs, names, x), truth
-
-
-def modal_basis(cable: Cable, attachments: Sequence[Attachment], tension: float, sampling_rate: float,
-                n_modes: int | None = None) -> ModeShapes:
-    """The modes a record at ``sampling_rate`` contains.
-
-    Parameters
-    ----------
-    cable, attachments, tension :
-        The configuration that vibrates (the true one).
-    sampling_rate : float
-        Hz.
-    n_modes : int or None
-        Default: all modes below ``NYQUIST_FRACTION × sampling_rate``.
-        Given, every one of them must lie below the Nyquist frequency.
-
-    Returns
-    -------
-    ModeShapes
-        Frequencies (Hz) and mass-normalised shapes.
-
-    Notes
-    -----
-    A massless, springless node is added at an irrational fraction of the
-    span, away from the attachments: the shapes come from the nodal values
-    of the dynamic stiffness, and without it a bare clamped cable has no
-    nodal unknowns, and a mode with a node at every attachment has none
-    that move. It changes no frequency or shape.
-    """
-    fs = float(sampling_rate)
-    if n_modes is None:
-        n = count_below(cable, attachments, tension, NYQUIST_FRACTION * fs)
-        if n == 0:
-            raise ModelError(f"no mode below {NYQUIST_FRACTION} x sampling rate ({fs:g} Hz): raise it",
-                             field="sampling_rate")
-    else:
-        if isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer) or n_modes < 1:
+        if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
+                                    or n_modes < 1):
             raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
-        n = int(n_modes)
-    shapes = mode_shapes(cable, attachments, tension, n)
-    if shapes.frequencies[-1] >= fs / 2:
-        raise ModelError(f"mode {n} at {shapes.frequencies[-1]:.4g} Hz is at or above the Nyquist frequency "
-                         f"({fs / 2:g} Hz) and would alias", field="n_modes")
-    return shapes
-
-
-def modal_damping(damping: float | Sequence[float], n_modes: int) -> np.ndarray:
-    """Damping ratios of the first ``n_modes`` modes, checked: 0 < ζ < 1."""
-    try:
-        values = np.atleast_1d(np.asarray(damping, dtype=float))
-    except (TypeError, ValueError):
-        raise ModelError(f"must be a number or a sequence of numbers, got {damping!r}", field="damping") from None
-    if values.ndim != 1:
-        raise ModelError("must be a number or a sequence of numbers", field="damping")
-    if values.size == 1 and np.ndim(damping) == 0:
-        values = np.full(n_modes, values[0])
-    if values.size < n_modes:
-        raise ModelError(f"gives {values.size} ratios for {n_modes} modes", field="damping")
-    values = values[:n_modes]
-    if not np.all(np.isfinite(values) & (values > 0) & (values < 1)):
-        raise ModelError("ratios must satisfy 0 < damping < 1", field="damping")
-    return values
-
-
-def _with_noise(clean: np.ndarray, snr_db: float | None, rng: np.random.Generator) -> np.ndarray:
-    if snr_db is None:
-        return clean
-    noise_rms = np.sqrt(np.mean(clean**2, axis=0)) * 10 ** (-snr_db / 20)
-    return clean + rng.standard_normal(clean.shape) * noise_rms
-
-
-def check_timing(duration, sampling_rate) -> tuple[float, int]:
-    duration = real_number(duration, "duration", positive=True)
-    fs = record_sampling_rate(sampling_rate)
-    n = duration * fs
-    if n > MAX_SAMPLES:
-        raise ModelError(f"gives {n:.3g} samples at {fs:g} Hz; a simulated record has at most {MAX_SAMPLES} "
-                         f"({MAX_SAMPLES / fs:.4g} s at this rate: memory grows with the samples)", field="duration")
-    n = round(n)
-    if n < 2:
-        raise ModelError(f"gives {n} samples at {fs:g} Hz: at least 2 needed", field="duration")
-    return fs, n
-
-
-def check_impulses(impulses) -> tuple[Impulse, ...]:
-    """The impulses (any iterable, read no further than one past the limit) as a checked tuple."""
-    out = tuple(itertools.islice(impulses, MAX_IMPULSES + 1))
-    if len(out) > MAX_IMPULSES:
-        raise ModelError(f"more than {MAX_IMPULSES} hand blows; at most {MAX_IMPULSES} per record (each adds its "
-                         "decay to every sample after it)", field="impulses")
-    for imp in out:
-        if not isinstance(imp, Impulse):
-            raise ModelError(f"must hold Impulse objects, got {type(imp).__name__}", field="impulses")
-    return out
-
-
-def _check_positions(positions, length: float, name: str) -> np.ndarray:
-    try:
-        x = np.atleast_1d(np.asarray(positions, dtype=float))
-    except (TypeError, ValueError):
-        raise ModelError(f"must be numbers (m), got {positions!r}", field=name) from None
-    if x.ndim != 1 or x.size == 0:
-        raise ModelError("must be a non-empty sequence of positions (m)", field=name)
-    bad = ~(np.isfinite(x) & (x > 0) & (x < length))
-    if bad.any():
-        raise ModelError(f"{x[bad][0]!r} m is outside the (true) span (0, {length:g}) m", field=name)
-    return x
-
-
-def _channel_names(names, n: int) -> tuple[str, ...]:
-    if names is None:
-        return tuple(f"A{i + 1}" for i in range(n))
-    names = tuple(str(s) for s in names)
-    if len(names) != n:
-        raise ModelError(f"gives {len(names)} names for {n} positions", field="channel_names")
-    return names
+        modal_damping(damping, 1)  # its checks before any work
+    rng = np.random.default_rng(seed)
+    own_rng = field_rng(rng) if field is not None else None
+    plane = plane_signal(*plane_model(cable, atts, "in"), tension, x, fs, n_samples, damping=damping,
+                         impulses=impulses, ambient=ambient, n_modes=n_modes, rng=rng, own_rng=own_rng, field=field,
+                         progress=progress)
+    signal = with_noise(plane.clean, snr_db, rng)
+    if field is not None:
+        signal = apply_sensor_disturbances(signal, plane.clean, fs, field, own_rng)
+    return Record(signal, fs, names, x), plane.truth

@@ -6,7 +6,9 @@ directory whose records come from a true model that may differ from it
 beside it in ``truth.json`` for scoring identification and diagnosis.
 Field-like disturbances (:class:`~stcs_ident.simulate.disturbances.FieldConditions`)
 may be given for all tests or per test; a test with a tension drift gets
-its time-averaged frequencies in ``truth.json``.
+its time-averaged frequencies in ``truth.json``. Channel directions (biaxial, triaxial sensors) and bridge
+conditions (:class:`~stcs_ident.simulate.bridge.BridgeConditions`) may be given too; ``truth.json`` then holds
+per test the in-plane and out-of-plane frequencies, the structural ones, the misalignments and the crossings.
 """
 
 from __future__ import annotations
@@ -24,8 +26,10 @@ import numpy as np
 from ..core.errors import ModelError
 from ..core.files import whole_directory
 from ..core.model import Attachment, Cable, Campaign, Damper, Test, has_dampers
+from ..core.planes import direction_text
 from ..forward.dsm import natural_frequencies
 from ..io.campaign import CAMPAIGN_FILE, campaign_to_toml
+from .bridge import BridgeConditions
 from .conditions import FieldConditions
 from .disturbances import write_record_as
 from .effects import Effects, true_model
@@ -39,6 +43,7 @@ from .simulate import (
     modal_damping,
     simulate_record_with_truth,
 )
+from .two_planes import check_channel_directions
 
 __all__ = ["TRUTH_FILE", "simulate_campaign"]
 
@@ -52,7 +57,8 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
                       effects: Effects | Mapping[str, Effects] | None = None, n_modes: int | None = None,
                       seed: int = 0, channel_names: Sequence[str] | None = None, overwrite: bool = False,
                       field: FieldConditions | Mapping[str, FieldConditions] | None = None,
-                      progress: Progress | None = None) -> Path:
+                      progress: Progress | None = None, directions: Sequence[str | float] | None = None,
+                      bridge: BridgeConditions | Mapping[str, BridgeConditions] | None = None) -> Path:
     """Write a campaign directory whose records come from a (hidden) true model.
 
     ``out_dir`` gets ``records/<test>.h5`` for each selected test,
@@ -95,6 +101,21 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
         were before this option existed.
     progress : callable(done, total), optional
         Called after each test with the number of tests done.
+    directions : sequence or None
+        One per position, as for :func:`simulate_record` (the records carry
+        them), the same for every test.
+    bridge : BridgeConditions or mapping of test name to BridgeConditions, optional
+        As for :func:`simulate_record`, for all tests or per test (tests not
+        in the mapping get none). With ``directions`` or ``bridge``, a
+        test's entry in ``truth.json`` also has ``"frequencies_in"`` (the
+        same as ``"frequencies"``), ``"frequencies_out"``,
+        ``"damping_out"`` and ``"modes_out"`` (the out-of-plane modes;
+        absent for a cable with dampers none of whose channels reads
+        out-of-plane motion), ``"channel_directions"`` (as stated in the
+        record), and with bridge conditions ``"bridge"`` (the parts that are
+        on), ``"structural_frequencies"`` (Hz), ``"misalignment"`` (degrees
+        per channel) and ``"traffic_crossings"`` (s, the crossings' start
+        times); under a drift ``"time_averaged_frequencies_out"``.
 
     Returns
     -------
@@ -117,18 +138,20 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
     selected = _select_tests(campaign, tests)
     per_test = _effects_per_test(effects, selected)
     field_per_test = _field_per_test(field, selected)
+    bridge_per_test = _per_test(bridge, selected, BridgeConditions, "bridge")
     stems = _record_stems([t.name for t in selected])
     streams = np.random.SeedSequence(seed).spawn(len(selected))
     options = {"duration": duration, "sampling_rate": sampling_rate, "damping": damping,
                "impulses": tuple(impulses), "ambient": ambient, "snr_db": snr_db, "n_modes": n_modes,
-               "channel_names": channel_names}
+               "channel_names": channel_names, "directions": directions}
     with whole_directory(out) as tmp:
         (tmp / "records").mkdir()
         nominal_tests, truth_tests = [], []
         for i, (test, stem) in enumerate(zip(selected, stems)):
             rel = f"records/{stem}.h5"
             truth_tests.append(_simulate_test(campaign, test, tmp / rel, positions, per_test[test.name],
-                                              streams[i], options, field_per_test[test.name]))
+                                              streams[i], options, field_per_test[test.name],
+                                              bridge_per_test[test.name]))
             truth_tests[-1]["record"] = rel
             nominal_tests.append(replace(test, frequencies=None, modes=None, planes=None, reference=(), record=rel))
             if progress is not None:
@@ -143,10 +166,12 @@ def simulate_campaign(campaign: Campaign, out_dir: str | os.PathLike, *, positio
 
 
 def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effects: Effects | None,
-                   stream: np.random.SeedSequence, options: dict, field: FieldConditions | None = None) -> dict:
+                   stream: np.random.SeedSequence, options: dict, field: FieldConditions | None = None,
+                   bridge: BridgeConditions | None = None) -> dict:
     attachments = campaign.setup(test.setup).attachments
     record, record_truth = simulate_record_with_truth(campaign.cable, attachments, test.tension, positions,
-                                                      effects=effects, seed=stream, field=field, **options)
+                                                      effects=effects, seed=stream, field=field, bridge=bridge,
+                                                      **options)
     write_record_as(record, path, float32=field is not None and field.float32)
     cable, atts, tension = true_model(campaign.cable, attachments, test.tension, effects)
     damped = has_dampers(atts)
@@ -173,7 +198,31 @@ def _simulate_test(campaign: Campaign, test: Test, path: Path, positions, effect
         if record_truth.drifts:
             truth["time_averaged_frequencies"] = [float(f) for f in record_truth.mean_frequencies]
             truth["mean_tension"] = record_truth.mean_tension
+    if options["directions"] is not None or bridge is not None:
+        truth.update(_planes_json(record_truth, frequencies, bridge))
     return truth
+
+
+def _planes_json(record_truth, frequencies, bridge: BridgeConditions | None) -> dict:
+    """truth.json's keys of both planes and the bridge (:func:`simulate_campaign`'s ``directions``, ``bridge``)."""
+    out: dict = {"frequencies_in": [float(f) for f in frequencies]}
+    if record_truth.out is not None:
+        f_out = record_truth.frequencies_out
+        out["modes_out"] = list(range(1, len(f_out) + 1))
+        out["frequencies_out"] = [float(f) for f in f_out]
+        out["damping_out"] = [float(z) for z in record_truth.damping_out]
+        if record_truth.out.drifts:
+            out["time_averaged_frequencies_out"] = [float(f) for f in record_truth.out.mean_frequencies]
+    directions = record_truth.channel_directions
+    out["channel_directions"] = None if directions is None else [direction_text(d) for d in directions]
+    if bridge is not None:
+        out["bridge"] = bridge.to_dict()
+        out["structural_frequencies"] = [float(f) for f in record_truth.structural_frequencies]
+        if record_truth.misalignment is not None:
+            out["misalignment"] = [float(d) for d in record_truth.misalignment]
+        if record_truth.crossings is not None and bridge.traffic is not None:
+            out["traffic_crossings"] = [float(t) for t in record_truth.crossings]
+    return out
 
 
 def _attachment_json(a: Attachment) -> dict:
@@ -197,10 +246,14 @@ def _options_json(positions, seed: int, options: dict) -> dict:
     return {
         "positions": [float(x) for x in np.atleast_1d(positions)], "seed": seed,
         "duration": float(options["duration"]), "sampling_rate": float(options["sampling_rate"]),
-        "impulses": [{"time": i.time, "position": i.position, "magnitude": i.magnitude} for i in options["impulses"]],
+        "impulses": [{"time": i.time, "position": i.position, "magnitude": i.magnitude,
+                      **({} if i.direction == "in" else {"direction": direction_text(i.direction)})}
+                     for i in options["impulses"]],
         "ambient": None if ambient is None else {"rms_pressure": ambient.rms_pressure,
                                                  "correlation_length": ambient.correlation_length},
         "snr_db": None if options["snr_db"] is None else float(options["snr_db"]), "n_modes": None if options["n_modes"] is None else int(options["n_modes"]),
+        **({} if options["directions"] is None else {"directions": [
+            direction_text(d) for d in check_channel_directions(options["directions"], len(np.atleast_1d(positions)))]}),
     }
 
 
@@ -227,6 +280,21 @@ def _effects_per_test(effects, tests: list[Test]) -> dict[str, Effects | None]:
     if unknown:
         raise ModelError(f"names tests not simulated: {sorted(unknown)}", field="effects")
     return {t.name: effects.get(t.name) for t in tests}
+
+
+def _per_test(value, tests: list[Test], kind: type, name: str) -> dict:
+    """``value`` (one ``kind`` for all tests, a mapping of test name to one, or None) per test name."""
+    if value is None or isinstance(value, kind):
+        return {t.name: value for t in tests}
+    if not isinstance(value, Mapping):
+        raise ModelError(f"must be a {kind.__name__}, a mapping of test name to {kind.__name__}, or None", field=name)
+    unknown = set(value) - {t.name for t in tests}
+    if unknown:
+        raise ModelError(f"names tests not simulated: {sorted(unknown)}", field=name)
+    for test, one in value.items():
+        if one is not None and not isinstance(one, kind):
+            raise ModelError(f"must be a {kind.__name__} or None, got {type(one).__name__}", field=f"{name}[{test}]")
+    return {t.name: value.get(t.name) for t in tests}
 
 
 def _field_per_test(field, tests: list[Test]) -> dict[str, FieldConditions | None]:
