@@ -353,3 +353,17 @@ def test_forward_command_plane_option(tmp_path, capsys):
     with pytest.raises(SystemExit) as refused:  # argparse refuses a bad choice, as the console script exits
         main(["forward", str(tmp_path), "--plane", "sideways"])
     assert refused.value.code == 2 and "--plane" in capsys.readouterr().err
+
+
+def test_the_shapes_of_a_bare_string_out_of_plane_are_sines():
+    """A bare string (EI = 0, no attachment) has no nodal unknown; out of plane it has no sag term either, so
+    the shapes need nodes the solver adds itself. They are sin(kπx/l) (mass-normalised: √(2/(m l)))."""
+    from stcs_ident.forward.shapes import mode_shapes
+
+    cable = Cable(100.0, 10.0, 0.0, EA=1e9)
+    shapes = mode_shapes(cable, [], 1e5, 4, plane="out")
+    x = np.array([13.0, 50.0, 70.0])
+    k = np.arange(1, 5)
+    expected = np.sqrt(2 / (10.0 * 100.0)) * np.sin(np.pi * np.outer(x, k) / 100.0)
+    got = shapes(x)
+    np.testing.assert_allclose(np.abs(got), np.abs(expected), atol=1e-9)  # to rounding; the sign is free

@@ -152,6 +152,59 @@ def test_support_motion_answer_is_the_taut_string_steady_state():
     assert not np.allclose(exact, x / string.length, rtol=0.05)  # the dynamics matter at this frequency
 
 
+def test_a_deck_mode_at_a_cable_frequency_resonates_in_that_modes_shape():
+    """End B moving at the string's mode-2 frequency: the cable answers in mode 2's shape, amplified by 1/(2ζ).
+    For a string φ_k = √(2/(ml)) sin(kπx/l) and Γ_k = ∫ m φ_k x/l dx = √(2m/l) (−1)^(k+1) l/(kπ), so mode 2's
+    term at resonance is Γ_2 φ_2(x) / (2iζ) = i sin(2πx/l) / (2πζ): 31.8 at x = l/4 for ζ = 0.005."""
+    string = Cable(length=50.0, mass_per_length=50.0, EI=1.0)
+    H, fs, n, zeta = 1.125e6, 100.0, 20000, 0.005  # c = 150 m/s: f_k = 1.5 k Hz (EI shifts them by 4e-5)
+    shapes = modal_basis(string, [], H, fs)
+    f2 = shapes.frequencies[1]
+    t = np.arange(n) / fs
+    u = np.cos(2 * math.pi * 3.0 * t)  # 600 whole periods: one FFT bin; 3.0 Hz is f2 to 1.2e-4 Hz « ζ f2
+    assert abs(f2 - 3.0) < 2e-4
+    acc = np.zeros((n, 3))
+    acc[:, 0] = u
+    x = np.array([12.5, 37.5])  # l/4 and 3l/4: mode 2's antinodes, of opposite sign
+    got = transverse_response(AnchorageMotion({"B": acc}, np.zeros(0)), "in", shapes,
+                              np.full(len(shapes.frequencies), zeta), [], 50.0, 50.0, x, fs, n)
+    quadrature = np.sin(2 * math.pi * 3.0 * t)
+    amplitude = np.hypot(got.T @ u, got.T @ quadrature) / (u @ u)
+    # the other modes and the chord line add at most ~1 to the 31.8 of mode 2 (their gains are O(1)): 5 %
+    assert amplitude == pytest.approx([1 / (2 * math.pi * zeta)] * 2, rel=0.05)
+    # in mode 2's shape: the two antinodes move in opposition, and a quarter period behind the anchorage
+    assert (got[:, 0] @ got[:, 1]) < -0.9 * np.sqrt((got[:, 0] @ got[:, 0]) * (got[:, 1] @ got[:, 1]))
+    assert abs(got[:, 0] @ u) < 0.1 * abs(got[:, 0] @ quadrature)
+
+
+def test_support_motion_answer_of_complex_modes_matches_the_real_modes_for_a_negligible_damper():
+    """A cable with a damper answers through its complex modes; with a dashpot of 1 N s/m (ζ added ~1e-7) the
+    answer is the undamped modes' one, to the finite-element Ritz basis's error against the exact shapes
+    (measured 1.1e-5 of the motion here; 5e-5 allows for it)."""
+    from stcs_ident.simulate.damped_modes import damped_modes
+
+    string = Cable(length=50.0, mass_per_length=50.0, EI=1.0)
+    H, fs, n = 1.0e6, 100.0, 5000
+    atts = [Damper("d", 2.0, coefficient=1.0)]
+    t = np.arange(n) / fs
+    acc = np.zeros((n, 3))
+    acc[:, 0] = np.cos(2 * math.pi * 2.0 * t) + 0.5 * np.sin(2 * math.pi * 3.7 * t)
+    motion = AnchorageMotion({"B": acc}, np.zeros(0))
+    x = np.array([5.0, 20.0, 37.0])
+    modes = damped_modes(string, atts, H, fs, None, lambda k: np.full(k, 1e-4), 0.45)
+    shapes = modal_basis(string, [], H, fs)
+    complex_answer = transverse_response(motion, "in", modes, None, atts, 50.0, 50.0, x, fs, n)
+    real_answer = transverse_response(motion, "in", shapes, np.full(len(shapes.frequencies), 1e-4), [], 50.0,
+                                      50.0, x, fs, n)
+    assert np.abs(complex_answer - real_answer).max() < 5e-5 * np.abs(real_answer).max()
+    # and a record of a damped stay with a deck mode is made end to end, the deck mode on its channels
+    rec = simulate_record(STAY, [Damper("d", 4.0, coefficient=2e4, angle=math.radians(30))], STAY_TENSION,
+                          [61.0, 61.0], directions=["in", "out"], duration=120.0, sampling_rate=10.0,
+                          bridge=BridgeConditions(anchorage_motion=[StructuralMode(0.65, 0.02,
+                                                                                  direction=(0.8, 0.6, 0.0))]))
+    assert np.all(np.isfinite(rec.acceleration)) and np.all(np.std(rec.acceleration, axis=0) > 0)
+
+
 @pytest.fixture(scope="module")
 def deck_record():
     deck = StructuralMode(0.65, 0.02, damping=0.01, end="B", direction=(0.6, 0.48, 0.64))
@@ -302,3 +355,106 @@ def test_two_hundred_ten_minute_biaxial_records_in_about_a_minute():
         elapsed = time.perf_counter() - start
     assert rec.n_samples == 30000
     assert elapsed < 90.0, f"{elapsed:.1f} s for 200 records"
+
+
+def test_command_line_makes_a_triaxial_campaign_with_a_deck_mode(tmp_path, capsys):
+    import json
+    from pathlib import Path
+
+    from stcs_ident.cli.main import main
+    from stcs_ident.io.records.hdf5 import read_record
+
+    han = Path(__file__).resolve().parents[1] / "campaigns" / "han2020"
+    out = tmp_path / "sim"
+    assert main(["simulate", str(han), "--out", str(out), "--test", "case1-L4", "--duration", "20", "--ambient", "2",
+                 "--sensors", "0.3,0.6", "--triaxial", "--deck-modes", "1.9:0.05", "--traffic", "60:0.02",
+                 "--misalignment", "3"]) == 0
+    record = read_record(out / "records" / "case1-L4.h5")
+    assert record.channel_directions == ("in", "out", "axial") * 2
+    assert record.channel_positions[0] == record.channel_positions[2] != record.channel_positions[3]
+    truth = json.loads((out / "truth.json").read_text())["tests"][0]
+    assert truth["structural_frequencies"] == [1.9] and truth["misalignment"] == [3.0] * 6
+    assert len(truth["frequencies_out"]) == len(truth["modes_out"]) > 0
+    # a bad value is one line naming the option
+    capsys.readouterr()
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--deck-modes", "1.9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--deck-modes" in err[0]
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--triaxial", "--directions", "in"]) == 2
+    capsys.readouterr()
+    assert main(["simulate", str(han), "--out", str(tmp_path / "bad"), "--traffic", "60"]) == 2  # nothing to swell
+    assert "--deck-modes" in capsys.readouterr().err
+
+
+def test_blows_act_in_their_direction():
+    x = [61.0, 61.0]
+    kw = {"duration": 30.0, "sampling_rate": 20.0, "directions": ["in", "out"]}
+    out_blow = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0, "out")], **kw)
+    assert np.all(out_blow.acceleration[:, 0] == 0) and np.abs(out_blow.acceleration[:, 1]).max() > 0
+    in_blow = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0)], **kw)
+    assert np.all(in_blow.acceleration[:, 1] == 0)
+    tilted = simulate_record(STAY, [], STAY_TENSION, x, impulses=[Impulse(1.0, 40.0, 50.0, 30.0)], **kw)
+    # cos 30° of the blow in-plane and sin 30° out of plane: the model is linear (to round-off)
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    np.testing.assert_allclose(tilted.acceleration[:, 0], c * in_blow.acceleration[:, 0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(tilted.acceleration[:, 1], s * out_blow.acceleration[:, 1], rtol=1e-9, atol=1e-12)
+
+
+def test_out_of_plane_loading_scales_with_its_ratio():
+    x = [61.0, 61.0]
+    kw = {"duration": 30.0, "sampling_rate": 20.0, "directions": ["in", "out"], "ambient": Ambient(2.0), "seed": 4}
+    one = simulate_record(STAY, [], STAY_TENSION, x, **kw).acceleration
+    two = simulate_record(STAY, [], STAY_TENSION, x, bridge=BridgeConditions(out_of_plane_ratio=2.0), **kw).acceleration
+    none = simulate_record(STAY, [], STAY_TENSION, x, bridge=BridgeConditions(out_of_plane_ratio=0.0),
+                           **kw).acceleration
+    assert np.array_equal(one[:, 0], two[:, 0])  # the in-plane loading is its own
+    # the same draws at twice the rms (to the round-off of the covariances' square roots)
+    np.testing.assert_allclose(two[:, 1], 2 * one[:, 1], rtol=1e-8, atol=1e-12 * np.abs(one[:, 1]).max())
+    assert np.all(none[:, 1] == 0)
+    # and the out-of-plane pressure is independent of the in-plane one: their correlation is small
+    # (|r| of two independent series with ~60 effective samples (30 s / 0.5 s) is below 3/√60 = 0.4)
+    r = np.corrcoef(one[:, 0], one[:, 1])[0, 1]
+    assert abs(r) < 0.4
+
+
+def test_a_drift_moves_both_planes_alike():
+    from stcs_ident.simulate import FieldConditions, TensionDrift
+
+    field = FieldConditions(drift=TensionDrift(amplitude=2e-3, period=20.0, walk=1e-4))
+    _, truth = simulate_record_with_truth(STAY, [], STAY_TENSION, [61.0, 61.0], directions=["in", "out"],
+                                          duration=30.0, sampling_rate=20.0, ambient=Ambient(2.0), field=field)
+    assert truth.out.drifts and np.array_equal(truth.out.relative_tension, truth.relative_tension)
+    # each plane's modes follow it with their own sensitivities (mode 1 in-plane is stiffened by the sag,
+    # whose share falls as the tension rises: its sensitivity differs from the out-of-plane string's 1/2)
+    assert truth.out.sensitivities[0] == pytest.approx(0.5, abs=0.01)  # a string's, to the bending's 1 %
+    assert abs(truth.sensitivities[0] - truth.out.sensitivities[0]) > 0.01
+
+
+def test_misaligned_axial_channel_reads_in_plane_motion():
+    delta = 5.0
+    rec = simulate_record(STAY, [], STAY_TENSION, [61.0, 61.0], directions=["in", "axial"],
+                          bridge=BridgeConditions(misalignment=(0.0, delta)), duration=30.0, sampling_rate=20.0,
+                          ambient=Ambient(2.0))
+    # no anchorage motion: the axial channel is sin δ of the in-plane motion alone (exactly, to round-off)
+    np.testing.assert_allclose(rec.acceleration[:, 1], math.sin(math.radians(delta)) * rec.acceleration[:, 0],
+                               rtol=1e-12, atol=1e-15)
+
+
+def test_structural_motion_has_its_rms_and_its_harmonics():
+    from stcs_ident.simulate.anchorage import anchorage_motion
+
+    fs, n = 20.0, 200_000
+    mode = StructuralMode(1.0, 0.03, damping=0.05, end="A", direction=(0.0, 0.0, 1.0), harmonics=(0.5,))
+    motion = anchorage_motion(BridgeConditions(anchorage_motion=[mode]), n, fs, np.random.default_rng(1))
+    assert set(motion.acceleration) == {"A"}
+    axial = motion.component("A", "axial")
+    assert not np.any(motion.component("A", "in"))
+    # rms² = fundamental² + harmonic² = (1 + 0.5²) A²: the harmonic r·A(t)cos 2θ has the fundamental's rms.
+    # Its envelope's time constant 1/(ζω) = 3.2 s gives ~1500 independent variance estimates in 10000 s:
+    # ±2.6 % (1σ) on the variance; 10 % is ~4σ
+    assert np.mean(axial**2) == pytest.approx(1.25 * mode.amplitude**2, rel=0.1)
+    f, p = welch(axial, fs, nperseg=4096)
+    peaks = f[np.argsort(p)[::-1]]
+    assert abs(peaks[0] - 1.0) < 0.02  # the fundamental, within its band (ζ f = 0.05 Hz half-width)
+    near_2 = (f > 1.8) & (f < 2.2)
+    assert abs(f[near_2][np.argmax(p[near_2])] - 2.0) < 0.1  # the 2nd harmonic, twice the band's width

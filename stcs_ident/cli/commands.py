@@ -50,6 +50,8 @@ COMMANDS: dict[str, Command] = {
     "simulate": Command("stcs_ident.cli.simulate",
                         "simulated records of a campaign's tests, with optional hidden effects",
                         ("stcs-ident simulate campaigns/han2020 --out sim/ --test case1-L4 --extra-mass 5@6.0 --seed 1",
+                         ("stcs-ident simulate campaigns/han2020 --out sim3d/ --test case1-L4 --ambient 2 --triaxial "
+                          "--deck-modes 1.9:0.05 --traffic 60:0.02 --misalignment 3"),
                          ARCHIVE_EXAMPLE)),
     "identify": Command("stcs_ident.cli.identify",
                         "correct tension, EI, attachment positions... from measured frequencies",

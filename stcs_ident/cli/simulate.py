@@ -47,6 +47,20 @@ def add_parser(sub) -> None:
     fld.add_argument("--float32", action="store_true", help="write single-precision samples")
     fld.add_argument("--field-random", action="store_true",
                      help="random field-like conditions per test (each part on with probability 0.75; from --seed)")
+    brg = sim.add_argument_group("both planes and the bridge (what a cable on a bridge records besides its "
+                                 "in-plane response; all off by default)")
+    brg.add_argument("--directions", metavar="D,...",
+                     help="channels per sensor position: in, out, axial or an angle in degrees (in,out: a biaxial "
+                          "sensor at each position; default in)")
+    brg.add_argument("--triaxial", action="store_true", help="same as --directions in,out,axial")
+    brg.add_argument("--misalignment", type=float, metavar="DEG",
+                     help="every sensor's true axis turned by DEG from its stated direction (planes mix)")
+    brg.add_argument("--deck-modes", metavar="F:A[:END],...",
+                     help="deck modes moving an anchorage: frequency F Hz, rms acceleration A m/s2, end A or B "
+                          "(default B), vertical (in-plane and axial by the cable's inclination)")
+    brg.add_argument("--traffic", metavar="RATE[:B]",
+                     help="vehicles per hour crossing: bursts that triple the deck motion, with broadband "
+                          "anchorage motion of rms B m/s2 (default 0)")
     eff = sim.add_argument_group("hidden effects (in the records, not in the written campaign)")
     for effect in effects.effects():
         if effect.option is not None:
@@ -74,6 +88,11 @@ def run(args: argparse.Namespace) -> int:
     file = str(campaign_file(args.campaign))
     check_outputs([("--out", args.out, True)], campaign_inputs(campaign, file))
     if args.archive is not None:
+        for flag, given in (("--directions", args.directions), ("--triaxial", args.triaxial or None),
+                            ("--misalignment", args.misalignment), ("--deck-modes", args.deck_modes),
+                            ("--traffic", args.traffic)):
+            if given is not None:
+                raise InputError("applies to a campaign's records, not to an archive (--archive)", field=flag)
         if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
             raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
         return simulate_archive_from_args(args, campaign)
@@ -84,6 +103,10 @@ def run(args: argparse.Namespace) -> int:
     if not all(0 < x < 1 for x in fractions):
         raise InputError("fractions of the length must lie in (0, 1)", field="--sensors")
     length = campaign.cable.length
+    directions = _directions(args)
+    per_position = len(directions) if directions is not None else 1
+    positions = [f * length for f in fractions for _ in range(per_position)]
+    bridge = _bridge(args, campaign)
     hidden = {}
     for effect in effects.effects():
         given = getattr(args, f"effect_{effect.name}", None)
@@ -95,14 +118,71 @@ def run(args: argparse.Namespace) -> int:
     if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
         raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
     effect = Effects(**hidden) if hidden else None  # a refusal names effects.<key>, shown as its option
-    field = _field_conditions(args, campaign, len(fractions))
-    out = simulate_campaign(campaign, args.out, positions=[f * length for f in fractions],
+    field = _field_conditions(args, campaign, len(positions))
+    out = simulate_campaign(campaign, args.out, positions=positions,
+                            directions=None if directions is None else directions * len(fractions), bridge=bridge,
                             duration=args.duration, sampling_rate=args.sampling_rate, tests=args.test,
                             damping=args.damping, impulses=impulses, ambient=ambient, snr_db=args.snr,
                             effects=effect, seed=args.seed, overwrite=args.overwrite, field=field,
                             progress=lambda k, n: progress_line(f"simulate: test {k} of {n}"))
     print(f"wrote {out}")
     return 0
+
+
+def _directions(args) -> list | None:
+    """The channels' directions at each sensor position (``--directions``, ``--triaxial``), or None."""
+    from ..core.errors import ModelError
+    from ..core.planes import check_direction
+
+    if args.triaxial and args.directions is not None:
+        raise InputError("give --directions or --triaxial, not both", field="--triaxial")
+    if args.triaxial:
+        return ["in", "out", "axial"]
+    if args.directions is None:
+        return None
+    try:
+        return [check_direction(d) for d in args.directions.split(",")]
+    except ModelError as err:
+        raise InputError(err.message, field="--directions") from None
+
+
+def _bridge(args, campaign):
+    """``--misalignment``, ``--deck-modes`` and ``--traffic`` as BridgeConditions, or None."""
+    import math
+
+    from ..core.errors import ModelError
+    from ..simulate import BridgeConditions, StructuralMode, Traffic
+
+    theta = campaign.cable.inclination
+    vertical = (math.cos(theta), 0.0, math.sin(theta))  # a deck's vertical motion in the cable's frame
+
+    def deck_mode(text):
+        parts = text.split(":")
+        if len(parts) not in (2, 3):
+            raise ValueError(f"expected F:A or F:A:END, got {text!r}")
+        return StructuralMode(float(parts[0]), float(parts[1]), end=parts[2] if len(parts) == 3 else "B",
+                              direction=vertical)
+
+    def traffic(text):
+        rate, _, broadband = text.partition(":")
+        return Traffic(float(rate), broadband=float(broadband) if broadband else 0.0, direction=vertical)
+
+    parts = {}
+    try:
+        flag = "--misalignment"
+        if args.misalignment is not None:
+            parts["misalignment"] = args.misalignment
+        flag = "--deck-modes"
+        if args.deck_modes is not None:
+            parts["anchorage_motion"] = tuple(deck_mode(t) for t in args.deck_modes.split(","))
+        flag = "--traffic"
+        if args.traffic is not None:
+            parts["traffic"] = traffic(args.traffic)
+            if not parts.get("anchorage_motion") and parts["traffic"].broadband == 0:
+                raise ValueError("swells the deck motion: give --deck-modes too, or a broadband level (RATE:B)")
+        return BridgeConditions(**parts) if parts else None
+    except (ValueError, ModelError) as err:
+        raise InputError(" ".join(str(getattr(err, "message", err)).split()), field=flag) from None
 
 
 def _field_conditions(args, campaign, n_channels: int):

@@ -102,8 +102,11 @@ def mode_shapes(cable: Cable, attachments: Sequence[Attachment], tension: float,
         return _mode_shapes(cable, attachments, tension, n_modes, tension_model)
     except _NodesAtRest:
         node = _null_node(cable.length, attachments)
-        shapes = _mode_shapes(cable, (*attachments, node), tension, n_modes, tension_model)
-        return shapes
+        try:
+            return _mode_shapes(cable, (*attachments, node), tension, n_modes, tension_model)
+        except _NodesAtRest:  # a bare string: one null node is one unknown, too few to tell a null vector
+            second = _null_node(cable.length, (*attachments, node))
+            return _mode_shapes(cable, (*attachments, node, second), tension, n_modes, tension_model)
 
 
 class _NodesAtRest(ComputationError):

@@ -52,11 +52,13 @@ from scipy.signal import hilbert
 from ..core.model import Attachment
 from ..forward.shapes import ModeShapes
 from .bridge import ENDS, BridgeConditions, StructuralMode, Traffic
+from .damped_modes import DampedModes
 
 __all__ = ["AnchorageMotion", "anchorage_motion", "axial_response", "chord_weight", "transverse_response"]
 
 #: Components of a motion, in the order of StructuralMode.direction.
 COMPONENTS = ("in", "out", "axial")
+_FREQUENCY_BLOCK = 2048  # frequency bins per block of the modal gains (bounds memory to BLOCK × n_modes)
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,29 +111,69 @@ def chord_weight(end: str, x: np.ndarray, length: float) -> np.ndarray:
     return s if end == "B" else 1.0 - s
 
 
-def transverse_response(motion: AnchorageMotion, plane: str, shapes: ModeShapes, damping: np.ndarray,
-                        masses: Sequence[Attachment], length: float, mass_per_length: float, x: np.ndarray,
-                        sampling_rate: float, n_samples: int) -> np.ndarray:
+def transverse_response(motion: AnchorageMotion, plane: str, shapes: ModeShapes | DampedModes,
+                        damping: np.ndarray | None, masses: Sequence[Attachment], length: float,
+                        mass_per_length: float, x: np.ndarray, sampling_rate: float, n_samples: int) -> np.ndarray:
     """The absolute acceleration (n_samples, len(x)) of the cable's ``plane`` motion under the anchorages'
     ``plane`` components (the module docstring derives it).
 
-    ``shapes`` and ``damping`` are the plane's fixed-end modes and ratios, ``masses`` the attachments (their
-    masses ride on the chord line).
+    ``shapes`` and ``damping`` are the plane's fixed-end modes and ratios, or ``shapes`` its complex modes
+    (:class:`~stcs_ident.simulate.damped_modes.DampedModes`, ``damping`` None) for a cable with dampers;
+    ``masses`` the attachments (their masses ride on the chord line).
     """
     out = np.zeros((n_samples, len(x)))
     omega = 2 * math.pi * np.fft.rfftfreq(n_samples, 1.0 / sampling_rate)
-    wk = 2 * math.pi * np.asarray(shapes.frequencies, float)
-    gain = None
-    phi_x = shapes(x)  # (n_ch, N)
     for end in ENDS:
         u = motion.component(end, plane)
         if u is None or not np.any(u):
             continue
-        if gain is None:
-            gain = omega[:, None] ** 2 / (wk**2 - omega[:, None] ** 2 + 2j * damping * wk * omega[:, None])
-        gamma = _participation(shapes, end, masses, length, mass_per_length)
-        tf = chord_weight(end, x, length)[None, :] + gain @ (gamma[:, None] * phi_x.T)  # (n_f, n_ch)
+        if isinstance(shapes, DampedModes):
+            modal = _complex_modal_gain(shapes, end, masses, length, mass_per_length, x, omega)
+        else:
+            modal = _modal_gain(shapes, damping, end, masses, length, mass_per_length, x, omega)
+        tf = chord_weight(end, x, length)[None, :] + modal  # (n_f, n_ch)
         out += np.fft.irfft(np.fft.rfft(u)[:, None] * tf, n=n_samples, axis=0)
+    return out
+
+
+def _modal_gain(shapes: ModeShapes, damping: np.ndarray, end: str, masses, length: float, mass_per_length: float,
+                x: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Σ_k φ_k(x) Γ_k ω² / (ω_k² − ω² + 2iζ_kω_kω), (n_f, n_ch): in real arithmetic, a block of frequencies
+    at a time (the (n_f, n_modes) complex gains of a long record at a high rate would be hundreds of MB)."""
+    wk = 2 * math.pi * np.asarray(shapes.frequencies, float)
+    read = _participation(shapes, end, masses, length, mass_per_length)[:, None] * shapes(x).T  # (N, n_ch)
+    out = np.empty((len(omega), len(x)), dtype=complex)
+    for start in range(0, len(omega), _FREQUENCY_BLOCK):
+        w = omega[start:start + _FREQUENCY_BLOCK, None]
+        real = wk**2 - w**2
+        imag = 2 * damping * wk * w
+        scale = w**2 / (real**2 + imag**2)
+        out[start:start + len(w)].real = (scale * real) @ read
+        out[start:start + len(w)].imag = -(scale * imag) @ read
+    return out
+
+
+def _complex_modal_gain(modes: DampedModes, end: str, masses, length: float, mass_per_length: float,
+                        x: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The complex modes' answer to the chord line's inertia load, (n_f, n_ch).
+
+    The load −m s(x) ü gives the Ritz forces −g ü (g_i = ∫ m b_i s dx + Σ M_a b_i(x_a) s(x_a)) and the modal
+    forces u_j = −c_j ü, c_j = q_jᵀ g. With η̇_j = s_j η_j + u_j the sensor reads Re z, z = Σ_j w_j φ_j(x)
+    s_j (s_j η_j + u_j), whose transfer from ü is G(ω) = −Σ_j w_j φ_j(x) s_j c_j iω / (iω − s_j); a real
+    signal's Re z has the transfer (G(ω) + conj G(−ω)) / 2. The dashpots act on the relative motion only
+    (a damper riding on the moving anchorage's structure), as the intrinsic damping does.
+    """
+    c = modes.to_modal.T @ _participation(modes.basis, end, masses, length, mass_per_length)  # (p,)
+    read = modes.shapes(x) * (modes.weights * modes.poles * c)[None, :]  # (n_ch, p)
+    s = modes.poles
+
+    def g(w):
+        return -(1j * w[:, None] / (1j * w[:, None] - s[None, :])) @ read.T
+
+    out = np.empty((len(omega), len(x)), dtype=complex)
+    for start in range(0, len(omega), _FREQUENCY_BLOCK):
+        w = omega[start:start + _FREQUENCY_BLOCK]
+        out[start:start + len(w)] = 0.5 * (g(w) + np.conj(g(-w)))
     return out
 
 
@@ -145,7 +187,7 @@ def axial_response(motion: AnchorageMotion, x: np.ndarray, length: float, n_samp
     return out
 
 
-def _participation(shapes: ModeShapes, end: str, attachments: Sequence[Attachment], length: float,
+def _participation(shapes, end: str, attachments: Sequence[Attachment], length: float,
                    mass_per_length: float) -> np.ndarray:
     """Γ_k = ∫ m φ_k s dx + Σ_a M_a φ_k(x_a) s(x_a), s the chord weight of ``end``."""
     xq, wq = shapes.quadrature()

@@ -59,7 +59,8 @@ def damped_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
                   sampling_rate: float, n_samples: int, *, damping: Callable[[int], np.ndarray],
                   n_modes: int | None, band_fraction: float, impulses: Sequence, ambient_load: tuple | None,
                   field: FieldConditions | None, rng: np.random.Generator, field_rng: np.random.Generator | None,
-                  progress: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, RecordTruth]:
+                  progress: Callable[[int, int], None] | None = None,
+                  modes: DampedModes | None = None) -> tuple[np.ndarray, RecordTruth]:
     """The noise-free record of a cable with dampers and what it truly holds.
 
     Parameters
@@ -79,6 +80,10 @@ def damped_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         Only its coloured loading and drift act here (the sensor side is the caller's).
     rng, field_rng :
         The signal's stream and the disturbances' own (for a drift's random walk).
+    modes : DampedModes or None
+        The complex modes, if the caller has them already
+        (:func:`~stcs_ident.simulate.damped_modes.damped_modes` of the same
+        arguments); None: computed here.
 
     Returns
     -------
@@ -89,7 +94,8 @@ def damped_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         sensitivity Re κ (its frequency's, as for the undamped records).
     """
     fs = float(sampling_rate)
-    modes = damped_modes(cable, attachments, tension, fs, n_modes, damping, band_fraction)
+    if modes is None:
+        modes = damped_modes(cable, attachments, tension, fs, n_modes, damping, band_fraction)
     truth = RecordTruth(modes.frequencies, tension, fs, n_samples, damping=modes.damping)
     force_sqrt = None
     if ambient_load is not None:

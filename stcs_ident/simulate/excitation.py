@@ -24,6 +24,7 @@ from ..core.record import sampling_rate as record_sampling_rate
 from ..forward.dsm import count_below
 from ..forward.shapes import ModeShapes, mode_shapes
 from .conditions import FieldConditions, RecordTruth
+from .damped_modes import DampedModes, damped_modes
 from .damped_response import damped_record
 from .disturbances import lowpass_force_filter, relative_tension, tension_sensitivities
 from .field_response import superpose_field
@@ -86,7 +87,11 @@ class Impulse:
         if self.direction == "out":
             return self.magnitude if plane == "out" else 0.0
         angle = direction_angle(self.direction)
-        return self.magnitude * (math.cos(angle) if plane == "in" else math.sin(angle))
+        if self.direction % 90.0 == 0.0:  # ±180°, -90°: exact, as "in" and "out" are
+            c, s = round(math.cos(angle)), round(math.sin(angle))
+        else:
+            c, s = math.cos(angle), math.sin(angle)
+        return self.magnitude * (c if plane == "in" else s)
 
 
 @dataclass(frozen=True)
@@ -123,13 +128,14 @@ class PlaneSignal:
     """One plane's noise-free response and what it holds.
 
     ``shapes`` and ``damping`` are the undamped modes and their ratios (None for a cable with dampers, whose
-    complex modes are :mod:`~stcs_ident.simulate.damped_response`'s).
+    complex modes are ``complex_modes``, :mod:`~stcs_ident.simulate.damped_modes`'s).
     """
 
-    clean: np.ndarray
+    clean: np.ndarray | None
     truth: RecordTruth
     shapes: ModeShapes | None = None
     damping: np.ndarray | None = None
+    complex_modes: DampedModes | None = None
 
 
 def plane_model(cable: Cable, attachments: Sequence[Attachment], plane: str) -> tuple[Cable, tuple]:
@@ -154,11 +160,13 @@ def plane_signal(cable: Cable, attachments: Sequence[Attachment], tension: float
     """
     if has_dampers(attachments):
         load = None if ambient is None else (ambient.rms_pressure, ambient.correlation_length, UNCORRELATED_LENGTH)
+        modes = damped_modes(cable, attachments, tension, fs, n_modes, lambda n: modal_damping(damping, n),
+                             NYQUIST_FRACTION)
         clean, truth = damped_record(cable, attachments, tension, x, fs, n_samples,
                                      damping=lambda n: modal_damping(damping, n), n_modes=n_modes,
                                      band_fraction=NYQUIST_FRACTION, impulses=impulses, ambient_load=load,
-                                     field=field, rng=rng, field_rng=own_rng, progress=progress)
-        return PlaneSignal(clean, truth)
+                                     field=field, rng=rng, field_rng=own_rng, progress=progress, modes=modes)
+        return PlaneSignal(clean, truth, complex_modes=modes)
     shapes = modal_basis(cable, attachments, tension, fs, n_modes)
     zeta = modal_damping(damping, len(shapes.frequencies))
     force_sqrt = None

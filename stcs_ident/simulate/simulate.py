@@ -151,7 +151,10 @@ def simulate_record(cable: Cable, attachments: Sequence[Attachment], tension: fl
         them (``Record.channel_directions``). None: every channel
         in-plane, and the record states no directions (as before they
         existed). When a channel reads out-of-plane motion, the
-        out-of-plane modes are simulated too (:mod:`.two_planes`).
+        out-of-plane modes are simulated too (:mod:`.two_planes`). An
+        axial channel reads only the anchorages' axial motion (the cable's
+        transverse modes give no axial acceleration to first order); its
+        ``snr_db`` noise is at the transverse channels' mean noise level.
     bridge : BridgeConditions or None
         A cable on a bridge (:mod:`~stcs_ident.simulate.bridge`): the
         out-of-plane loading's level, misaligned sensors, deck and pylon

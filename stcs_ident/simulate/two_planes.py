@@ -31,13 +31,24 @@ import numpy as np
 
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable, has_dampers
-from ..core.planes import check_direction, direction_angle
+from ..core.planes import check_direction
 from ..core.record import Record
 from .anchorage import anchorage_motion, axial_response, transverse_response
 from .bridge import BridgeConditions
 from .conditions import FieldConditions, RecordTruth
+from .damped_modes import damped_modes
 from .disturbances import apply_sensor_disturbances, field_rng
-from .excitation import Ambient, Impulse, PlaneSignal, Progress, modal_basis, modal_damping, plane_model, plane_signal
+from .excitation import (
+    NYQUIST_FRACTION,
+    Ambient,
+    Impulse,
+    PlaneSignal,
+    Progress,
+    modal_basis,
+    modal_damping,
+    plane_model,
+    plane_signal,
+)
 
 __all__ = ["check_channel_directions", "planes_record"]
 
@@ -73,20 +84,19 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         raise ModelError(f"must be a BridgeConditions or None, got {type(bridge).__name__}", field="bridge")
     n_ch = len(x)
     stated = directions if directions is not None else ("in",) * n_ch
-    delta = np.radians(bridge.misalignment_per_channel(n_ch))
-    angles = [direction_angle(d) for d in stated]  # None: axial
-    true = [None if a is None else a + float(dl) for a, dl in zip(angles, delta)]
-    reads_in = [a is not None and math.cos(a) != 0.0 or a is None and dl != 0.0 for a, dl in zip(true, delta)]
-    reads_out = [a is not None and math.sin(a) != 0.0 for a in true]
-    axial = [a is None for a in true]
+    delta_deg = bridge.misalignment_per_channel(n_ch)
+    delta = np.radians(delta_deg)
+    # each transverse channel's true axis as (cos, sin) from in-plane; exact at multiples of 90° (an "out"
+    # channel reads nothing of the in-plane motion, not cos(π/2) = 6e-17 of it)
+    axes = [None if d == "axial" else _cos_sin(_degrees(d) + float(dl)) for d, dl in zip(stated, delta_deg)]
+    axial = [a is None for a in axes]
+    reads_in = [a[0] != 0.0 if a is not None else dl != 0.0 for a, dl in zip(axes, delta)]
+    reads_out = [a is not None and a[1] != 0.0 for a in axes]
     if has_dampers(attachments):
         if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
                                     or n_modes < 1):
             raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
         modal_damping(damping, 1)  # its checks before any work
-        if bridge.moves_anchorages:
-            raise ModelError("moving anchorages are simulated for cables without dampers only (their complex "
-                             "modes' answer to a support motion is not modelled yet)", field="bridge.anchorage_motion")
 
     rng = np.random.default_rng(seed)
     own_rng = field_rng(rng) if field is not None else None
@@ -109,7 +119,7 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
         sig_out = plane_signal(*model_out, tension, x, fs, n_samples, damping=damping,
                                impulses=_plane_impulses(impulses, "out"), ambient=ambient_out, n_modes=n_modes,
                                rng=out_rng, own_rng=out_field_rng, field=field)
-    elif not has_dampers(model_out[1]):  # no channel reads it: its modes only, for the truth and the anchorages
+    else:  # no channel reads it: its modes only, for the truth
         sig_out = _modes_only(model_out, tension, fs, n_samples, damping, n_modes)
 
     clean = np.zeros((n_samples, n_ch))
@@ -128,18 +138,31 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
             if reads_in[c]:
                 clean[:, c] += math.sin(delta[c]) * transverse_in[:, c]
             continue
-        a = true[c]
-        clean[:, c] = math.cos(a) * transverse_in[:, c] if reads_in[c] else 0.0
+        cos_a, sin_a = axes[c]
+        clean[:, c] = cos_a * transverse_in[:, c] if reads_in[c] else 0.0
         if reads_out[c]:
-            clean[:, c] += math.sin(a) * transverse_out[:, c]
+            clean[:, c] += sin_a * transverse_out[:, c]
     signal = _noisy(clean, snr_db, rng, axial)
     if field is not None:
         signal = apply_sensor_disturbances(signal, clean, fs, field, own_rng)
     truth = replace(sig_in.truth, out=None if sig_out is None else sig_out.truth,
                     structural=bridge.anchorage_motion,
-                    misalignment=None if bridge.misalignment is None else np.degrees(delta),
+                    misalignment=None if bridge.misalignment is None else bridge.misalignment_per_channel(n_ch),
                     channel_directions=directions, crossings=None if motion is None else motion.crossings)
     return Record(signal, fs, names, x, channel_directions=directions), truth
+
+
+def _degrees(direction) -> float:
+    """A transverse direction in degrees from in-plane."""
+    return {"in": 0.0, "out": 90.0}.get(direction, direction) if isinstance(direction, str) else float(direction)
+
+
+def _cos_sin(degrees: float) -> tuple[float, float]:
+    """(cos, sin) of an angle in degrees, exact at multiples of 90°."""
+    quarter, rest = divmod(degrees, 90.0)
+    if rest == 0.0:
+        return ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[int(quarter) % 4]
+    return math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
 
 
 def _plane_impulses(impulses: Sequence[Impulse], plane: str) -> list[Impulse]:
@@ -154,9 +177,13 @@ def _plane_impulses(impulses: Sequence[Impulse], plane: str) -> list[Impulse]:
 
 
 def _modes_only(model, tension: float, fs: float, n_samples: int, damping, n_modes) -> PlaneSignal:
-    """The out-of-plane modes of a cable without dampers (for the truth and the anchorages' answer) when no
-    channel reads that plane."""
+    """The out-of-plane modes (for the truth) when no channel reads that plane."""
     cable, atts = model
+    if has_dampers(atts):
+        modes = damped_modes(cable, atts, tension, fs, n_modes, lambda n: modal_damping(damping, n),
+                             NYQUIST_FRACTION)
+        return PlaneSignal(None, RecordTruth(modes.frequencies, tension, fs, n_samples, damping=modes.damping),
+                           complex_modes=modes)
     shapes = modal_basis(cable, atts, tension, fs, n_modes)
     zeta = modal_damping(damping, len(shapes.frequencies))
     return PlaneSignal(None, RecordTruth(np.asarray(shapes.frequencies, float), tension, fs, n_samples,
@@ -165,7 +192,8 @@ def _modes_only(model, tension: float, fs: float, n_samples: int, damping, n_mod
 
 def _anchorage_answer(motion, plane: str, sig: PlaneSignal, model, x, fs, n_samples) -> np.ndarray:
     cable, atts = model
-    return transverse_response(motion, plane, sig.shapes, sig.damping, atts, cable.length, cable.mass_per_length,
+    modes = sig.complex_modes if sig.complex_modes is not None else sig.shapes
+    return transverse_response(motion, plane, modes, sig.damping, atts, cable.length, cable.mass_per_length,
                                x, fs, n_samples)
 
 
