@@ -122,7 +122,7 @@ def test_a_record_without_directions_is_read_in_plane_and_says_so():
     r = _analyse(case.__class__(plain, case.campaign, case.test, case.truth))
     assert r.planes is None and set(r.mode_planes) == {"in"} and r.structural == ()
     assert [str(n) for n in r.notes] == [NO_DIRECTIONS]
-    assert r.summary()["notes"] == [NO_DIRECTIONS] and r.summary()["plane"] == ["in"] * len(r.modes)
+    assert r.summary()["notes"] == [NO_DIRECTIONS] and r.summary()["planes"] == ["in"] * len(r.modes)
     truth = case.truth["in"]
     z = (r.frequencies - truth[np.array(r.modes) - 1]) / r.uncertainty
     assert len(r.modes) >= 5 and np.all(np.abs(z) < 4)  # 4σ: a 1-in-16000 miss per mode for an honest 1σ
@@ -171,7 +171,7 @@ def test_deck_modes_are_structural_and_reported():
         assert abs(f - case.truth[plane][mode - 1]) < 4 * u, (plane, mode)
     summary = json.loads(json.dumps(r.summary()))  # JSON-able
     assert {s["frequency"] for s in summary["structural"]} == set(structural)
-    assert summary["plane"] == list(r.mode_planes) and len(summary["shape"]) == len(r.modes)
+    assert summary["planes"] == list(r.mode_planes) and len(summary["shape"]) == len(r.modes)
     assert set(summary["shape"][0]) <= set(case.record.channel_names)
     table = modes_table([r])
     assert table["plane"].tolist() == list(r.mode_planes) and "mac" in table

@@ -158,7 +158,7 @@ class TestSpectra(PickingResult):
             "dropped_channels": [{"channel": c, "reason": r} for c, r in self.dropped],
             "options": self.options.summary(), "record_replaced": [
                 {"option": option, "given": given, "file": found} for option, given, found in self.record_replaced],
-            "plane": list(self.mode_planes), "mac": [None if math.isnan(x) else float(x) for x in self._macs()],
+            "planes": list(self.mode_planes), "mac": [None if math.isnan(x) else float(x) for x in self._macs()],
             "shape": [dict(s) for s in self.shapes] if self.shapes is not None else [{} for _ in self.modes],
             "structural": [{"frequency": f, "uncertainty": u, "reason": r} for f, u, r in self.structural],
             "plane_options": self.plane_options.summary(), "notes": [str(n) for n in self.notes],
