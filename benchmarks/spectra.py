@@ -38,16 +38,15 @@ the minimum over the runs and, when ``threadpoolctl`` is importable (it
 comes with pyOMA-2's scikit-learn), the time with BLAS limited to one
 thread, and prints the load average.
 
-Planes: ``python benchmarks/spectra.py --planes [--repeat N]`` times :func:`analyse_record` on a biaxial
-record of the stay with deck modes (benchmarks/plane_records.py: 3 positions x in/out, 400 s at 12.8 Hz),
-read per plane (with its channel directions) and read as one plane (the same record without them, as
-every record was read before the planes), and prints the seconds per channel of each (minimum over N
-interleaved runs, default 5). Run with another checkout's package first on ``PYTHONPATH`` to time that
-code on the same records (a checkout without the planes reads both as one plane; copy the compiled
-forward kernels, ``stcs_ident/forward/_*_kernel*.so``, into it, or its pure-Python fallback is timed).
-Measured (2 idle cores, min of 5): main at 385a164 23.0 ms per channel; this code 23.5 read as one plane
-(+2 %: the MAC of each mode) and 34.2 read per plane (1.49x: each plane's modes are fitted and numbered on
-their own, where one plane's reading fits an in/out pair as one merged peak).
+Planes: ``python benchmarks/spectra.py --planes [--repeat N] [--baseline PYTHON]`` times
+:func:`analyse_record` on biaxial records of the stay with deck modes (benchmarks/plane_records.py: 3
+positions x in/out, 400 s at 12.8 Hz), read per plane (with their channel directions) and read as one plane
+(the same records without them, as every record was read before the planes), and prints the seconds per
+channel of each (minimum over N runs, default 5). With ``--baseline PYTHON`` (an interpreter with another
+stcs_ident installed, e.g. ``python3 -m venv /tmp/venv-base && /tmp/venv-base/bin/pip install <checkout of
+the code before the planes>``) the same records are pickled and timed by that code too
+(benchmarks/time_records.py), and the ratios printed: the issue's baseline is the code before the planes,
+which reads a biaxial record as one plane.
 
 Run: ``python benchmarks/spectra.py [--quick]`` (about 1.5 minutes on two idle
 cores; ``--quick``: one record per case, one timing repeat, about 25 s), or
@@ -417,45 +416,53 @@ def print_throughput(tp: dict) -> None:
         print("  (other processes were running: wall times are inflated; compare the min column and the 1-thread row)")
 
 
-def planes_throughput(repeat: int = 5, seeds=(0, 1, 2)) -> dict:
+def planes_throughput(repeat: int = 5, seeds=(0, 1, 2), baseline: str | None = None) -> dict:
     """Seconds per channel of analyse_record on biaxial records of the stay read per plane and read as one
-    plane (minimum over ``repeat`` interleaved runs, summed over the seeds' records)."""
-    import warnings
-    from dataclasses import replace
-
-    from stcs_ident.spectra.pipeline import analyse_record
+    plane (minimum over ``repeat`` runs, summed over the seeds' records); with ``baseline`` (another Python,
+    with another stcs_ident installed) that code's times on the same records too."""
+    import json
+    import pickle
+    import subprocess
+    import tempfile
 
     try:
         from benchmarks.plane_records import make_case
+        from benchmarks.time_records import seconds_per_channel
     except ImportError:  # run as a script from the repository's root
         from plane_records import make_case
+        from time_records import seconds_per_channel
 
     cases = [make_case("stay", seed, layout="biaxial") for seed in seeds]
-    times = {"planes": [], "one plane": []}
-    n_channels = sum(c.record.n_channels for c in cases)
-    for _ in range(repeat):
-        for label, runs in times.items():
-            total = 0.0
-            for c in cases:
-                record = c.record if label == "planes" else replace(c.record, channel_directions=None)
-                record = replace(record, acceleration=record.acceleration.copy())  # analysed in place
-                t = time.perf_counter()
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    analyse_record(c.campaign, c.test, record, "bench")
-                total += time.perf_counter() - t
-            runs.append(total / n_channels)
-    return {label: min(v) for label, v in times.items()} | {"n_channels": n_channels, "repeat": repeat,
-                                                            "records": len(cases)}
+    records = [(c.campaign, c.test, c.record) for c in cases]
+    out = {"this": seconds_per_channel(records, repeat), "n_channels": sum(c.record.n_channels for c in cases),
+           "repeat": repeat, "records": len(cases)}
+    if baseline is not None:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "records.pickle")
+            with open(path, "wb") as stream:
+                pickle.dump(records, stream)
+            script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "time_records.py")
+            done = subprocess.run([baseline, script, path, "--repeat", str(repeat)], capture_output=True, text=True,
+                                  check=True, cwd=tmp)  # not this checkout: the baseline's installed package
+        out["baseline"] = json.loads(done.stdout.strip().splitlines()[-1])
+    return out
 
 
 def print_planes_throughput(tp: dict) -> None:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"\nPlanes: analyse_record on {tp['records']} biaxial records of the stay ({tp['n_channels']} channels in "
           f"all), minimum of {tp['repeat']} runs, load average {load:.2f}")
+    this = tp["this"]
     for label in ("planes", "one plane"):
-        print(f"  read {label:>9}: {1e3 * tp[label]:8.1f} ms per channel")
-    print(f"  ratio planes / one plane: {tp['planes'] / tp['one plane']:.2f}")
+        print(f"  this code, read {label:>9}: {1e3 * this[label]:8.1f} ms per channel")
+    print(f"  ratio planes / one plane: {this['planes'] / this['one plane']:.2f}")
+    if "baseline" in tp:
+        base = tp["baseline"]
+        path = "compiled kernel" if base["kernel"] else "numpy fallback"
+        print(f"  baseline ({base['package']}, {path}), every record read as it reads them: "
+              f"{1e3 * base['one plane']:8.1f} ms per channel")
+        print(f"  ratio this code per plane / baseline: {this['planes'] / base['one plane']:.2f}; "
+              f"one plane / baseline: {this['one plane'] / base['one plane']:.2f}")
 
 
 def main(argv=None) -> int:
@@ -466,9 +473,12 @@ def main(argv=None) -> int:
     parser.add_argument("--planes", action="store_true",
                         help="only the per-channel time of a biaxial record read per plane and as one plane")
     parser.add_argument("--repeat", type=int, default=5, help="timing runs with --throughput (default 5)")
+    parser.add_argument("--baseline", metavar="PYTHON",
+                        help="with --planes: also time the same records with the stcs_ident of this Python")
     args = parser.parse_args(argv)
     if args.planes:
-        print_planes_throughput(planes_throughput(max(1, args.repeat)))
+        print_header()
+        print_planes_throughput(planes_throughput(max(1, args.repeat), baseline=args.baseline))
         return 0
     print_header()
     if args.throughput:
