@@ -31,6 +31,7 @@ def psd(signal, fs, nperseg=4096):
     return welch(signal, fs, nperseg=nperseg)
 
 
+@pytest.mark.slow  # several records of each kind: about 10 s
 def test_default_records_are_unchanged():
     """Directions all in-plane, or BridgeConditions(), take the new path and give the old record bit for bit
     (the in-plane signal and the noise are drawn as before; only the record's stated directions differ)."""
@@ -177,6 +178,7 @@ def test_a_deck_mode_at_a_cable_frequency_resonates_in_that_modes_shape():
     assert abs(got[:, 0] @ u) < 0.1 * abs(got[:, 0] @ quadrature)
 
 
+@pytest.mark.slow  # complex modes of an FE model: about 15 s
 def test_support_motion_answer_of_complex_modes_matches_the_real_modes_for_a_negligible_damper():
     """A cable with a damper answers through its complex modes; with a dashpot of 1 N s/m (ζ added ~1e-7) the
     answer is the undamped modes' one, to the finite-element Ritz basis's error against the exact shapes
@@ -417,6 +419,7 @@ def test_out_of_plane_loading_scales_with_its_ratio():
     assert abs(r) < 0.4
 
 
+@pytest.mark.slow  # drifting records in both planes: about 20 s
 def test_a_drift_moves_both_planes_alike():
     from stcs_ident.simulate import FieldConditions, TensionDrift
 
