@@ -217,12 +217,21 @@ def position_uncertainty(campaign: Campaign, measurements: Sequence[Measurement]
     J = problem.jacobian(x)
     if not np.all(np.isfinite(J)):
         return {}
-    cov = np.linalg.pinv(J.T @ J)
+    normal = J.T @ J
+    length = campaign.cable.length
     out = {}
     for j, q in enumerate(problem.parameters):
         if q.kind == "position" and not q.slots and q.member in members:
-            var = cov[j, j]
-            out[q.member] = float(q.value_uncertainty(x[j], math.sqrt(var))) if var > 0 else math.inf
+            # The conditional precision of the position, the others free (a Schur complement). A position the
+            # frequencies do not feel (a mass at midspan: every mode's slope there is 0 or its shape's, and the
+            # Jacobian's column is rounding noise) has none; pinv of the whole matrix gave such a column a
+            # variance of 0 or of 1e4 m by the noise of the differences, and so a prior cost that moved
+            # from one run of the same data to another.
+            others = [i for i in range(J.shape[1]) if i != j]
+            precision = normal[j, j] - (normal[j, others] @ np.linalg.pinv(normal[np.ix_(others, others)])
+                                        @ normal[others, j] if others else 0.0)
+            sigma = float(q.value_uncertainty(x[j], 1.0 / math.sqrt(precision))) if precision > 0 else math.inf
+            out[q.member] = sigma if sigma < length else math.inf  # beyond the span: the data cannot place it
     return out
 
 
