@@ -193,6 +193,17 @@ def plane_signal(cable: Cable, attachments: Sequence[Attachment], tension: float
     return PlaneSignal(clean, truth, shapes, zeta)
 
 
+def check_damped_inputs(attachments: Sequence[Attachment], n_modes, damping) -> None:
+    """With a damper among ``attachments``, the checks of ``n_modes`` and ``damping`` made before any work (the
+    complex modes are solved first, and would take these values unchecked)."""
+    if not has_dampers(attachments):
+        return
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
+                                or n_modes < 1):
+        raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
+    modal_damping(damping, 1)
+
+
 def modal_basis(cable: Cable, attachments: Sequence[Attachment], tension: float, sampling_rate: float,
                 n_modes: int | None = None) -> ModeShapes:
     """The modes a record at ``sampling_rate`` contains.

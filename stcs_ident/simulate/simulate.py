@@ -54,7 +54,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.errors import ModelError
-from ..core.model import Attachment, Cable, has_dampers, real_number
+from ..core.model import Attachment, Cable, real_number
 from ..core.record import Record
 from .bridge import BridgeConditions, StructuralMode, Traffic
 from .conditions import FieldConditions, RecordTruth
@@ -68,6 +68,7 @@ from .excitation import (
     Ambient,
     Impulse,
     Progress,
+    check_damped_inputs,
     check_impulses,
     check_positions,
     check_timing,
@@ -229,11 +230,7 @@ def simulate_record_with_truth(cable: Cable, attachments: Sequence[Attachment], 
                              impulses=impulses, ambient=ambient, snr_db=snr_db, n_modes=n_modes, seed=seed,
                              field=field, bridge=bridge, progress=progress)
     # in-plane channels only: the record as it was before the planes
-    if has_dampers(atts):
-        if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
-                                    or n_modes < 1):
-            raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
-        modal_damping(damping, 1)  # its checks before any work
+    check_damped_inputs(atts, n_modes, damping)
     rng = np.random.default_rng(seed)
     own_rng = field_rng(rng) if field is not None else None
     plane = plane_signal(*plane_model(cable, atts, "in"), tension, x, fs, n_samples, damping=damping,

@@ -44,6 +44,7 @@ from .excitation import (
     Impulse,
     PlaneSignal,
     Progress,
+    check_damped_inputs,
     modal_basis,
     modal_damping,
     plane_model,
@@ -92,11 +93,7 @@ def planes_record(cable: Cable, attachments: Sequence[Attachment], tension: floa
     axial = [a is None for a in axes]
     reads_in = [a[0] != 0.0 if a is not None else dl != 0.0 for a, dl in zip(axes, delta)]
     reads_out = [a is not None and a[1] != 0.0 for a in axes]
-    if has_dampers(attachments):
-        if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int | np.integer)
-                                    or n_modes < 1):
-            raise ModelError(f"must be an integer >= 1, got {n_modes!r}", field="n_modes")
-        modal_damping(damping, 1)  # its checks before any work
+    check_damped_inputs(attachments, n_modes, damping)
 
     rng = np.random.default_rng(seed)
     own_rng = field_rng(rng) if field is not None else None
