@@ -138,7 +138,8 @@ def test_in_and_out_modes_at_one_frequency_are_never_merged():
     assert len(both) >= 4  # each plane's channels carry their own mode: two peaks, one per plane
     for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
         assert abs(f - case.truth[plane][mode - 1]) < 4 * u, (plane, mode)  # 4σ as above
-    assert [n.kind for n in r.notes] == []  # nothing set aside as a leak: the sensors are aligned
+    # Nothing set aside as a leak: the sensors are aligned (a "misfit" note may widen a mode's 1σ)
+    assert [n.kind for n in r.notes if n.kind != "misfit"] == []
 
 
 def test_a_misaligned_sensor_leaks_the_other_plane_which_is_set_aside():
