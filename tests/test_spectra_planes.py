@@ -309,9 +309,25 @@ def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="not yet met: without an axial channel a deck mode within 2 % of a cable "
-                   "mode merges with it unseen (biaxial: 3σ coverage 91–93 %, 1σ 55–60 %), and a merged peak "
-                   "can sit nearer the deck than the cable's mode (3 peaks in 2 of the 200 records)")
+def test_biaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
+    """Without an axial channel a deck mode beside a cable mode is merged with it, seen only by the fit's
+    misfit (plane_analysis._misfit). Measured on these seeds (in / out): 1σ 70.5 / 69.5 %, 3σ 98.4 / 97.7 %
+    (before the misfit's widening: 56.2 / 59.6 %, 91.0 / 92.2 %)."""
+    for plane, a in _coverage(acceptance, ("biaxial",)).items():
+        assert a.size >= 400
+        # 68 ± 7 %: the issue's band (the binomial spread of 500 pairs is ± 2.1 %)
+        assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
+        # 96.5 %: a guard 1.2 % below the 97.7 % measured for the out-of-plane modes (about 2σ of the
+        # binomial spread of 500 pairs at 2.3 % beyond 3σ)
+        assert np.mean(a <= 3) >= 0.965, (plane, np.mean(a <= 3))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="not yet met, narrowly: in-plane 3σ coverage 97.99 % (22 of 1092 modes "
+                   "beyond 3σ, 21 allowed; out-of-plane 98.5 %, 1σ 69.6 / 69.5 %), and one triaxial record "
+                   "(hanger 10045) numbers a cable mode pulled 0.41 % by a deck mode 0.59 % from it: its fitted ζ "
+                   "is narrowed to 0.09 % by the pull, so widening by ζ f falls short (a floor of 0.5 % on the "
+                   "overlapped modes' ζ takes the triaxial in-plane 1σ to 77.5 %, out of the band)")
 def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane(acceptance):
     numbered_deck = [d for _, (_, dk) in acceptance.items() for d in dk]
     assert numbered_deck == []
