@@ -138,7 +138,8 @@ def test_in_and_out_modes_at_one_frequency_are_never_merged():
     assert len(both) >= 4  # each plane's channels carry their own mode: two peaks, one per plane
     for plane, mode, f, u in zip(r.mode_planes, r.modes, r.frequencies, r.uncertainty):
         assert abs(f - case.truth[plane][mode - 1]) < 4 * u, (plane, mode)  # 4σ as above
-    assert [n.kind for n in r.notes] == []  # nothing set aside as a leak: the sensors are aligned
+    # Nothing set aside as a leak: the sensors are aligned (a "misfit" note may widen a mode's 1σ)
+    assert [n.kind for n in r.notes if n.kind != "misfit"] == []
 
 
 def test_a_misaligned_sensor_leaks_the_other_plane_which_is_set_aside():
@@ -190,6 +191,63 @@ def test_given_structural_frequencies_are_never_numbered():
             assert all(abs(f - order * f_deck) > 3 * fit_sigma[f] for order in range(1, 6)), (f, f_deck)
     reasons = [why for _, _, why in r.structural]
     assert any("given structural frequency" in why for why in reasons)
+
+
+def _sdof_record(seed: int, coloured: bool) -> Record:
+    """Two channels of one mode (5 Hz, ζ 0.5 %, 300 s at 50 Hz, 30 dB): driven by white noise, or (coloured) also
+    by a deck's narrow-band motion 1 % above it (ζ 1.5 %, three times the white part's rms)."""
+    from scipy.signal import lfilter
+
+    def oscillator(x, f, zeta):
+        w = 2 * math.pi * f
+        pole = np.exp((-zeta * w + 1j * w * math.sqrt(1 - zeta**2)) / fs)
+        return lfilter([1.0], [1.0, -2 * pole.real, abs(pole) ** 2], x)
+
+    fs, n, burn = 50.0, 15_000, 5_000
+    rng = np.random.default_rng(seed)
+    force = rng.standard_normal(n + burn)
+    if coloured:
+        deck = oscillator(rng.standard_normal(n + burn), 5.05, 0.015)
+        force = force + 3 * deck / deck.std()
+    q = oscillator(force, 5.0, 0.005)[burn:]
+    x = np.column_stack([q, 0.5 * q])
+    x = x + 0.03 * x.std(axis=0) * rng.standard_normal(x.shape)
+    return Record(acceleration=x, sampling_rate=fs, channel_names=("a", "b"), channel_positions=np.array([1.0, 2.0]))
+
+
+def test_the_fits_misfit_tells_a_mode_driven_through_a_deck_mode_beside_it():
+    from stcs_ident.spectra.peaks import find_peaks
+    from stcs_ident.spectra.plane_analysis import MISFIT_RATIO
+
+    flagged = {}
+    for coloured in (False, True):
+        misfits = []
+        for seed in range(12):
+            result = find_peaks(_sdof_record(seed, coloured), 3.0, 7.0)
+            misfits.append(min(result.peaks, key=lambda p: abs(p.frequency - 5.0)).misfit)
+        assert all(m >= 1.0 for m in misfits)  # the larger of the sandwich and the Fisher 1σ, over Fisher's
+        flagged[coloured] = sum(m > MISFIT_RATIO for m in misfits)
+    # Measured: 1 of 12 white, 9 of 12 coloured (on 20 seeds of 400 s: 2 and 18). The bounds leave room for
+    # a change of the fit's numerics: a white-noise mode flagged in more than a quarter of records would widen
+    # too many clean modes' 1σ; a driven one missed in more than a third would leave them uncovered.
+    assert flagged[False] <= 3, flagged
+    assert flagged[True] >= 8, flagged
+
+
+def test_a_misfitting_mode_is_widened_by_its_half_power_half_width_once():
+    from types import SimpleNamespace
+
+    from stcs_ident.spectra.plane_analysis import CABLE_DAMPING, MISFIT_RATIO, PlaneMode, _misfit
+
+    mode = PlaneMode("in", 3, 0, False, float("nan"), (), 0.01)
+    peak = SimpleNamespace(frequency=10.0, damping=0.002, misfit=MISFIT_RATIO * 1.01)
+    widened = _misfit(mode, peak)
+    assert widened.misfit and widened.uncertainty == pytest.approx(math.hypot(0.01, CABLE_DAMPING * 10.0))
+    assert _misfit(mode, SimpleNamespace(frequency=10.0, damping=0.008, misfit=MISFIT_RATIO * 1.01)
+                   ).uncertainty == pytest.approx(math.hypot(0.01, 0.008 * 10.0))  # the fitted ζ where larger
+    assert _misfit(mode, SimpleNamespace(frequency=10.0, damping=0.002, misfit=MISFIT_RATIO)) == mode
+    overlapped = PlaneMode("in", 3, 0, False, float("nan"), (), 0.05, overlapped_by=10.1)
+    assert _misfit(overlapped, peak) == overlapped  # widened once only
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -251,9 +309,25 @@ def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="not yet met: without an axial channel a deck mode within 2 % of a cable "
-                   "mode merges with it unseen (biaxial: 3σ coverage 91–93 %, 1σ 55–60 %), and a merged peak "
-                   "can sit nearer the deck than the cable's mode (3 peaks in 2 of the 200 records)")
+def test_biaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
+    """Without an axial channel a deck mode beside a cable mode is merged with it, seen only by the fit's
+    misfit (plane_analysis._misfit). Measured on these seeds (in / out): 1σ 70.5 / 69.5 %, 3σ 98.4 / 97.7 %
+    (before the misfit's widening: 56.2 / 59.6 %, 91.0 / 92.2 %)."""
+    for plane, a in _coverage(acceptance, ("biaxial",)).items():
+        assert a.size >= 400
+        # 68 ± 7 %: the issue's band (the binomial spread of 500 pairs is ± 2.1 %)
+        assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
+        # 96.5 %: a guard 1.2 % below the 97.7 % measured for the out-of-plane modes (about 2σ of the
+        # binomial spread of 500 pairs at 2.3 % beyond 3σ)
+        assert np.mean(a <= 3) >= 0.965, (plane, np.mean(a <= 3))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="not yet met, narrowly: in-plane 3σ coverage 97.99 % (22 of 1092 modes "
+                   "beyond 3σ, 21 allowed; out-of-plane 98.5 %, 1σ 69.6 / 69.5 %), and one triaxial record "
+                   "(hanger 10045) numbers a cable mode pulled 0.41 % by a deck mode 0.59 % from it: its fitted ζ "
+                   "is narrowed to 0.09 % by the pull, so widening by ζ f falls short (a floor of 0.5 % on the "
+                   "overlapped modes' ζ takes the triaxial in-plane 1σ to 77.5 %, out of the band)")
 def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane(acceptance):
     numbered_deck = [d for _, (_, dk) in acceptance.items() for d in dk]
     assert numbered_deck == []

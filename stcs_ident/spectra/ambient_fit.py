@@ -77,6 +77,10 @@ class AmbientFit:
         phase of the mode shape relative to its largest entry, m/s².
     mode_shape : ndarray (n_channels,) complex
         Unit-norm mode shape (not whitened).
+    misfit : float
+        The sandwich (misfit-robust) 1σ of the frequency over the Fisher information's, at least 1: about 1
+        where one mode over the background describes the band, larger where it does not (a second
+        resonance under the mode, an excitation far from white across the band).
     significance : float
         Root of the likelihood-ratio statistic, sqrt(2 (ℓ₀ − ℓ)), of the
         mode against the background and neighbours alone: a z-like score,
@@ -94,6 +98,7 @@ class AmbientFit:
     mode_shape: np.ndarray
     significance: float
     converged: bool
+    misfit: float = 1.0
 
 
 def fejer_lorentzian(
@@ -299,8 +304,9 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits,
     return theta, False, mean, grad
 
 
-def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray) -> np.ndarray:
-    """Covariance of (f, σ): the inverse Fisher information, widened to the sandwich estimate where larger.
+def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray) -> tuple[np.ndarray, float]:
+    """Covariance of (f, σ): the inverse Fisher information, widened to the sandwich estimate where larger;
+    and the frequency's widening factor (:attr:`AmbientFit.misfit`).
 
     The sandwich F⁻¹ J F⁻¹, J = Σ_k s_k s_kᵀ with the per-bin scores
     s_k = ∂E_k (I_k − E_k) / E_k², equals F⁻¹ when the model is right and
@@ -313,7 +319,7 @@ def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarr
     inverse = np.linalg.pinv(fisher, rcond=1e-12)
     sandwich = (inverse @ (scores.T @ scores) @ inverse)[:2, :2]
     widen = np.sqrt(np.maximum(np.diag(sandwich) / np.diag(cov), 1.0))
-    return cov * np.outer(widen, widen)
+    return cov * np.outer(widen, widen), float(widen[0])
 
 
 def _marginal_covariance(fisher: np.ndarray) -> np.ndarray:
@@ -421,7 +427,7 @@ def fit_ambient(
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
     try:
-        cov = _robust_covariance(grad[:, free], mean, problem.periodogram)
+        cov, misfit = _robust_covariance(grad[:, free], mean, problem.periodogram)
     except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
@@ -432,7 +438,7 @@ def fit_ambient(
     shape = u * noise_scale
     shape = shape / np.linalg.norm(shape)
     amplitude = np.sqrt(max(variance_y, 0.0)) * np.abs(u) * noise_scale * np.sign(np.cos(np.angle(u)))
-    return _result(theta[:2], cov, amplitude, shape, significance, ok)
+    return _result(theta[:2], cov, amplitude, shape, significance, ok, misfit)
 
 
 def _fixed_basis(freq, f_centre, half_width, neighbours, k, n, dt) -> np.ndarray:
@@ -468,7 +474,7 @@ def _grid_start(starts: list[float], problem: _Problem, limits, damping_grid) ->
     return best
 
 
-def _result(theta, cov, amplitude, shape, significance, ok) -> AmbientFit:
+def _result(theta, cov, amplitude, shape, significance, ok, misfit=1.0) -> AmbientFit:
     f_d, sigma = theta
     f_n, f_std, zeta, zeta_std = pole_statistics(f_d, sigma, cov)
     return AmbientFit(
@@ -482,4 +488,5 @@ def _result(theta, cov, amplitude, shape, significance, ok) -> AmbientFit:
         mode_shape=shape,
         significance=float(significance),
         converged=bool(ok),
+        misfit=misfit if np.isfinite(misfit) else 1.0,
     )

@@ -39,6 +39,9 @@ class Peak:
         Height of the peak above the floor of the combined spectrum, dB.
     channel_snr_db : ndarray (n_channels,)
         Height above each channel's floor, dB.
+    misfit : float
+        Of an ambient fit, the misfit-robust 1σ of the frequency over the Fisher information's (about 1 where
+        one mode describes its band; 1 for other fits).
     """
 
     frequency: float
@@ -49,6 +52,7 @@ class Peak:
     amplitude: np.ndarray
     snr_db: float
     channel_snr_db: np.ndarray = field(repr=False)
+    misfit: float = field(default=1.0, repr=False)
 
 
 class PickingResult(Result):

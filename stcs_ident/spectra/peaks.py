@@ -371,6 +371,7 @@ def _ambient_peak(c: Candidate, fit: AmbientFit, overview: Overview, names, chan
         amplitude=fit.amplitude,
         snr_db=c.snr_db,
         channel_snr_db=snr,
+        misfit=fit.misfit,
     )
 
 

@@ -281,6 +281,9 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
     notes += tuple(Note.plain("overlap", f"{PLANE_NAMES[m.plane]} mode {m.mode}: 1σ widened by its own half-power "
                                          f"half-width, a structural resonance at {m.overlapped_by:.4f} Hz "
                                          "overlaps it") for m in outcome.modes if m.overlapped_by is not None)
+    notes += tuple(Note.plain("misfit", f"{PLANE_NAMES[m.plane]} mode {m.mode}: 1σ widened by its own half-power "
+                                        "half-width, its fit misfits its band (a resonance merged with it?)")
+                   for m in outcome.modes if m.misfit)
     return TestSpectra(
         name=test.name, record=path, modes=tuple(m.mode for m in outcome.modes),
         frequencies=np.array([p.frequency for p in chosen], float),
