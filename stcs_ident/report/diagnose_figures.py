@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .. import effects as registry
-from .plots import Drawn, mode_axis, new_figure
+from .plots import Drawn, mode_axis, new_figure, set_mode_ticks
 
 #: How the three models of the residual figure are drawn: label, colour, marker, x offset (modes).
 RESIDUAL_STYLE = {
@@ -62,7 +62,7 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
     lines: dict[str, list] = {key: [] for key in models}
     bands = []
     for i, (m, ax) in enumerate(zip(d.measurements, axes)):
-        k, ticks = mode_axis(m.modes, getattr(m, "planes", None))  # out-of-plane modes after the in-plane ones
+        k, _ = mode_axis(m.modes, getattr(m, "planes", None))  # out-of-plane modes after the in-plane ones
         u = m.uncertainty / m.frequencies * 100.0
         edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
         bands.append(ax.stairs(u, edges, baseline=-u, fill=True, color="0.85", lw=0,
@@ -71,9 +71,10 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
         for key in models:
             label, colour, marker, dx = RESIDUAL_STYLE[key]
             err = (per_test[key][i] - m.frequencies) / m.frequencies * 100.0
-            lines[key].append(ax.plot(k + dx, err, marker=marker, color=colour, lw=0.8, ms=5, label=label)[0])
+            xs, ys = _broken_between_planes(k + dx, err, getattr(m, "planes", None))
+            lines[key].append(ax.plot(xs, ys, marker=marker, color=colour, lw=0.8, ms=5, label=label)[0])
         ax.set_title(f"{m.name} (setup {m.test.setup}, {m.test.tension / 1e3:.4g} kN)", fontsize=9)
-        ax.set_xticks(k, ticks)
+        set_mode_ticks(ax, m.modes, getattr(m, "planes", None))
         ax.set_xlim(k[0] - 0.6, k[-1] + 0.6)
         ax.grid(True, axis="y", lw=0.3, alpha=0.6)
         if i % ncols == 0:
@@ -212,3 +213,14 @@ def plot_profiles(diagnosis, fig=None) -> Drawn:
     if missing:
         fig.suptitle(unscanned_sentence(missing), fontsize=8, color="0.3")
     return Drawn({"figure": fig, "panels": panels, "unscanned": missing})
+
+
+def _broken_between_planes(x: np.ndarray, y: np.ndarray, planes) -> tuple[np.ndarray, np.ndarray]:
+    """``x, y`` with a gap (NaN) where the out-of-plane modes start, so no line joins the two planes."""
+    if planes is None:
+        return x, y
+    out = np.asarray(planes) == "out"
+    if not out.any() or out.all():
+        return x, y
+    first = int(np.argmax(out))
+    return np.insert(np.asarray(x, float), first, np.nan), np.insert(np.asarray(y, float), first, np.nan)

@@ -22,7 +22,7 @@ import textwrap
 import numpy as np
 
 from ..identify.measurement import mode_label
-from .plots import Drawn, mode_axis, new_figure, save_figure
+from .plots import Drawn, mode_axis, new_figure, save_figure, set_mode_ticks
 
 
 def parameter_label(p) -> str:
@@ -214,7 +214,7 @@ def plot_errors(result, fig=None) -> Drawn:
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     before, after, errorbars = [], [], []
     for i, (t, ax) in enumerate(zip(tests, axes)):
-        x, ticks = mode_axis(t.modes, getattr(t, "mode_planes", None))
+        x, _ = mode_axis(t.modes, getattr(t, "mode_planes", None))
         sigma = np.asarray(t.uncertainty, float) / np.asarray(t.measured, float) * 100.0
         for errors, dx, colour, bars in ((t.before_error, -0.2, "tab:gray", before),
                                          (t.after_error, 0.2, "tab:blue", after)):
@@ -223,7 +223,7 @@ def plot_errors(result, fig=None) -> Drawn:
             errorbars.append(ax.errorbar(x + dx, errors, yerr=sigma, fmt="none", ecolor="k", elinewidth=0.8,
                                          capsize=2))
         ax.axhline(0.0, color="0.4", lw=0.6)
-        ax.set_xticks(x, ticks)
+        set_mode_ticks(ax, t.modes, getattr(t, "mode_planes", None))
         ax.set_title(f"{t.name}: rms {t.rms_before:.2f} % before, {t.rms_after:.2f} % corrected", fontsize=8)
         ax.grid(True, axis="y", lw=0.3, alpha=0.6)
         if i % ncols == 0:

@@ -121,6 +121,22 @@ def mode_axis(modes, planes=None) -> tuple[np.ndarray, list[str]]:
     return x, labels
 
 
+def set_mode_ticks(ax, modes, planes=None) -> np.ndarray:
+    """The x ticks of a figure by mode (:func:`mode_axis`): numbers only, and where both planes are shown a
+    dashed line between them with "in-plane" and "out-of-plane" over each group (a label "3 out" per tick
+    overlaps its neighbours from about ten modes a plane). Returns the x positions."""
+    x, _ = mode_axis(modes, planes)
+    ax.set_xticks(x, [str(int(m)) for m in np.asarray(modes)])
+    out = np.zeros(x.size, bool) if planes is None else np.asarray(planes) == "out"
+    if out.any() and (~out).any():
+        split = (x[~out].max() + x[out].min()) / 2
+        ax.axvline(split, color="0.6", lw=0.6, ls="--")
+        where = ax.get_xaxis_transform()  # x in data, y in axes fractions
+        for group, text in ((~out, "in-plane"), (out, "out-of-plane")):
+            ax.text(x[group].mean(), 0.98, text, transform=where, ha="center", va="top", fontsize=7, color="0.35")
+    return x
+
+
 def save_figure(fig, path) -> None:
     """Save a PNG whole or not at all, with the permissions of any other output
     (:func:`stcs_ident.core.files.write_figure`)."""
