@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from .boundary import Boundary
 from .checks import (  # noqa: F401 (re-exported: the checks were defined here, and are imported from here)
     BANDS,
     FREQUENCY_BAND,
@@ -35,55 +36,6 @@ from .planes import check_direction, check_plane
 #: and its time grows steeply with their number (6 modes of an 8 m hanger: 5 ms with 20, 1 s with 50,
 #: 94 s with 200): beyond this an identification or a diagnosis, hundreds of evaluations, would take hours.
 MAX_ATTACHMENTS = 50
-
-
-@dataclass(frozen=True)
-class Boundary:
-    """Rotational restraint of one anchorage (transverse displacement is zero).
-
-    Parameters
-    ----------
-    rotational_stiffness : float
-        N m/rad; ``math.inf`` is a clamped end, ``0`` a pinned end.
-    """
-
-    rotational_stiffness: float = math.inf
-
-    def __post_init__(self):
-        k = self.rotational_stiffness
-        if isinstance(k, bool):
-            raise ModelError(f"must be a number, got {k!r}", field="boundary")
-        try:
-            k = float(k)
-        except (TypeError, ValueError):
-            raise ModelError(f"must be a number, got {k!r}", field="boundary") from None
-        if math.isnan(k) or k < 0:
-            raise ModelError(f"rotational stiffness must be >= 0, got {k!r}", field="boundary")
-        object.__setattr__(self, "rotational_stiffness", k)
-
-    @classmethod
-    def clamped(cls) -> Boundary:
-        return cls(math.inf)
-
-    @classmethod
-    def pinned(cls) -> Boundary:
-        return cls(0.0)
-
-    @property
-    def is_clamped(self) -> bool:
-        return math.isinf(self.rotational_stiffness)
-
-    @property
-    def kind(self) -> str:
-        """``"clamped"``, ``"pinned"`` or ``"spring"``."""
-        if self.is_clamped:
-            return "clamped"
-        return "pinned" if self.rotational_stiffness == 0 else "spring"
-
-    def describe(self) -> str:
-        if self.kind == "spring":
-            return f"rotational spring {self.rotational_stiffness:.4g} N m/rad"
-        return self.kind
 
 
 @dataclass(frozen=True)
