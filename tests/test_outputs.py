@@ -397,7 +397,20 @@ def test_a_service_that_is_not_dask_is_refused_within_the_timeout(greeting, arch
 # Item 4: Ctrl-C and a killed parent (subprocesses).
 
 def _command(*args) -> list[str]:
-    return [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main())", *args]
+    """The command in a child Python with Ctrl-C as a terminal gives it: a process started in the background by
+    a non-interactive shell (``nohup``, ``cmd &``, some CI runners) inherits SIGINT ignored, and the command
+    rightly keeps an ignored SIGINT ignored; these tests are about what a pressed Ctrl-C does."""
+    start = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+             "from stcs_ident.cli.main import main; sys.exit(main())")
+    return [sys.executable, "-c", start, *args]
+
+
+@pytest.fixture
+def sigint_default():
+    """Python's own SIGINT handler in this process for the test (see :func:`_command`), the former one after."""
+    former = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, former)
 
 
 def _children(pid: int) -> set[int]:
@@ -530,7 +543,7 @@ def test_ctrl_c_on_dask_stops_with_one_line_and_keeps_the_parts(dask_scheduler, 
 
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
-def test_ctrl_c_lost_in_a_finaliser_is_still_said(campaign, monkeypatch, capsys):
+def test_ctrl_c_lost_in_a_finaliser_is_still_said(campaign, monkeypatch, capsys, sigint_default):
     import stcs_ident.cli.forward
 
     class Finalised:
