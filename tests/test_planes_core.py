@@ -172,6 +172,21 @@ def test_a_campaign_gives_planes_directions_angles_and_round_trips(tmp_path):
     assert back == dataclasses.replace(campaign, directory=back.directory)
 
 
+def test_a_campaign_gives_the_structure_s_frequencies_and_round_trips(tmp_path):
+    text = CAMPAIGN.format(planes="").replace("modes = [1, 1, 2]", "") + "\n[structure]\nfrequencies = [0.52, 1.3]\n"
+    campaign = load_campaign(_write(tmp_path, text))
+    assert campaign.structural_frequencies == (0.52, 1.3)
+    again = tmp_path / "again"
+    again.mkdir()
+    assert load_campaign(_write(again, campaign_to_toml(campaign))).structural_frequencies == (0.52, 1.3)
+    for bad, field in (("frequencies = [-1.0]", "structure.frequencies"), ("modes = [1]", "structure.modes")):
+        other = tmp_path / bad.split()[0]
+        other.mkdir()
+        with pytest.raises((CampaignError, ModelError)) as err:
+            load_campaign(_write(other, text.replace("frequencies = [0.52, 1.3]", bad)))
+        assert err.value.field == field
+
+
 def test_a_campaign_without_planes_is_in_plane(tmp_path):
     campaign = load_campaign(_write(tmp_path, CAMPAIGN.format(planes="").replace("modes = [1, 1, 2]", "")))
     assert campaign.tests[0].planes == ("in", "in", "in")

@@ -193,6 +193,21 @@ def test_given_structural_frequencies_are_never_numbered():
     assert any("given structural frequency" in why for why in reasons)
 
 
+def test_the_campaign_s_structure_frequencies_are_used_like_given_ones():
+    """``[structure] frequencies`` of the campaign (Campaign.structural_frequencies) act as ``--structural``:
+    the same structural peaks and numbers, and the options used say so."""
+    from dataclasses import replace
+
+    case = make_case("hanger", 6, layout="biaxial", near=0.015)
+    decks = tuple(f for f, _ in case.deck)
+    given = _analyse(case, plane_options=PlaneOptions(structural=tuple(sorted(decks))))
+    from_campaign = _analyse(replace(case, campaign=replace(case.campaign, structural_frequencies=decks)))
+    assert from_campaign.plane_options.structural == tuple(sorted(decks))
+    assert from_campaign.modes == given.modes and from_campaign.mode_planes == given.mode_planes
+    np.testing.assert_array_equal(from_campaign.frequencies, given.frequencies)
+    assert [why for *_, why in from_campaign.structural] == [why for *_, why in given.structural]
+
+
 def _sdof_record(seed: int, coloured: bool) -> Record:
     """Two channels of one mode (5 Hz, ζ 0.5 %, 300 s at 50 Hz, 30 dB): driven by white noise, or (coloured) also
     by a deck's narrow-band motion 1 % above it (ζ 1.5 %, three times the white part's rms)."""

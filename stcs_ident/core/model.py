@@ -411,6 +411,9 @@ class Campaign:
     bounds: tuple[tuple[str, tuple[float, float]], ...] = ()
     #: The channel directions of records whose files give none (top-level ``[channels]``; a test's own wins).
     channel_directions: tuple[tuple[str, str | float], ...] = ()
+    #: Frequencies of the structure the cable hangs from (deck, pylon: ``[structure] frequencies``), Hz: peaks at
+    #: them or their harmonics in the records are structural, never numbered.
+    structural_frequencies: tuple[float, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -430,6 +433,8 @@ class Campaign:
         object.__setattr__(self, "channels", tuple(
             (name, finite_number(position, f"channels.{name}")) for name, position in dict(self.channels).items()))
         object.__setattr__(self, "channel_directions", _directions(self.channel_directions, "channels"))
+        object.__setattr__(self, "structural_frequencies", tuple(
+            frequency(f, "structure.frequencies") for f in self.structural_frequencies))
         object.__setattr__(self, "setups", tuple(self.setups))
         object.__setattr__(self, "tests", tuple(self.tests))
         _unique((s.name for s in self.setups), "setup")

@@ -36,7 +36,7 @@ __all__ = ["CAMPAIGN_FILE", "campaign_to_toml", "load_campaign"]
 CAMPAIGN_FILE = "campaign.toml"
 
 _TOP_KEYS = ("campaign", "cable", "setup", "test", "published", "tolerance", "record_format", "channels",
-             "bounds")
+             "bounds", "structure")
 _PUBLISHED_KEYS = ("parameter", "low", "high", "basis", "source")
 _CAMPAIGN_KEYS = ("name", "description")
 _CABLE_KEYS = ("length", "mass_per_length", "EI", "EA", "inclination", "gravity", "boundary")
@@ -136,9 +136,12 @@ def _parse_campaign(data: dict[str, Any], directory: str) -> Campaign:
     tolerance = _parse_tolerance(_table(data.get("tolerance", {}), "tolerance"))
     bounds = _parse_bounds(_table(data.get("bounds", {}), "bounds"))
     channels, directions = _parse_channels(data.get("channels", {}), "channels")
+    structure = _table(data.get("structure", {}), "structure")
+    _check_keys(structure, ("frequencies",), "structure")
+    structural = _numbers(structure.get("frequencies", []), "structure.frequencies")
     return Campaign(name, cable, tuple(setups), tuple(tests), description, directory, tuple(published), tolerance,
                     bounds=bounds, record_format=_parse_record_format(data.get("record_format", {}), "record_format"),
-                    channels=channels, channel_directions=directions)
+                    channels=channels, channel_directions=directions, structural_frequencies=structural)
 
 
 def _parse_bounds(table: dict[str, Any]) -> dict[str, Any]:

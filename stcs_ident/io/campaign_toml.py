@@ -61,6 +61,8 @@ def campaign_tables(campaign: Campaign) -> dict[str, Any]:
         data["channels"] = _channels_table(campaign.channels, campaign.channel_directions)
     if campaign.bounds:
         data["bounds"] = {key: [float(lo), float(hi)] for key, (lo, hi) in campaign.bounds}
+    if campaign.structural_frequencies:
+        data["structure"] = {"frequencies": [float(f) for f in campaign.structural_frequencies]}
     return data
 
 

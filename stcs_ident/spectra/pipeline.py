@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -214,6 +214,9 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     plane_options = PlaneOptions() if plane_options is None else plane_options
     if not isinstance(plane_options, PlaneOptions):
         raise InputError(f"must be a PlaneOptions, got {plane_options!r}", field="plane_options")
+    if campaign.structural_frequencies:  # the campaign's [structure] with those given here
+        known = tuple(sorted({*plane_options.structural, *campaign.structural_frequencies}))
+        plane_options = replace(plane_options, structural=known)
     cable = campaign.cable
     atts = campaign.setup(test.setup).attachments
     check_positions(record, cable.length, file=path)
