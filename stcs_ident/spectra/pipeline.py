@@ -226,7 +226,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     check_bandwidth(record, nominal[0], usable=usable, file=path)
     if record.channel_directions is not None:
         outcome = analyse_planes(record, cable, atts, test.tension, max_modes=max_modes, tension_model=tension_model,
-                                 options=options, plane_options=plane_options)
+                                 options=options, plane_options=plane_options, nominal_in=nominal)
         return _plane_spectra(test, record, path, outcome, options, plane_options)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
     result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True,  # the record is ours

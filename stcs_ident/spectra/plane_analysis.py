@@ -73,8 +73,10 @@ class PlanesOutcome:
 
 
 def analyse_planes(record: Record, cable, attachments, tension: float, *, max_modes: int, tension_model: str,
-                   options: PickingOptions, plane_options: PlaneOptions) -> PlanesOutcome:
-    """Peaks per plane, numbered per plane, structural ones set apart (the module's steps)."""
+                   options: PickingOptions, plane_options: PlaneOptions,
+                   nominal_in: np.ndarray | None = None) -> PlanesOutcome:
+    """Peaks per plane, numbered per plane, structural ones set apart (the module's steps). ``nominal_in``: the
+    in-plane nominal frequencies of ``max_modes`` modes when the caller has them already."""
     channels, axial = plane_channels(record)
     if not channels:
         raise InputError("every channel is axial: the cable's transverse modes need an in-plane or out-of-plane "
@@ -82,8 +84,9 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
     fs = record.sampling_rate
     peaks, nominal, axial_share = {}, {}, {}
     for plane in channels:
-        nominal[plane] = natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
-                                             plane=plane)
+        nominal[plane] = (nominal_in if plane == "in" and nominal_in is not None else
+                          natural_frequencies(cable, attachments, tension, max_modes, tension_model=tension_model,
+                                              plane=plane))
     bands = {plane: (0.5 * nominal[plane][0], min(0.45 * fs, 1.3 * nominal[plane][-1])) for plane in channels}
     for plane, chans in channels.items():
         sub = plane_record(record, chans, axial)
