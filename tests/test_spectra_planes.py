@@ -252,17 +252,45 @@ def test_the_fits_misfit_tells_a_mode_driven_through_a_deck_mode_beside_it():
 def test_a_misfitting_mode_is_widened_by_its_half_power_half_width_once():
     from types import SimpleNamespace
 
-    from stcs_ident.spectra.plane_analysis import CABLE_DAMPING, MISFIT_RATIO, PlaneMode, _misfit
+    from stcs_ident.spectra.plane_analysis import CABLE_DAMPING, MISFIT_RATIO, MISFIT_SHARE, PlaneMode, _misfit
 
     mode = PlaneMode("in", 3, 0, False, float("nan"), (), 0.01)
     peak = SimpleNamespace(frequency=10.0, damping=0.002, misfit=MISFIT_RATIO * 1.01)
     widened = _misfit(mode, peak)
-    assert widened.misfit and widened.uncertainty == pytest.approx(math.hypot(0.01, CABLE_DAMPING * 10.0))
+    assert widened.misfit
+    assert widened.uncertainty == pytest.approx(math.hypot(0.01, MISFIT_SHARE * CABLE_DAMPING * 10.0))
     assert _misfit(mode, SimpleNamespace(frequency=10.0, damping=0.008, misfit=MISFIT_RATIO * 1.01)
-                   ).uncertainty == pytest.approx(math.hypot(0.01, 0.008 * 10.0))  # the fitted ζ where larger
+                   ).uncertainty == pytest.approx(math.hypot(0.01, MISFIT_SHARE * 0.008 * 10.0))  # the fitted ζ
     assert _misfit(mode, SimpleNamespace(frequency=10.0, damping=0.002, misfit=MISFIT_RATIO)) == mode
     overlapped = PlaneMode("in", 3, 0, False, float("nan"), (), 0.05, overlapped_by=10.1)
     assert _misfit(overlapped, peak) == overlapped  # widened once only
+
+
+def test_an_overlapped_mode_is_widened_by_at_least_half_its_planes_typical_half_width():
+    from types import SimpleNamespace
+
+    from stcs_ident.spectra.plane_analysis import (
+        OVERLAP_SHARE,
+        TYPICAL_DAMPING_SHARE,
+        PlaneMode,
+        _overlapped,
+        _typical_damping,
+    )
+
+    mode = PlaneMode("in", 3, 0, False, float("nan"), (), 0.01)
+    narrowed = SimpleNamespace(frequency=10.0, damping=0.001)  # a deck mode's pull narrowed the fitted ζ
+    typical = _typical_damping([SimpleNamespace(damping=z) for z in (0.004, 0.006, 0.001, None, float("nan"))])
+    assert typical == pytest.approx(0.004)  # the median of the fitted ζ, the missing ones left out
+    widened = _overlapped(mode, narrowed, [(10.05, 0.01)], typical)
+    assert widened.overlapped_by == 10.05
+    assert widened.uncertainty == pytest.approx(math.hypot(0.01, OVERLAP_SHARE * TYPICAL_DAMPING_SHARE * 0.004 * 10))
+    # A fitted ζ above the floor is kept; a resonance beyond 4 of its half-widths (and 3σ) leaves the mode alone.
+    assert _overlapped(mode, SimpleNamespace(frequency=10.0, damping=0.005), [(10.05, 0.01)], typical
+                       ).uncertainty == pytest.approx(math.hypot(0.01, OVERLAP_SHARE * 0.005 * 10))
+    assert _overlapped(mode, narrowed, [(10.5, 0.01)], typical) == mode
+    assert _typical_damping([]) != _typical_damping([])  # NaN: no floor
+    assert _overlapped(mode, narrowed, [(10.05, 0.01)]).uncertainty == pytest.approx(
+        math.hypot(0.01, OVERLAP_SHARE * 0.001 * 10))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -312,38 +340,40 @@ def _coverage(acceptance, layouts):
 @pytest.mark.slow
 def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
     """With an axial channel (the anchorage's motion seen alone): 68 ± 7 % within 1σ per plane. Measured on
-    these seeds (in / out): 1σ 68.7 / 69.6 %, 3σ 97.6 / 99.2 % (stay 96.8 / 99.1, hanger 98.3 / 99.3); the
-    issue's 98 % within 3σ is the strict test's below."""
+    these seeds (in / out): 1σ 68.9 / 69.1 %, 3σ 99.1 / 99.4 %; on seeds 20000+ and 30000+ (run once each,
+    after the constants were fixed): 71.6 / 77.0 % and 71.4 / 72.9 % within 1σ, 99.3 / 99.8 % and
+    98.7 / 99.1 % within 3σ (the issue's band is for both layouts together: the test below)."""
     for plane, a in _coverage(acceptance, ("triaxial",)).items():
         assert a.size >= 400
         # 68 ± 7 %: the issue's band (the binomial spread of 400 pairs is ± 2.3 %)
         assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
-        # 96 %: a guard below the 97.6 % measured for the in-plane modes, 1.6 % under the issue's 98 % (the
-        # strict test's)
-        assert np.mean(a <= 3) >= 0.96, (plane, np.mean(a <= 3))
+        # 97 %: a guard 1.7 % below the lowest measured on four seed sets (98.7 %), about 2σ of the binomial
+        # spread of 500 pairs at 1.5 % beyond 3σ
+        assert np.mean(a <= 3) >= 0.97, (plane, np.mean(a <= 3))
 
 
 @pytest.mark.slow
 def test_biaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
     """Without an axial channel a deck mode beside a cable mode is merged with it, seen only by the fit's
-    misfit (plane_analysis._misfit). Measured on these seeds (in / out): 1σ 70.5 / 69.5 %, 3σ 98.4 / 97.7 %
-    (before the misfit's widening: 56.2 / 59.6 %, 91.0 / 92.2 %)."""
+    misfit (plane_analysis._misfit). Measured on these seeds (in / out): 1σ 68.1 / 67.0 %, 3σ 98.4 / 97.7 %
+    (before the misfit's widening: 56.2 / 59.6 %, 91.0 / 92.2 %); on seeds 20000+ and 30000+: 1σ 71.5 / 72.0 %
+    and 69.0 / 72.4 %, 3σ 98.2 / 99.1 % and 97.4 / 98.9 %."""
     for plane, a in _coverage(acceptance, ("biaxial",)).items():
         assert a.size >= 400
         # 68 ± 7 %: the issue's band (the binomial spread of 500 pairs is ± 2.1 %)
         assert abs(np.mean(a <= 1) - 0.68) <= 0.07, (plane, np.mean(a <= 1))
-        # 96.5 %: a guard 1.2 % below the 97.7 % measured for the out-of-plane modes (about 2σ of the
-        # binomial spread of 500 pairs at 2.3 % beyond 3σ)
+        # 96.5 %: a guard 0.9 % below the lowest measured on four seed sets (97.4 %), about 1.5σ of the
+        # binomial spread of 500 pairs at 2.6 % beyond 3σ
         assert np.mean(a <= 3) >= 0.965, (plane, np.mean(a <= 3))
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="not yet met, narrowly: in-plane 3σ coverage 97.99 % (22 of 1092 modes "
-                   "beyond 3σ, 21 allowed; out-of-plane 98.5 %, 1σ 69.6 / 69.5 %), and one triaxial record "
-                   "(hanger 10045) numbers a cable mode pulled 0.41 % by a deck mode 0.59 % from it: its fitted ζ "
-                   "is narrowed to 0.09 % by the pull, so widening by ζ f falls short (a floor of 0.5 % on the "
-                   "overlapped modes' ζ takes the triaxial in-plane 1σ to 77.5 %, out of the band)")
 def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane(acceptance):
+    """The issue's acceptance: no deck mode numbered in 200 records; per plane, 68 ± 7 % within 1σ and ≥ 98 %
+    within 3σ. Measured on these seeds (in / out): 1σ 68.5 / 68.1 %, 3σ 98.7 / 98.6 %, no deck mode
+    numbered; on seeds 20000+ (200 records, run once after the constants were fixed): 71.5 / 74.5 %,
+    98.7 / 99.4 %, none; on seeds 30000+: 70.2 / 72.6 %, 98.1 / 99.0 %, none. (Before the floor on an
+    overlapped mode's ζ these seeds gave 97.99 % in-plane within 3σ and one deck mode numbered.)"""
     numbered_deck = [d for _, (_, dk) in acceptance.items() for d in dk]
     assert numbered_deck == []
     for plane, a in _coverage(acceptance, ("triaxial", "biaxial")).items():
