@@ -144,3 +144,59 @@ def test_complex_mode_shapes_reduce_to_the_real_ones_and_carry_a_phase_with_a_da
     assert 10.0 < lag < 80.0, lag
     assert shapes.damping[0] == pytest.approx(complex_modes(STAY, [Damper("D1", 4.0, coefficient=C_OPT)], H, 1)
                                               .damping[0], rel=1e-12)
+
+
+@pytest.mark.skipif(damped._damped_kernel is None, reason="the compiled kernel is not built")
+@pytest.mark.parametrize("scale", [0.3, 1.0, 5.0])
+def test_a_warm_start_finds_the_cold_solves_roots_and_refuses_what_moved_too_far(scale):
+    """A fit's trial points are warm-started from the previous point's roots (forward.damped._warm): nearby,
+    the same roots as the solve from the undamped ones (to 1e-9 of |s|: both stop the secant at 1e-10); far
+    (tension ×1.5, every root moved by more than its spacing), refused by the checks and solved cold, so
+    again the same; and a start holding a neighbour's root in place of a mode's is refused, not followed."""
+    atts = [Damper("D1", 4.0, 10.0, coefficient=scale * C_OPT), Attachment("W", 61.0, 40.0, 2e3)]
+    base = batch_complex_modes(STAY, atts, H, 12, certify=False)
+    tensions = H * np.array([1.0, 1.0 + 1e-6, 1.003, 1.5])
+    cold = batch_complex_modes(STAY, atts, tensions, 12, certify=False)
+    warm = batch_complex_modes(STAY, atts, tensions, 12, certify=False, start=base)
+    assert np.max(np.abs(warm / cold - 1)) < 1e-9
+    ok = damped._warm(build_batch(STAY, atts, tensions)[1][0][0], np.broadcast_to(base, (4, 12)), 12)[1]
+    assert ok[:3].all() and not ok[3]  # the far one went cold
+    wrong = base.copy()
+    wrong[4] = wrong[5]  # mode 5's start is mode 6's root: two starts at one root
+    ok = damped._warm(build_batch(STAY, atts, H)[1][0][0], wrong[None, :], 12)[1]
+    assert not ok.any()
+    assert np.allclose(batch_complex_modes(STAY, atts, H, 12, certify=False, start=wrong), base, rtol=1e-9)
+
+
+def test_a_lost_parameter_set_is_nan_when_asked_and_the_others_are_kept(monkeypatch):
+    """``lost="nan"``: a fit's extreme trial point whose roots cannot be followed gives NaN roots, the other
+    rows of its batch their roots (the fits used to solve such a batch again row by row)."""
+    atts = [Damper("D1", 4.0, 10.0, coefficient=C_OPT)]
+    tensions = H * np.array([1.0, 1.1])
+    good = batch_complex_modes(STAY, atts, tensions, 6, certify=False)
+    kernel = damped._damped_kernel
+    if damped.use_kernel():  # the kernel reports the second parameter set's path lost
+        from types import SimpleNamespace
+
+        monkeypatch.setattr(damped, "_damped_kernel", SimpleNamespace(solve=_failing_second(kernel.solve),
+                                                                      refine=kernel.refine))
+    else:
+        def failing(batch, config, *args, **kwargs):
+            if config == 1:
+                raise ComputationError("a damped mode could not be followed as the dampers grow")
+            return follow_roots(batch, config, *args, **kwargs)
+        monkeypatch.setattr(damped, "follow_roots", failing)
+    with pytest.raises(ComputationError, match="could not be followed"):
+        batch_complex_modes(STAY, atts, tensions, 6, certify=False)
+    s = batch_complex_modes(STAY, atts, tensions, 6, certify=False, lost="nan")
+    assert np.allclose(s[0], good[0], rtol=1e-12) and np.all(np.isnan(s[1]))
+
+
+def _failing_second(solve):
+    """The kernel's solve with the status of its second configuration set to a lost path."""
+    def wrapped(*args):
+        raw, status = solve(*args)
+        status = bytearray(status)
+        status[4:8] = np.array([1], dtype=np.intc).tobytes()
+        return raw, bytes(status)
+    return wrapped

@@ -27,7 +27,7 @@ from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
 from ..identify.plausibility import check_plausibility as plausible
-from ..identify.problem import Measurement, gather_measurements, mode_label, picked_planes
+from ..identify.problem import Measurement, gather_measurements, mode_label, picked_planes, reset_warm_starts
 from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
@@ -189,6 +189,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     order = {s: (len(s), i) for i, s in enumerate(sets)}
     fits = {s: fits[s] for s in sorted(fits, key=lambda s: order.get(s, (len(s), len(sets))))}
     timings = {s: timings[s] for s in fits}
+    reset_warm_starts()  # what follows in this process must not depend on which jobs ran here
     if needs_model_error(fits, n):
         reference = data(campaign, measurements, settings.tension_model)  # the frequencies (and damping ratios)
         for fit in fits.values():
@@ -304,6 +305,7 @@ def _fit_job(job) -> tuple[tuple[str, ...], HypothesisFit, float]:
     """Fit and cross-validate one hypothesis (runs in a worker process)."""
     campaign, measurements, effects, tension_model, symmetric, seeds = job
     t0 = time.perf_counter()
+    reset_warm_starts()  # the hypothesis's result depends on it alone, in whichever worker it runs
     if not effects:
         fit = fit_nominal(campaign, measurements, tension_model)
         return effects, fit, time.perf_counter() - t0

@@ -425,8 +425,76 @@ done:
     return result;
 }
 
+/* Warm start: each of the n roots of configuration cfg by the secant method from start[k] (a nearby
+ * configuration's root). 0 when every root converged within JUMP of the distance from its start to the
+ * nearest other start, Im s > 0, the roots distinct and in the starts' order by Im s; else 7 (the caller
+ * solves the configuration from its undamped roots instead). */
+static int refine_config(const Problem *P, long long cfg, const cplx *start, int n, cplx *s) {
+    for (int k = 0; k < n; k++) {
+        cplx s0 = start[k];
+        if (!isfinite(creal(s0)) || !isfinite(cimag(s0)) || !(cimag(s0) > 0)) return 7;
+        double gap = INFINITY;
+        for (int j = 0; j < n; j++)
+            if (j != k && cabs(start[j] - s0) < gap) gap = cabs(start[j] - s0);
+        if (!(gap > 0)) return 7;
+        cplx b = s0 * (1 + 1e-7), root;
+        if (secant(P, cfg, 1.0, s0, cdet(P, cfg, s0, 1.0), b, &root) != 0) return 7;
+        if (!(cabs(root - s0) <= JUMP * gap) || !(cimag(root) > 0)) return 7;
+        for (int j = 0; j < k; j++) {
+            if (cabs(s[j] - root) <= DUPLICATE * cabs(root)) return 7;
+            if ((cimag(start[j]) < cimag(s0)) != (cimag(s[j]) < cimag(root))) return 7;
+        }
+        s[k] = root;
+    }
+    return 0;
+}
+
+/* refine(topology ints, arrays..., configs, starts (configs × n), n) -> (bytes of complex128 s, configs × n,
+ *        bytes of int32 status per config: 0 or 7) */
+static PyObject *py_refine(PyObject *self, PyObject *args) {
+    int n_att, n_dof, n_h, string, tension_model, n;
+    PyObject *objs[PROBLEM_ARRAYS + 3];
+    if (!PyArg_ParseTuple(args, "iiiii" "OOOOOOOOOOOOOOO" "i", &n_att, &n_dof, &n_h, &string, &tension_model,
+                          &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
+                          &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13], &objs[14], &n))
+        return NULL;
+    static const char *const names[PROBLEM_ARRAYS + 3] = {PROBLEM_ARRAY_NAMES, "dash", "configs", "starts"};
+    Py_buffer views[PROBLEM_ARRAYS + 3];
+    Problem P;
+    PyObject *result = NULL;
+    int got = open_buffers(objs, names, PROBLEM_ARRAYS + 3, views);
+    if (got < PROBLEM_ARRAYS + 3
+        || problem_of(&P, n_att, n_dof, n_h, string, tension_model, views, views[12].buf) != 0)
+        goto done;
+    if (n < 1 || n > MAX_MODES) {
+        PyErr_SetString(PyExc_ValueError, "refine: the number of roots must be 1 ... 512");
+        goto done;
+    }
+    const long long *configs = views[13].buf;
+    const cplx *starts = views[14].buf;
+    Py_ssize_t n_cfg = views[13].len / (Py_ssize_t)sizeof(long long);
+    if (views[14].len != n_cfg * n * (Py_ssize_t)sizeof(cplx)) {
+        PyErr_SetString(PyExc_ValueError, "refine: starts must hold n roots per configuration");
+        goto done;
+    }
+    PyObject *out = PyBytes_FromStringAndSize(NULL, n_cfg * n * (Py_ssize_t)sizeof(cplx));
+    PyObject *status = PyBytes_FromStringAndSize(NULL, n_cfg * (Py_ssize_t)sizeof(int));
+    if (!out || !status) { Py_XDECREF(out); Py_XDECREF(status); goto done; }
+    cplx *s = (cplx *)PyBytes_AS_STRING(out);
+    int *st = (int *)PyBytes_AS_STRING(status);
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n_cfg; i++)
+        st[i] = refine_config(&P, configs[i], starts + i * n, n, s + i * n);
+    Py_END_ALLOW_THREADS
+    result = Py_BuildValue("NN", out, status);
+done:
+    close_buffers(views, got);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"solve", py_solve, METH_VARARGS, "Complex eigenvalues (rad/s) of damped configurations, with a status each."},
+    {"refine", py_refine, METH_VARARGS, "Complex eigenvalues (rad/s) refined from a nearby configuration's, with a status each."},
     {NULL, NULL, 0, NULL},
 };
 

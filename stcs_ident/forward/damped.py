@@ -126,11 +126,19 @@ def _modes(s: np.ndarray) -> ComplexModes:
 
 def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension, n_modes: int = 6, *,
                         tension_model: str = "uniform", certify: bool = True, plane: str | None = "in",
-                        **overrides) -> np.ndarray:
+                        start: np.ndarray | None = None, lost: str = "raise", **overrides) -> np.ndarray:
     """Complex eigenvalues s (rad/s) of many parameter sets, shape ``broadcast_shape + (n_modes,)``.
 
     Parameters as :func:`~stcs_ident.forward.batch_frequencies` (``plane`` too), with one more per-attachment
     override, ``coefficients`` (N s/m, the dashpots; 0 for an attachment without one).
+
+    ``start``: the ``n_modes`` eigenvalues of a nearby parameter set (a fit's previous point), broadcast
+    against the result. Each is then refined by the secant method (:func:`_warm`), and a parameter set whose
+    roots do not all pass the warm start's checks is solved from its undamped roots as without it. Not with
+    ``certify`` (a count needs the contour).
+
+    ``lost``: ``"raise"`` (a :class:`~stcs_ident.core.errors.ComputationError` when a parameter set's roots
+    cannot be found) or ``"nan"`` (that set's roots NaN, the others kept: a fit's extreme trial points).
     """
     if int(n_modes) < 1:
         raise ModelError(f"must be >= 1, got {n_modes}", field="n_modes")
@@ -141,24 +149,79 @@ def batch_complex_modes(cable: Cable, attachments: Sequence[Attachment], tension
     shape, groups = build_batch(cable, attachments, tension, tension_model=tension_model, **overrides)
     total = math.prod(shape)
     out = np.empty((total, n_modes), dtype=complex)
+    warm = None
+    if start is not None and not certify and use_kernel():
+        warm = np.broadcast_to(np.asarray(start, complex), shape + (n_modes,)).reshape(total, n_modes)
     for batch, sel in groups:
-        count = len(sel)
-        config, mode = mode_items(0, count, n_modes + 1)
-        omega = solve_modes(batch, config, mode).reshape(count, n_modes + 1)
-        s = 1j * omega
-        damped = np.flatnonzero(batch.dashpots.any(axis=1))
-        pinned = _pinned_roots(batch, damped, n_modes + 1) if damped.size else None
-        if damped.size and use_kernel() and batch.n_dof <= 64 and n_modes < MAX_KERNEL_MODES:
-            s[damped] = _solve_compiled(batch, damped, omega, pinned, n_modes, certify)
+        cold = np.arange(len(sel))
+        if warm is not None and batch.dashpots.any() and batch.n_dof <= 64:
+            s, ok = _warm(batch, warm[sel], n_modes)
+            out[sel[ok]] = s[ok]
+            cold = np.flatnonzero(~ok)
+        if cold.size:
+            out[sel[cold]] = _cold(batch, cold, n_modes, certify, lost)
+    return out.reshape(shape + (n_modes,))
+
+
+def _warm(batch, start: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """The roots of every damped configuration of ``batch`` refined from ``start`` (configs × n_modes) by the
+    compiled kernel's secant method, and which configurations passed its checks: every root converged
+    within a quarter of the distance from its start to the nearest other start (it cannot have jumped to a
+    neighbour's), with Im s > 0, distinct and in the starts' order. A fit's trial points move the roots by a
+    small fraction of their spacing, and a few determinants per root replace the undamped solve, the pinned
+    solve and the path from the undamped root."""
+    count = len(batch)
+    configs = np.flatnonzero(batch.dashpots.any(axis=1))
+    s = np.full((count, n_modes), np.nan, dtype=complex)
+    ok = np.zeros(count, bool)
+    if configs.size:
+        raw, status = _damped_kernel.refine(*_kernel_problem(batch), np.ascontiguousarray(configs, dtype=np.int64),
+                                            np.ascontiguousarray(start[configs], dtype=complex), int(n_modes))
+        s[configs] = np.frombuffer(raw, dtype=complex).reshape(configs.size, n_modes)
+        ok[configs] = np.frombuffer(status, dtype=np.intc) == 0
+    return s, ok
+
+
+def _cold(batch, configs: np.ndarray, n_modes: int, certify: bool, lost: str = "raise") -> np.ndarray:
+    """The first ``n_modes`` roots of the configurations ``configs`` of ``batch``, each from its undamped
+    roots, (len(configs), n_modes); ``lost`` as :func:`batch_complex_modes`'s."""
+    n = n_modes + 1
+    config = np.repeat(configs.astype(np.int64), n)
+    mode = np.tile(np.arange(1, n + 1, dtype=np.int64), configs.size)
+    omega_sub = solve_modes(batch, config, mode).reshape(configs.size, n)
+    omega = np.zeros((len(batch), n))  # the kernel indexes the undamped roots by configuration
+    omega[configs] = omega_sub
+    s = 1j * omega_sub
+    where = np.flatnonzero(batch.dashpots[configs].any(axis=1))  # rows of s
+    damped = configs[where]
+    if damped.size:
+        pinned = _pinned_roots(batch, damped, n)
+        if use_kernel() and batch.n_dof <= 64 and n_modes < MAX_KERNEL_MODES:
+            s[where] = _solve_compiled(batch, damped, omega, pinned, n_modes, certify, lost)
         else:
             for i, c in enumerate(damped):
-                s[c] = follow_roots(batch, int(c), omega[c], pinned[i], tolerant=certify)
-                if certify:
-                    s[c] = complete(batch, int(c), omega[c], s[c], n_modes)
-        if damped.size:
-            s[damped] = np.take_along_axis(s[damped], np.argsort(s[damped].imag, axis=1), axis=1)
-        out[sel] = s[:, :n_modes]
-    return out.reshape(shape + (n_modes,))
+                try:
+                    s[where[i]] = follow_roots(batch, int(c), omega[c], pinned[i], tolerant=certify)
+                    if certify:
+                        s[where[i]] = complete(batch, int(c), omega[c], s[where[i]], n_modes)
+                except ComputationError:
+                    if lost != "nan":
+                        raise
+                    s[where[i]] = np.nan
+        s[where] = np.take_along_axis(s[where], np.argsort(s[where].imag, axis=1), axis=1)
+    return s[:, :n_modes]
+
+
+def _kernel_problem(batch) -> tuple:
+    """The leading arguments of the compiled kernel's entry points for ``batch``."""
+    topo = batch.topology
+    model = {"none": 0, "uniform": 1, "per-segment": 2}[topo.tension_model]
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)
+    return (topo.n_attachments, batch.n_dof, topo.n_h, int(topo.string), model,
+            i64(batch.v_dof), i64(batch.t_dof), i64(batch.h_dof),
+            f64(batch.length), f64(batch.m), f64(batch.EI), f64(batch.H), f64(batch.w), f64(batch.seg_len),
+            f64(batch.masses), f64(batch._constant), f64(batch._scale), f64(batch.dashpots))
 
 
 def use_kernel() -> bool:
@@ -190,22 +253,17 @@ def _pinned_roots(batch, configs: np.ndarray, n: int) -> np.ndarray:
     return solve_modes(pinned, config[keep], mode[keep]).reshape(len(configs), n)
 
 
-def _solve_compiled(batch, configs, omega, pinned, n_modes, certify):
-    topo = batch.topology
-    model = {"none": 0, "uniform": 1, "per-segment": 2}[topo.tension_model]
+def _solve_compiled(batch, configs, omega, pinned, n_modes, certify, lost: str = "raise"):
     f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)
-    raw, status = _damped_kernel.solve(
-        topo.n_attachments, batch.n_dof, topo.n_h, int(topo.string), model,
-        i64(batch.v_dof), i64(batch.t_dof), i64(batch.h_dof),
-        f64(batch.length), f64(batch.m), f64(batch.EI), f64(batch.H), f64(batch.w), f64(batch.seg_len),
-        f64(batch.masses), f64(batch._constant), f64(batch._scale), f64(batch.dashpots), i64(configs), f64(omega), f64(pinned),
-        int(n_modes), int(bool(certify)),
-    )
+    raw, status = _damped_kernel.solve(*_kernel_problem(batch), np.ascontiguousarray(configs, dtype=np.int64),
+                                       f64(omega), f64(pinned), int(n_modes), int(bool(certify)))
     status = np.frombuffer(status, dtype=np.intc)
+    s = np.frombuffer(raw, dtype=complex).reshape(len(configs), n_modes + 1).copy()
     if status.any():
-        raise ComputationError(_FAILURES[int(status[status != 0][0])])
-    return np.frombuffer(raw, dtype=complex).reshape(len(configs), n_modes + 1).copy()
+        if lost != "nan":
+            raise ComputationError(_FAILURES[int(status[status != 0][0])])
+        s[status != 0] = np.nan
+    return s
 
 
 def determinant(batch, config: int, s: np.ndarray, t: float = 1.0) -> np.ndarray:

@@ -13,7 +13,7 @@ from ..core.notes import Note
 from ..core.parameters import parse_parameters
 from ..core.settings import Settings
 from .nuisance import nuisance_parameters
-from .problem import Problem, gather_measurements
+from .problem import Problem, gather_measurements, reset_warm_starts
 from .result import IdentificationResult
 
 METHODS = ("lsq", "contour")
@@ -114,6 +114,7 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         check(campaign, measurements, settings.tension_model)
     nuisance = nuisance_parameters(campaign, [m.test for m in measurements], parameters) if tolerances else ()
     problem = Problem(campaign, measurements, parameters, settings.tension_model, nuisance=nuisance)
+    reset_warm_starts()  # the result depends on these inputs alone, not on what this process solved before
     if method == "lsq":
         from .lsq import fit_lsq
 

@@ -231,8 +231,18 @@ class Problem:
         cable = self.campaign.cable
         try:
             if damped or _dashpots(atts, overrides):  # the fit's trial points: uncertified (see FIT_CERTIFY)
+                # Warm-started from the last row solved: a fit's next trial point, or a Jacobian's steps, moves
+                # each root by a small part of its spacing (forward.damped._warm checks that, else solves cold).
+                # The start is scaled by √(H / H_last): the tension moves every root about so.
+                key = _roots_key(cable, atts, plane, n_modes, self.tension_model)
+                last = _LAST_ROOTS.get(key, _LAST_ROOTS.get(key[:1] + key[2:]))  # else another setup's, if any
+                start = None if last is None else last[1][None, :] * np.sqrt(np.reshape(tension, (-1, 1)) / last[0])
                 s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                        certify=FIT_CERTIFY, plane=plane, **overrides)
+                                        certify=FIT_CERTIFY, plane=plane, start=start, lost="nan", **overrides)
+                if np.all(np.isfinite(s[-1])) and np.all(s[-1].imag > 0):
+                    _LAST_ROOTS[key] = _LAST_ROOTS[key[:1] + key[2:]] = (float(np.ravel(tension)[-1]), s[-1].copy())
+                    while len(_LAST_ROOTS) > MAX_WARM_STARTS:
+                        del _LAST_ROOTS[next(iter(_LAST_ROOTS))]
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
             return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
                                      plane=plane, **overrides), None
@@ -295,6 +305,32 @@ class Problem:
         r = (self.predict(np.atleast_2d(X)) - self.measured) / self.sigma
         c = np.sum(r**2, axis=1)
         return np.where(np.isfinite(c), c, np.inf)
+
+
+#: The tension and complex roots of the last damped row solved per (cable, attachments, plane, modes, tension model), in
+#: this process: the warm start of the next solve of that model (:meth:`Problem._solve`), whichever fit asks
+#: (a diagnosis's hypotheses and cross-validation folds start near each other's points); and per model without
+#: its attachments, the start of a setup not solved yet (a hypothesis's added mass moves the roots a little; the
+#: warm start's checks refuse what moved too far). At most this many.
+MAX_WARM_STARTS = 64
+_LAST_ROOTS: dict = {}
+
+
+def reset_warm_starts() -> None:
+    """Forget the roots kept for warm starts: a computation that begins here (an identification, one
+    hypothesis of a diagnosis with its cross-validation) then depends on its own inputs only, not on what
+    this process solved before (a warm start that succeeds where the cold solve of a trial point fails can
+    lead a fit elsewhere; the fitted values agree to about 1e-9 where the fit is well posed)."""
+    _LAST_ROOTS.clear()
+
+
+def _roots_key(cable, atts, plane: str, n_modes: int, tension_model: str):
+    try:
+        key = (cable, tuple(atts), plane, n_modes, tension_model)
+        hash(key)
+    except TypeError:  # an unhashable attachment (none today): the roots are kept per object
+        key = (id(cable), tuple(id(a) for a in atts), plane, n_modes, tension_model)
+    return key
 
 
 def _dashpots(atts, overrides) -> bool:
