@@ -271,6 +271,7 @@ def plot_damping(table, fig=None) -> Drawn:
         edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
         ax_d.stairs(np.nan_to_num(sigma), edges, baseline=-np.nan_to_num(sigma), fill=True, color="0.85", lw=0)
         ax_d.axhline(0.0, color="tab:blue", lw=0.8)
+        ax_d.use_sticky_edges = False  # the band's edges must not clip the points at zero
         for key in models:
             label, colour, marker, dx = DAMPING_STYLE[key]
             model = 100 * rows[key].to_numpy(float)
