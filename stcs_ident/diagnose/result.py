@@ -22,7 +22,7 @@ from ..forward.compare import ForwardResult
 from ..identify.problem import Measurement
 from .fitting import HypothesisFit
 from .selection import Selection, baseline_fit, ranking
-from .tables import diagnosis_tables
+from .tables import damping_columns, diagnosis_tables
 
 
 def _finite_or_none(v: float | None) -> float | None:
@@ -165,6 +165,7 @@ class Diagnosis(Result):
         parts = {"nominal": self.per_test(nominal), "corrected": self.per_test(corrected)}
         if baseline is not None:
             parts["baseline"] = self.per_test(baseline)
+        damping = damping_columns(self)
         for i, m in enumerate(self.measurements):
             entry = {"name": m.name, "setup": m.test.setup, "modes": [int(k) for k in m.modes],
                      "planes": [str(p) for p in m.planes],
@@ -173,6 +174,8 @@ class Diagnosis(Result):
                 entry[label] = values[i].tolist()
             for label, values in parts.items():
                 entry[f"{label}_error"] = percent_error(values[i], m.frequencies).tolist()
+            if damping is not None and np.isfinite(damping[i]["measured"]).any():
+                entry["damping"] = {key: [_finite_or_none(v) for v in values] for key, values in damping[i].items()}
             tests.append(entry)
         ranked = self.ranked
         best = ranked[0].aicc

@@ -2,7 +2,9 @@
 
 Every number of the report comes from these tables: the ranking of the
 hypotheses, the frequencies per test and mode, the gain, the named cause's
-parameters and the nominal comparison (taut string, pinned beam, DSM).
+parameters, the nominal comparison (taut string, pinned beam, DSM) and, where
+the damping ratios are data (a damper in question), the damping ratios
+measured and modelled.
 They are data, laid out by :mod:`stcs_ident.report.diagnose`.
 """
 
@@ -16,9 +18,14 @@ import pandas as pd
 from .. import effects as registry
 from ..core import kinds
 from ..core.formatting import percent_error
+from ..identify.problem import DAMPING_SPREAD
+from .fitting import data
 
 #: The tables of :func:`diagnosis_tables`, in order (each a CSV file of the report).
 TABLES = ("ranking", "frequencies", "gain", "nominal_comparison", "cause")
+#: Columns of :func:`damping_table`.
+DAMPING_COLUMNS = ("test", "setup", "mode", "plane", "measured", "uncertainty", "sigma", "nominal", "corrected",
+                   "nominal_z", "corrected_z")
 
 
 def effects_label(effects) -> str:
@@ -156,9 +163,62 @@ def nominal_comparison(diagnosis) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def damping_columns(diagnosis) -> list[dict[str, np.ndarray]] | None:
+    """Per measurement, its damping ratios measured and modelled, by mode (NaN where a mode's ratio is not data);
+    None when the damping ratios are not data of the diagnosis (no damper in question, or none measured).
+
+    Keys: ``measured`` and ``uncertainty`` (its 1σ from the spectra); ``sigma``, the σ the diagnosis weighs it
+    by (the 1σ with :data:`~stcs_ident.identify.problem.DAMPING_SPREAD`, the mode-to-mode spread of a cable's
+    own damping, added in quadrature); ``nominal`` and ``corrected``, the ratios of the nominal model and of
+    the chosen hypothesis (the dampers' −Re(s)/|s| of the complex modes plus the cable's own ratio profiled
+    out of the data, as each fit weighed them); ``nominal_z`` and ``corrected_z``, (measured − model) / sigma,
+    whose squares are the damping ratios' terms of each model's χ².
+    """
+    d = diagnosis
+    if not any(m.damping_is_data for m in d.measurements):
+        return None
+    problem = data(d.campaign, d.measurements, d.settings.tension_model)
+    if not problem.use_damping:
+        return None
+    rows = {}
+    for key, fit in (("nominal", d.nominal), ("corrected", d.corrected)):
+        predicted = np.asarray(fit.predicted, float)
+        rows[key] = predicted if predicted.size == problem.n_data else np.full(problem.n_data, np.nan)
+    out = []
+    for columns in problem.damping_columns(rows["nominal"], rows["corrected"]):
+        sigma = np.hypot(columns["uncertainty"], DAMPING_SPREAD)
+        entry = {"measured": columns["measured"], "uncertainty": columns["uncertainty"], "sigma": sigma,
+                 "nominal": columns["before"], "corrected": columns["after"]}
+        for key in ("nominal", "corrected"):
+            entry[f"{key}_z"] = (entry["measured"] - entry[key]) / sigma
+        out.append(entry)
+    return out
+
+
+def damping_table(diagnosis) -> pd.DataFrame:
+    """Per test and mode whose damping ratio is data of the diagnosis: measured (with its 1σ), the σ it is
+    weighed by, the nominal and the chosen (corrected) model's ratios and each one's z (:func:`damping_columns`;
+    ratios, not percent). No rows when the damping ratios are not data."""
+    d = diagnosis
+    columns = damping_columns(d)
+    if columns is None:
+        return pd.DataFrame(columns=list(DAMPING_COLUMNS))
+    frames = []
+    for m, entry in zip(d.measurements, columns):
+        used = np.isfinite(entry["measured"])
+        frame = {"test": m.name, "setup": m.test.setup, "mode": m.modes[used], "plane": [str(p) for p in m.planes[used]]}
+        frame |= {key: entry[key][used] for key in DAMPING_COLUMNS[4:]}
+        frames.append(pd.DataFrame(frame, columns=list(DAMPING_COLUMNS)))
+    return pd.concat(frames, ignore_index=True)
+
+
 def diagnosis_tables(diagnosis) -> dict[str, pd.DataFrame]:
-    """Every table of :data:`TABLES` by name; ``nominal_comparison`` only when the diagnosis carries one."""
+    """Every table of :data:`TABLES` by name; ``nominal_comparison`` only when the diagnosis carries one;
+    ``damping`` (:func:`damping_table`) added when the damping ratios are data."""
     makers = {"ranking": ranking_table, "frequencies": frequency_table, "gain": gain_table,
               "nominal_comparison": nominal_comparison, "cause": cause_table}
-    return {name: makers[name](diagnosis) for name in TABLES
-            if name != "nominal_comparison" or diagnosis.comparison is not None}
+    out = {name: makers[name](diagnosis) for name in TABLES
+           if name != "nominal_comparison" or diagnosis.comparison is not None}
+    if damping_columns(diagnosis) is not None:
+        out["damping"] = damping_table(diagnosis)
+    return out

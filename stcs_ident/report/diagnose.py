@@ -18,9 +18,11 @@ import pandas as pd
 from ..core.errors import InputError
 from ..core.files import whole_directory, write_atomic, write_csv, write_figure
 from ..core.formatting import counted, markdown_table, number, percent, rms
+from .diagnose_damping import DAMPING_CSV, DAMPING_PNG, damping_lines
 from .diagnose_tables import (
     CSV_FILES,
     cause_table,
+    damping_table,
     effects_label,
     frequency_table,
     gain_table,
@@ -59,6 +61,9 @@ def diagnosis_text(diagnosis) -> str:
     if d.test_cv:
         shown = ", ".join(f"{label} {value:.3f} %" for label, value in d.test_cv.items())
         lines.append(f"Leave one test out (each test predicted from the others, its tension as stated): {shown}.")
+    damping = damping_lines(damping_table(d), effects_label(d.corrected.effects))
+    if damping:
+        lines += ["", *damping[:-1]]
     for note in d.notes:
         lines.append(f"Note: {note}")
     for name, reason in d.skipped:
@@ -233,6 +238,18 @@ def _before_after_section(d, freq: pd.DataFrame, figures: dict) -> list[str]:
     return out
 
 
+def _damping_section(d, table: pd.DataFrame, figures: dict) -> list[str]:
+    """Measured against modelled damping ratios (nothing when the damping ratios are not data)."""
+    if table.empty:
+        return []
+    out = ["## Damping ratios, measured and modelled", ""]
+    if "damping" in figures:
+        out += [f"![Damping ratios per mode]({figures['damping']})", "",
+                ("Damping ratio in % per mode for each test: measured with ±1σ error bars, the nominal and the "
+                 "corrected model's."), ""]
+    return out + damping_lines(table, effects_label(d.corrected.effects), "markdown")
+
+
 def _gain_section(d, gain: pd.DataFrame) -> list[str]:
     g = d.summary()["gain"]
     sentence = (f"The rms error against the measured frequencies is {percent(g['rms_error_nominal'])} with the nominal "
@@ -289,9 +306,13 @@ def report_markdown(diagnosis, tables: dict, figures: dict, spectra=None) -> str
     lines += _ranking_section(d, tables["ranking"])
     lines += _cause_section(d, tables["cause"], figures)
     lines += _before_after_section(d, tables["frequencies"], figures)
+    damping = tables.get("damping")
+    if damping is not None:
+        lines += _damping_section(d, damping, figures)
     lines += _gain_section(d, tables["gain"])
     lines += _notes_section(d)
-    lines += ["## Files", "", "Tables as CSV: " + ", ".join(f"[{f}]({f})" for f in CSV_FILES) + ".", ""]
+    csv = CSV_FILES + ((DAMPING_CSV,) if damping is not None and not damping.empty else ())
+    lines += ["## Files", "", "Tables as CSV: " + ", ".join(f"[{f}]({f})" for f in csv) + ".", ""]
     return "\n".join(lines)
 
 
@@ -322,7 +343,9 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
     ``out_dir`` gets ``report.md`` (tables, figures and the named cause in
     plain words), the tables as CSV (:data:`CSV_FILES`) and the figures as
     PNG: ``residuals.png``, ``profile.png`` when the cause is an unmodeled
-    mass or support, and ``spectra_<test>.png`` for each test with a record.
+    mass or support, and ``spectra_<test>.png`` for each test with a record;
+    where the damping ratios are data (a damper in question), also
+    ``damping.csv`` and ``damping.png``, measured against modelled.
     The report is built in a temporary directory beside ``out_dir`` and
     renamed; an existing ``out_dir`` is replaced as a whole only once the
     new report is complete, and left untouched if anything fails.
@@ -353,6 +376,9 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
     spectra = d.spectra if spectra is None else spectra
     tables = {"ranking": ranking_table(d), "frequencies": frequency_table(d), "gain": gain_table(d),
               "nominal_comparison": nominal_comparison(d), "cause": cause_table(d)}
+    damping = damping_table(d)
+    if not damping.empty:  # a damper in question: its table and figure
+        tables["damping"] = damping
     with whole_directory(out) as tmp:
         for name, frame in tables.items():
             write_csv(frame, tmp / f"{name}.csv", index=False)
@@ -368,6 +394,9 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
                     figures["spectra"].append((ts.name, file))
         write_figure(diagnosis_figures.plot_residuals(d)["figure"], tmp / "residuals.png")
         figures["residuals"] = "residuals.png"
+        if "damping" in tables:
+            write_figure(diagnosis_figures.plot_damping(damping)["figure"], tmp / DAMPING_PNG)
+            figures["damping"] = DAMPING_PNG
         if diagnosis_figures.profile_scans(d):
             drawn = diagnosis_figures.plot_profiles(d)
             write_figure(drawn["figure"], tmp / "profile.png")

@@ -224,3 +224,70 @@ def _broken_between_planes(x: np.ndarray, y: np.ndarray, planes) -> tuple[np.nda
         return x, y
     first = int(np.argmax(out))
     return np.insert(np.asarray(x, float), first, np.nan), np.insert(np.asarray(y, float), first, np.nan)
+
+
+#: How the damping figure draws the models: label, colour, marker, x offset (modes).
+DAMPING_STYLE = {
+    "nominal": ("nominal model", "0.35", "o", -0.15),
+    "corrected": ("corrected: chosen hypothesis", "tab:red", "^", 0.15),
+}
+
+
+def plot_damping(table, fig=None) -> Drawn:
+    """Damping ratio (%) per mode for each test: measured with ±1σ error bars, the nominal and the corrected
+    model's; below, each model's ratio minus the measured one (% points) over the measured ±1σ band (the
+    ratios grow with the mode, and a misfit of a few hundredths of a per cent is lost at their scale).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :func:`~stcs_ident.diagnose.tables.damping_table` (not empty).
+    fig : matplotlib.figure.Figure, optional
+
+    Returns
+    -------
+    dict with the figure, the axes (``axes``: (ratio, difference) per test), the measured error bars
+    (``measured``: one per test) and the models' points (``lines``: {model: [Line2D per test]}, the ratios;
+    ``corrected`` absent when it is the nominal model).
+    """
+    tests = list(dict.fromkeys(table["test"]))
+    n = len(tests)
+    ncols = 1 if n == 1 else 2
+    nrows = math.ceil(n / ncols)
+    fig = fig or new_figure(figsize=(5.2 * ncols, 3.6 * nrows + 0.6), layout="constrained")
+    panels = np.atleast_1d(fig.subfigures(nrows, ncols, squeeze=False).ravel())
+    same = np.array_equal(table["nominal"].to_numpy(), table["corrected"].to_numpy(), equal_nan=True)
+    models = ["nominal"] if same else ["nominal", "corrected"]
+    lines: dict[str, list] = {key: [] for key in models}
+    measured, axes = [], []
+    for i, (test, panel) in enumerate(zip(tests, panels)):
+        rows = table[table["test"] == test]
+        modes, planes = rows["mode"].to_numpy(int), rows["plane"].to_numpy(str)
+        k, _ = mode_axis(modes, planes)
+        zeta, sigma = 100 * rows["measured"].to_numpy(float), 100 * rows["uncertainty"].to_numpy(float)
+        ax, ax_d = panel.subplots(2, 1, sharex=True, height_ratios=(2, 1))
+        measured.append(ax.errorbar(k, zeta, yerr=sigma, fmt="s", ms=5, color="tab:blue", capsize=3, lw=1.0,
+                                    label="measured (±1σ)"))
+        edges = np.concatenate([[k[0] - 0.4], (k[:-1] + k[1:]) / 2, [k[-1] + 0.4]])
+        ax_d.stairs(np.nan_to_num(sigma), edges, baseline=-np.nan_to_num(sigma), fill=True, color="0.85", lw=0)
+        ax_d.axhline(0.0, color="tab:blue", lw=0.8)
+        ax_d.use_sticky_edges = False  # the band's edges must not clip the points at zero
+        for key in models:
+            label, colour, marker, dx = DAMPING_STYLE[key]
+            model = 100 * rows[key].to_numpy(float)
+            lines[key].append(ax.plot(k + dx, model, ls="none", marker=marker, color=colour, ms=5, label=label)[0])
+            ax_d.plot(k + dx, model - zeta, ls="none", marker=marker, color=colour, ms=4)
+        ax.set_title(f"{test} (setup {rows['setup'].iloc[0]})", fontsize=9)
+        set_mode_ticks(ax_d, modes, planes)
+        ax_d.set_xlim(k.min() - 0.6, k.max() + 0.6)
+        for a in (ax, ax_d):
+            a.grid(True, axis="y", lw=0.3, alpha=0.6)
+        ax.set_ylabel("damping ratio (%)")
+        ax_d.set_ylabel("model − measured (%)", fontsize=8)
+        ax_d.set_xlabel("mode")
+        axes.append((ax, ax_d))
+    for panel in panels[n:]:
+        panel.set_visible(False)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside upper center", ncols=len(labels), fontsize=8, frameon=False)
+    return Drawn({"figure": fig, "axes": axes, "measured": measured, "lines": lines})

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from ..diagnose.tables import (
     cause_table,
+    damping_table,
     effects_label,
     frequency_table,
     gain_table,
@@ -12,7 +13,7 @@ from ..diagnose.tables import (
     ranking_table,
 )
 
-__all__ = ["CSV_FILES", "cause_table", "effects_label", "frequency_table", "gain_table",
+__all__ = ["CSV_FILES", "cause_table", "damping_table", "effects_label", "frequency_table", "gain_table",
            "nominal_comparison", "parameter_rows", "ranking_table"]
 
 #: Files of the report, besides the figures.

@@ -10,14 +10,13 @@ from __future__ import annotations
 import math
 import os
 
-import numpy as np
 import pandas as pd
 
 from ..core import files
-from ..core.formatting import number
+from ..core.formatting import is_missing, number
 from ..core.planes import PLANE_NAMES
 
-__all__ = ["MODES_CSV", "modes_table", "spectra_text", "write_modes_csv"]
+__all__ = ["MODES_CSV", "damping_cell", "modes_table", "spectra_text", "write_modes_csv"]
 
 #: File name of the table, in the ``--plot`` directory.
 MODES_CSV = "modes.csv"
@@ -45,10 +44,8 @@ def modes_table(results) -> pd.DataFrame:
     frames = []
     for r in results:
         frame = r.to_dataframe()
-        damping_sigma = np.full(len(r.modes), np.nan) if r.damping_uncertainty is None else r.damping_uncertainty
         frame.insert(0, "test", r.name)
         frame.insert(1, "record_kind", r.peaks.kind)
-        frame["damping_uncertainty"] = np.asarray(damping_sigma, float)
         frames.append(frame)
     if not frames:
         return pd.DataFrame(columns=_COLUMNS)
@@ -62,10 +59,24 @@ def write_modes_csv(results, directory: str | os.PathLike) -> str:
     return path
 
 
+#: Width of the damping ratio and of its 1σ (in %, three decimals) in the text table's ``damping % ± 1σ``.
+_DAMPING_WIDTH = 6
+
+
+def damping_cell(zeta: float, sigma: float) -> str:
+    """``ζ ± σ`` in % (three decimals each) with the ± at a fixed place, so that a column of them stays
+    aligned: the ratio alone where its σ is missing, :data:`~stcs_ident.core.formatting.MISSING` where the
+    ratio is."""
+    value = number(100 * zeta, "{:.3f}", width=_DAMPING_WIDTH)
+    if is_missing(zeta) or is_missing(sigma):
+        return value + " " * (_DAMPING_WIDTH + 3)
+    return f"{value} ± {number(100 * sigma, '{:.3f}'):<{_DAMPING_WIDTH}}"
+
+
 def spectra_text(campaign: str, results, skipped) -> str:
     """The ``spectra`` tables: per test, mode (and its plane where the record has channel directions),
-    frequency, uncertainty, damping, MAC, channels; then the peaks left unnumbered, the structural ones (the
-    deck's or pylon's, never numbered) and the notes."""
+    frequency, uncertainty, damping ratio with its 1σ (:func:`damping_cell`), MAC, channels; then the peaks left
+    unnumbered, the structural ones (the deck's or pylon's, never numbered) and the notes."""
     lines = [f"Campaign {campaign}: modal frequencies picked from the records", ""]
     for r in results:
         lines.append(f"Test {r.name} ({r.peaks.kind} record {os.path.basename(r.record)})")
@@ -74,16 +85,18 @@ def spectra_text(campaign: str, results, skipped) -> str:
         for option, given, found in getattr(r, "record_replaced", ()):
             lines.append(f"  record: {option} {given!r} from record_format replaces the file's {found!r}")
         planes = r.planes is not None
-        macs = r.to_dataframe()["mac"]
+        table = r.to_dataframe()
         head = f"{'plane':>5} " if planes else ""
-        lines.append(f"{head}{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping %':>9} {'MAC':>5}  channels")
-        for k, f, u, z, ch, doubt, plane, m in zip(r.modes, r.frequencies, r.uncertainty, r.damping, r.channels,
-                                                   r.doubtful, r.mode_planes, macs):
+        width = 2 * _DAMPING_WIDTH + 3
+        lines.append(f"{head}{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping % ± 1σ':>{width}} {'MAC':>5}"
+                     "  channels")
+        for k, f, u, z, s, ch, doubt, plane, m in zip(r.modes, r.frequencies, r.uncertainty, table["damping"],
+                                                      table["damping_uncertainty"], r.channels, r.doubtful,
+                                                      r.mode_planes, table["mac"]):
             flag = "?" if doubt else " "
-            zeta = number(100 * z, "{:.2f}")
             mac = "" if math.isnan(m) else f"{m:.2f}"
             head = f"{plane:>5} " if planes else ""
-            lines.append(f"{head}{k:>3}{flag} {f:11.4f} {u:11.5f} {zeta:>9} {mac:>5}  {' '.join(ch)}")
+            lines.append(f"{head}{k:>3}{flag} {f:11.4f} {u:11.5f} {damping_cell(z, s)} {mac:>5}  {' '.join(ch)}")
         if any(r.doubtful):
             lines.append("  ? = doubtful mode number: another family of modes fits almost as well")
         where = r.unassigned_planes or ("in",) * len(r.unassigned)

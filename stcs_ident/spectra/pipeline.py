@@ -138,7 +138,7 @@ class TestSpectra(PickingResult):
     def to_dataframe(self) -> pd.DataFrame:
         return pd.DataFrame({
             "mode": self.modes, "frequency_Hz": self.frequencies, "uncertainty_Hz": self.uncertainty,
-            "damping": self.damping, "doubtful": self.doubtful,
+            "damping": self.damping, "damping_uncertainty": self.damping_sigmas(), "doubtful": self.doubtful,
             "channels": [" ".join(c) for c in self.channels], "plane": self.mode_planes,
             "mac": self._macs(),
         })
@@ -146,12 +146,19 @@ class TestSpectra(PickingResult):
     def _macs(self) -> np.ndarray:
         return np.full(len(self.modes), np.nan) if self.mac is None else np.asarray(self.mac, float)
 
+    def damping_sigmas(self) -> np.ndarray:
+        """The 1σ of each mode's damping ratio (NaN where not estimated, all NaN when none was)."""
+        if self.damping_uncertainty is None:
+            return np.full(len(self.modes), np.nan)
+        return np.asarray(self.damping_uncertainty, float)
+
     def summary(self) -> dict:
         return {
             "name": self.name, "record": self.record, "kind": self.peaks.kind, "modes": list(self.modes),
             "frequencies": [float(x) for x in self.frequencies],
             "uncertainty": [float(x) for x in self.uncertainty],
             "damping": [None if math.isnan(x) else float(x) for x in self.damping],
+            "damping_uncertainty": [None if math.isnan(x) else float(x) for x in self.damping_sigmas()],
             "channels": [list(c) for c in self.channels], "doubtful": list(self.doubtful),
             "unassigned": [{"frequency": f, "uncertainty": u, "plane": p} for (f, u), p in zip(
                 self.unassigned, self.unassigned_planes or ("in",) * len(self.unassigned))],
