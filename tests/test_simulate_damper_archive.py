@@ -315,6 +315,15 @@ def test_a_bad_damper_option_exits_2_with_one_line(tmp_path, capsys, option, wor
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.parametrize("option", [["--damper-change", "C1,seizure,2026-03-01T00:00:00"],
+                                    ["--damper-temperature-coefficient", "0.01"]])
+def test_a_damper_option_without_an_archive_exits_2(tmp_path, capsys, option):
+    code = main(["simulate", str(ROOT / "campaigns" / "damped-stay"), "--out", str(tmp_path / "x")] + option)
+    err = capsys.readouterr().err
+    assert code == 2 and f"option '{option[0]}'" in err and "--archive DAYS" in err
+    assert not (tmp_path / "x").exists()
+
+
 def test_a_damper_change_of_a_campaign_without_a_damper_exits_2(tmp_path, capsys):
     code = main(["simulate", str(ROOT / "campaigns" / "han2020"), "--out", str(tmp_path / "x"), "--archive", "0.01",
                  "--damper-change", "C1,seizure,2026-03-01T00:00:00"])

@@ -11,7 +11,7 @@ from .common import command_parser, worker_count, write_output
 
 TRACK_EXAMPLE = COMMANDS["track"].examples[0]
 
-__all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parser", "run",
+__all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parser", "check_archive_only", "run",
            "simulate_archive_from_args"]
 
 
@@ -88,6 +88,14 @@ def add_archive_options(sim) -> None:
     arc.add_argument("--damper-temperature-coefficient", type=float, metavar="A",
                      help="per °C: a damper's coefficient is c·exp(-A (θ - θ_mean)), stiffer in the cold "
                           "(default 0.015, silicone oil; 0: constant)")
+
+
+def check_archive_only(args) -> None:
+    """Refuses the damper options of an archive given without ``--archive`` (one line, exit 2)."""
+    for flag, given in (("--damper-change", args.damper_change),
+                        ("--damper-temperature-coefficient", args.damper_temperature_coefficient)):
+        if given is not None:
+            raise InputError("applies to an archive (--archive DAYS), not to a campaign's records", field=flag)
 
 
 def simulate_archive_from_args(args, campaign) -> int:
