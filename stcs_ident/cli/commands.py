@@ -39,6 +39,9 @@ class Command:
 
 ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/han2020 --out archive/ --archive 3 --cables 3 "
                    "--tension-change C2,2026-03-02T12:00:00+00:00,-0.015")
+DAMPED_ARCHIVE_EXAMPLE = ("stcs-ident simulate campaigns/damped-stay --out archive/ --archive 7 --cables 3 "
+                          "--sampling-rate 50 --duration 600 --damper-change C1,leak,2026-03-04T12:00:00+00:00,0.3 "
+                          "--damper-change C3,loss,2026-03-02T00:00:00+00:00,0.5,3")
 
 #: The commands, in the order ``--help`` lists them.
 COMMANDS: dict[str, Command] = {
@@ -52,7 +55,7 @@ COMMANDS: dict[str, Command] = {
                         ("stcs-ident simulate campaigns/han2020 --out sim/ --test case1-L4 --extra-mass 5@6.0 --seed 1",
                          ("stcs-ident simulate campaigns/han2020 --out sim3d/ --test case1-L4 --ambient 2 --triaxial "
                           "--deck-modes 1.9:0.05 --traffic 60:0.02 --misalignment 3"),
-                         ARCHIVE_EXAMPLE)),
+                         ARCHIVE_EXAMPLE, DAMPED_ARCHIVE_EXAMPLE)),
     "identify": Command("stcs_ident.cli.identify",
                         "correct tension, EI, attachment positions... from measured frequencies",
                         (("stcs-ident identify campaigns/han2020 --test case1-L4 --params tension,EI "

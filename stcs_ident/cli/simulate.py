@@ -8,7 +8,7 @@ import os
 from .. import effects
 from ..core.errors import InputError
 from .common import campaign_inputs, command_parser, progress_line
-from .track import add_archive_options, simulate_archive_from_args
+from .track import add_archive_options, check_archive_only, simulate_archive_from_args
 
 
 def add_parser(sub) -> None:
@@ -96,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         if os.path.exists(args.out) and os.listdir(args.out) and not args.overwrite:
             raise InputError("exists and is not empty (use --overwrite to replace it)", field="--out", file=args.out)
         return simulate_archive_from_args(args, campaign)
+    check_archive_only(args)
     try:
         fractions = [float(x) for x in args.sensors.split(",")]
     except ValueError:

@@ -11,7 +11,7 @@ from .common import command_parser, worker_count, write_output
 
 TRACK_EXAMPLE = COMMANDS["track"].examples[0]
 
-__all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parser", "run",
+__all__ = ["ARCHIVE_EXAMPLE", "TRACK_EXAMPLE", "add_archive_options", "add_parser", "check_archive_only", "run",
            "simulate_archive_from_args"]
 
 
@@ -80,10 +80,27 @@ def add_archive_options(sim) -> None:
     arc.add_argument("--interval", type=float, default=600.0, metavar="S", help="seconds between records (600)")
     arc.add_argument("--tension-change", metavar="CABLE,TIME,REL",
                      help="a lasting relative tension change of one cable from an ISO 8601 time on")
+    arc.add_argument("--damper-change", action="append", metavar="CABLE[:DAMPER],KIND,TIME[,FRACTION[,DAYS]]",
+                     help="a damper of a cable degrades from an ISO 8601 time on (repeatable): KIND leak (the "
+                          "coefficient drops by FRACTION), loss (linearly, by FRACTION after DAYS) or seizure (the "
+                          "coefficient grows 20-fold: the damper's node nearly stops); every damper of the cable "
+                          "unless :DAMPER names one")
+    arc.add_argument("--damper-temperature-coefficient", type=float, metavar="A",
+                     help="per °C: a damper's coefficient is c·exp(-A (θ - θ_mean)), stiffer in the cold "
+                          "(default 0.015, silicone oil; 0: constant)")
+
+
+def check_archive_only(args) -> None:
+    """Refuses the damper options of an archive given without ``--archive`` (one line, exit 2)."""
+    for flag, given in (("--damper-change", args.damper_change),
+                        ("--damper-temperature-coefficient", args.damper_temperature_coefficient)):
+        if given is not None:
+            raise InputError("applies to an archive (--archive DAYS), not to a campaign's records", field=flag)
 
 
 def simulate_archive_from_args(args, campaign) -> int:
     from ..simulate.archive import ArchiveOptions, TensionChange, simulate_archive
+    from ..simulate.damper_history import check_damper_changes
 
     if not 1 <= args.cables <= 1000:
         raise InputError(f"must be 1 … 1000, got {args.cables}", field="--cables")
@@ -100,23 +117,56 @@ def simulate_archive_from_args(args, campaign) -> int:
         if change.cable not in names:
             raise InputError(f"no cable named {change.cable!r} (cables: {', '.join(names)})",
                              field="--tension-change")
+    damper_changes = [_damper_change(text) for text in args.damper_change or ()]
+    if damper_changes and campaign.tests:  # a campaign without a test is refused by the archive itself
+        try:
+            check_damper_changes(damper_changes, dict.fromkeys(names, campaign.setup(campaign.tests[0].setup)
+                                                               .attachments))
+        except ValueError as err:
+            raise InputError(getattr(err, "message", str(err)), field="--damper-change") from None
+    temperature = {} if args.damper_temperature_coefficient is None else {
+        "damper_temperature_coefficient": args.damper_temperature_coefficient}
     try:
         options = ArchiveOptions(days=args.archive, interval=args.interval, duration=args.duration,
                                  sampling_rate=args.sampling_rate, snr_db=args.snr, damping=args.damping,
                                  rms_pressure=args.ambient or 20.0,
-                                 sensors=tuple(float(x) for x in args.sensors.split(",")))
+                                 sensors=tuple(float(x) for x in args.sensors.split(",")), **temperature)
     except ValueError as err:
         options_of = {"archive.days": "--archive", "archive.snr_db": "--snr", "archive.rms_pressure": "--ambient",
                       "archive.interval": "--interval", "archive.duration": "--duration",
-                      "archive.sampling_rate": "--sampling-rate", "archive.damping": "--damping"}
+                      "archive.sampling_rate": "--sampling-rate", "archive.damping": "--damping",
+                      "archive.damper_temperature_coefficient": "--damper-temperature-coefficient"}
         raise InputError(getattr(err, "message", str(err)),
                          field=options_of.get(getattr(err, "field", None), "--archive")) from None
     if options.n_records * args.cables > 10**6:
         raise InputError(f"gives {options.n_records * args.cables} records; at most 1,000,000", field="--archive")
-    out = simulate_archive(dict.fromkeys(names, campaign), args.out, options=options, change=change, seed=args.seed,
-                           progress=_every(500))
+    out = simulate_archive(dict.fromkeys(names, campaign), args.out, options=options, change=change,
+                           damper_changes=damper_changes, seed=args.seed, progress=_every(500))
     print(f"wrote {out}")
     return 0
+
+
+def _damper_change(text: str):
+    """``CABLE[:DAMPER],KIND,TIME[,FRACTION[,DAYS]]`` as a DamperChange; InputError naming ``--damper-change``."""
+    from ..simulate.damper_history import DamperChange
+
+    parts = text.split(",")
+    if not 3 <= len(parts) <= 5:
+        raise InputError(f"expected CABLE[:DAMPER],KIND,TIME[,FRACTION[,DAYS]], got {text!r}", field="--damper-change")
+    cable, _, damper = parts[0].partition(":")
+    numbers = []
+    for label, part in zip(("FRACTION", "DAYS"), parts[3:]):
+        try:
+            numbers.append(float(part))
+        except ValueError:
+            raise InputError(f"{label} must be a number, got {part!r} in {text!r}", field="--damper-change") from None
+    fraction, days = (*numbers, None, None)[:2]
+    try:
+        return DamperChange(cable, parts[1].strip(), parts[2], fraction=fraction, days=days, damper=damper or None)
+    except ValueError as err:
+        what = getattr(err, "field", None) or ""
+        raise InputError(f"{what.removeprefix('damper_change.') or 'value'}: {getattr(err, 'message', str(err))} "
+                         f"(in {text!r})", field="--damper-change") from None
 
 
 def _lines():

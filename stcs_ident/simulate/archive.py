@@ -15,9 +15,20 @@ simulated at the cable's tension at that time:
 - Δ, an optional lasting change from t_Δ on one cable (a broken wire, a
   slipped anchorage).
 
+A cable whose setup holds a :class:`~stcs_ident.core.model.Damper` is
+simulated with its exact complex modes, the dashpot's coefficient following
+the temperature (viscous dampers stiffen in the cold) and any
+:class:`~stcs_ident.simulate.damper_history.DamperChange` (a leak, a slow
+loss, a seizure) of its damper: the law is in
+:mod:`~stcs_ident.simulate.damper_history`. The campaign written beside the
+records keeps the coefficient it gave (at the archive's mean temperature).
+
 The excitation is ambient (wind): a random pressure along the cable with
 sensor noise. ``truth.json`` beside the cables holds each record's true
-tension and temperature, and the change.
+tension and temperature, and the changes; a damped cable's records also
+their dampers' true coefficients and the complex modes' true frequencies and
+damping ratios. A cable without a damper gets the records it got before
+dampers entered the archive, bit for bit.
 """
 
 from __future__ import annotations
@@ -26,19 +37,21 @@ import json
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta
+from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import ModelError
 from ..core.files import whole_directory, write_atomic
-from ..core.model import Campaign, real_number
+from ..core.model import Campaign, Damper, real_number
 from ..io.campaign_toml import campaign_to_toml
 from ..io.records.hdf5 import write_record
-from .simulate import Ambient, simulate_record
+from .damper_history import DAMPER_TEMPERATURE_COEFFICIENT, DamperChange, check_damper_changes, damper_coefficients
+from .damper_history import utc_time as _utc
+from .simulate import Ambient, simulate_record_with_truth
 
-__all__ = ["ArchiveOptions", "TensionChange", "simulate_archive"]
+__all__ = ["ArchiveOptions", "DamperChange", "TensionChange", "simulate_archive"]
 
 
 @dataclass(frozen=True)
@@ -73,12 +86,20 @@ class ArchiveOptions:
     rms_pressure: float = 20.0  # N/m, the wind
     snr_db: float = 30.0
     damping: float = 0.005
+    #: Per °C: a damper's coefficient is c_ref · exp(−a (θ − temperature_mean)); 0: constant
+    #: (:mod:`~stcs_ident.simulate.damper_history`).
+    damper_temperature_coefficient: float = DAMPER_TEMPERATURE_COEFFICIENT
 
     def __post_init__(self):
         for name in ("days", "interval", "duration", "sampling_rate", "rms_pressure"):
             object.__setattr__(self, name, real_number(getattr(self, name), f"archive.{name}", positive=True))
         for name in ("temperature_mean", "temperature_amplitude", "thermal_coefficient", "scatter", "snr_db"):
             object.__setattr__(self, name, real_number(getattr(self, name), f"archive.{name}"))
+        a = real_number(self.damper_temperature_coefficient, "archive.damper_temperature_coefficient")
+        if not 0 <= a <= 0.1:
+            raise ModelError(f"must lie between 0 and 0.1 per °C (viscous dampers stiffen in the cold; silicone oil "
+                             f"about 0.015), got {a!r}", field="archive.damper_temperature_coefficient")
+        object.__setattr__(self, "damper_temperature_coefficient", a)
         if self.duration > self.interval:
             raise ModelError("a record cannot last longer than the interval between records", field="archive.duration")
         object.__setattr__(self, "start", _utc(self.start, "archive.start").isoformat())
@@ -90,7 +111,7 @@ class ArchiveOptions:
 
 def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, *,
                      options: ArchiveOptions | None = None, change: TensionChange | None = None,
-                     seed: int = 0, progress: Callable[[int, int], None] | None = None) -> Path:
+                     damper_changes: Sequence[DamperChange] = (), seed: int = 0, progress: Callable[[int, int], None] | None = None) -> Path:
     """Write an archive ``out/<cable>/{campaign.toml, records/<day>/<cable>_<time>.h5}`` and ``out/truth.json``.
 
     Parameters
@@ -100,6 +121,9 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
     options : ArchiveOptions
     change : TensionChange or None
         A lasting change of one cable's tension.
+    damper_changes : sequence of DamperChange
+        Leaks, slow losses and seizures of the cables' dampers (each cable named must have a damper); they
+        may come with ``change`` and with each other (on one damper, their factors multiply).
     seed : int
         The same seed gives the same archive.
     progress : callable(done, total), optional
@@ -114,12 +138,15 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
     for name, campaign in campaigns.items():
         if not campaign.tests:
             raise ModelError("needs a test: its setup and tension are the cable's reference", field=f"cable[{name}]")
+    damper_changes = check_damper_changes(damper_changes, {name: c.setup(c.tests[0].setup).attachments
+                                                           for name, c in campaigns.items()})
     options = ArchiveOptions() if options is None else options
     out = Path(out)
     start = datetime.fromisoformat(options.start)
     times = [start + timedelta(seconds=k * options.interval) for k in range(options.n_records)]
     total, done = len(campaigns) * len(times), 0
-    truth: dict = {"options": _asdict(options), "change": None if change is None else _asdict(change), "cables": {}}
+    truth: dict = {"options": _asdict(options), "change": None if change is None else _asdict(change),
+                   "damper_changes": [_asdict(c) for c in damper_changes], "cables": {}}
     with whole_directory(out) as tmp:
         for index, (name, campaign) in enumerate(campaigns.items()):
             rng = np.random.default_rng([seed, index])
@@ -131,6 +158,7 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
             write_atomic(cable_dir / "campaign.toml", campaign_to_toml(campaign, header=f"cable {name} of a "
                                                                                           "simulated archive"))
             attachments = campaign.setup(test.setup).attachments
+            damped = any(isinstance(a, Damper) for a in attachments)
             positions = [f * campaign.cable.length for f in options.sensors]
             rows = []
             for k, (time, theta) in enumerate(zip(times, temperature)):
@@ -138,21 +166,36 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
                 tension *= 1 + options.scatter * rng.standard_normal()
                 if change is not None and change.cable == name and time >= datetime.fromisoformat(change.time):
                     tension *= 1 + change.change
-                record = simulate_record(campaign.cable, attachments, tension, positions,
-                                         duration=options.duration, sampling_rate=options.sampling_rate,
-                                         damping=options.damping, ambient=Ambient(options.rms_pressure),
-                                         snr_db=options.snr_db, seed=[seed, index, k])
+                row = {}
+                atts = attachments
+                if damped:  # the dashpots at this time and temperature; a cable without one is as it was
+                    coefficients = damper_coefficients(name, attachments, time, float(theta),
+                                                       temperature_coefficient=options.damper_temperature_coefficient,
+                                                       reference_temperature=options.temperature_mean,
+                                                       changes=damper_changes)
+                    atts = tuple(_with(a, coefficient=coefficients[a.name]) if isinstance(a, Damper) else a
+                                 for a in attachments)
+                record, record_truth = simulate_record_with_truth(
+                    campaign.cable, atts, tension, positions, duration=options.duration,
+                    sampling_rate=options.sampling_rate, damping=options.damping,
+                    ambient=Ambient(options.rms_pressure), snr_db=options.snr_db, seed=[seed, index, k])
+                if damped:
+                    row = {"coefficients": coefficients, "frequencies": record_truth.frequencies.tolist(),
+                           "damping": record_truth.damping.tolist()}
                 record = _with(record, start_time=time.isoformat(), temperature=round(float(theta), 3))
                 day = cable_dir / "records" / time.strftime("%Y-%m-%d")
                 day.mkdir(exist_ok=True)
                 relative = f"records/{day.name}/{name}_{time.strftime('%Y%m%dT%H%M%S')}.h5"
                 write_record(record, cable_dir / relative)
                 rows.append({"record": relative, "start_time": time.isoformat(), "tension": tension,
-                             "temperature": float(theta)})
+                             "temperature": float(theta), **row})
                 done += 1
                 if progress is not None:
                     progress(done, total)
             truth["cables"][name] = {"reference_tension": reference, "records": rows}
+            if damped:
+                truth["cables"][name]["reference_coefficients"] = {a.name: a.coefficient for a in attachments
+                                                                   if isinstance(a, Damper)}
         write_atomic(tmp / "truth.json", json.dumps(truth, indent=1) + "\n")
     return out
 
@@ -176,11 +219,3 @@ def _asdict(obj) -> dict:
     from dataclasses import asdict
 
     return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(obj).items()}
-
-
-def _utc(text, field: str) -> datetime:
-    try:
-        time = datetime.fromisoformat(str(text))
-    except ValueError:
-        raise ModelError(f"is not an ISO 8601 time: {text!r}", field=field) from None
-    return time.replace(tzinfo=UTC) if time.tzinfo is None else time
