@@ -34,6 +34,7 @@ import pandas as pd
 
 from ..core.errors import InputError, TrackWarning
 from ..core.files import remove_stale
+from ..core.model import has_dampers
 from ..core.version import __version__
 from .archive import CableSpec, cable_names, content_id, discover
 from .events import analyse_history
@@ -68,6 +69,8 @@ def cable_version(spec: CableSpec) -> str:
     test's setup and tension, the reader options, the modes picked per record and the toolkit's version."""
     shaping = (replace(spec.campaign, directory=None), spec.setup, spec.reference_tension, spec.channels,
                spec.record_format, MAX_MODES, __version__)
+    if has_dampers(spec.campaign.setup(spec.setup).attachments):  # rows from before the coefficient lack it
+        shaping += ("damper coefficient",)
     return hashlib.sha256(repr(shaping).encode("utf-8")).hexdigest()[:16]
 
 
