@@ -127,20 +127,15 @@ class TrackResult(Result):
         return {"archive": str(self.archive), "cables": self.cables}
 
     def tables(self) -> dict[str, pd.DataFrame]:
-        """``cables`` (one row per cable, the main table; the ``damper_*`` columns empty for a cable without one
-        damper), ``events`` (one row per lasting change of a tension or a damper's coefficient, ``kind``) and
+        """``cables`` (one row per cable, the main table; with a damped cable among them, the damper's columns,
+        empty for a cable without one damper), ``events`` (one row per lasting change of a tension or a damper's coefficient, ``kind``) and
         ``records`` (one row per record: :attr:`table`)."""
         cables = self.cables
         summary = pd.DataFrame([
             {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
              "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
              "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"],
-             "events": len(c["events"]), "state": c["state"],
-             "reference_coefficient_Nsm": c["damper"]["reference_coefficient"] if "damper" in c else None,
-             "damper_thermal_coefficient_per_C": c["damper"]["thermal_coefficient"] if "damper" in c else None,
-             "damper_scatter": c["damper"]["scatter"] if "damper" in c else None,
-             "damper_events": len(c["damper"]["events"]) if "damper" in c else None,
-             "damper_state": c["damper"]["state"] if "damper" in c else None}
+             "events": len(c["events"]), "state": c["state"], **_damper_columns(c, bool(self.dampers))}
             for name, c in cables.items()])
         events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items()
                                for e in c["events"] + c.get("damper", {}).get("events", [])],
@@ -163,6 +158,15 @@ class TrackResult(Result):
             damper = sum(len(h.events) for _, h in self.dampers.values())
             line += f", {damper} of a damper"
         return line
+
+
+def _damper_columns(cable: dict, any_damper: bool) -> dict:
+    if not any_damper:
+        return {}
+    d = cable.get("damper", {})
+    return {"reference_coefficient_Nsm": d.get("reference_coefficient"),
+            "damper_thermal_coefficient_per_C": d.get("thermal_coefficient"), "damper_scatter": d.get("scatter"),
+            "damper_events": len(d["events"]) if d else None, "damper_state": d.get("state")}
 
 
 def _events(history: History, times, kind: str) -> list[dict]:
