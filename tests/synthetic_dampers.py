@@ -2,8 +2,9 @@
 
 Used by ``tests/test_track_dampers.py`` and ``benchmarks/track.py --damper-false-alarms``.
 
-The damper's oil follows the air with a lag (its temperature θ_d(t) = θ(t − lag) without the weather drift
-the air has), the coefficient is c_ref e^{a (θ_d − 12 °C)} with a = −1.5 % per °C (a silicone oil thins as
+The damper's oil follows the air with a lag (its temperature θ_d(t) = θ(t − lag), the daily cycle and the
+weather's drift; ``unfollowed`` leaves a share of the drift out, a misfit of the temperature model), the
+coefficient is c_ref e^{a (θ_d − 12 °C)} with a = −1.5 % per °C (a silicone oil thins as
 it warms), times (1 − loss) from the record ``at`` on. Each record's relative 1σ is log-normal: median
 ``sigma`` and log-spread ``spread``; its error is Gaussian in ln c with a true scale that differs from the
 reported 1σ by a log-normal factor of spread 0.2 (a fit's 1σ is itself uncertain).
@@ -29,12 +30,18 @@ REFERENCE = 1.0e5  # N s/m
 
 
 def coefficient_history(rng: np.random.Generator, *, days: float = 30.0, loss: float = 0.0, at: int | None = None,
-                        sigma: float = SIGMA, spread: float = SPREAD, lag: float = 1.0, drift: float = 0.05):
-    """(coefficient, its 1σ, air temperature, times in s) of 10-minute records over ``days`` (see the module)."""
+                        sigma: float = SIGMA, spread: float = SPREAD, lag: float = 1.0, drift: float = 0.05,
+                        unfollowed: float = 0.0):
+    """(coefficient, its 1σ, air temperature, times in s) of 10-minute records over ``days`` (see the module);
+    ``unfollowed``: the share of the air's weather drift the damper's oil does not follow (a sensor in the
+    sun, say)."""
     hours = np.arange(round(days * 144)) / 6.0
     weather = np.cumsum(rng.standard_normal(hours.size)) * drift
-    air = 12 - 6 * np.cos(2 * np.pi * (hours - 5) / 24) + weather
-    oil = 12 - 6 * np.cos(2 * np.pi * (hours - 5 - lag) / 24)
+    cycle = 12 - 6 * np.cos(2 * np.pi * (hours - 5) / 24)
+    air = cycle + weather
+    steps = round(lag * 6)  # the oil lags the air by ``lag`` hours, its weather too
+    lagged = np.concatenate([np.full(steps, weather[0]), weather[:weather.size - steps]])
+    oil = 12 - 6 * np.cos(2 * np.pi * (hours - 5 - lag) / 24) + (1 - unfollowed) * lagged
     true = REFERENCE * np.exp(THERMAL * (oil - 12))
     if loss:
         true = np.where(np.arange(hours.size) >= at, true * (1 - loss), true)
