@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.files import write_atomic, write_csv, write_figure
+from ..core.model import Damper
 from .plots import Drawn, new_figure
 
 __all__ = ["plot_cable_history", "records_csv_table", "write_report"]
@@ -160,7 +161,7 @@ def _damper_panel(ax, spec, table: pd.DataFrame, rows, history) -> None:
         return
     t = data["start_time"].dt.tz_convert(None)
     k = 1e-3
-    ax.errorbar(t, data["coefficient"] * k, yerr=data["coefficient_sigma"] * k, fmt=".", ms=2, lw=0.4,
+    ax.errorbar(t, data["coefficient"] * k, yerr=data["coefficient_sigma"] * k, fmt=".", ms=3, lw=0.4,
                 color="tab:blue", alpha=0.35, label="fitted, 1σ")
     ax.plot(t, history.normalised * k, ".", ms=2.5, color="tab:purple",
             label=f"normalised to {history.mean_temperature:.1f} °C" if np.isfinite(history.mean_temperature)
@@ -170,11 +171,14 @@ def _damper_panel(ax, spec, table: pd.DataFrame, rows, history) -> None:
         ax.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
         ax.annotate(f" {100 * e.change:+.1f} ± {100 * e.uncertainty:.1f} %", (t.iloc[e.index], 0.97),
                     xycoords=("data", "axes fraction"), va="top", ha="left", color="tab:red", fontsize=8)
-    low, high = np.nanpercentile(history.normalised * k, [1, 99])
+    shown = np.concatenate([history.normalised, data["coefficient"].to_numpy()]) * k
+    low, high = np.nanpercentile(shown, [1, 99])
     ax.set_ylim(max(0.0, low - 0.5 * (high - low)), high + 0.5 * (high - low))  # a wild record off the scale
     ax.set_ylabel("damper (kN s/m)")
-    ax.set_title(f"damper: {len(data)} records with a coefficient; {100 * history.thermal_coefficient:+.2f} % "
-                 f"per °C; {history.state}", fontsize=9)
+    thermal = (f"{100 * history.thermal_coefficient:+.2f} % per °C; " if history.state == "monitoring"
+               and np.isfinite(history.mean_temperature) else "")
+    ax.set_title(f"damper {_damper_name(spec)}: {len(data)} records with a coefficient; {thermal}{history.state}",
+                 fontsize=9)
     ax.legend(loc="lower left", fontsize=8, ncol=3)
 
 
@@ -207,6 +211,10 @@ def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
     lines += [f"- {name}/{f['record']}: {f['reason']}" for name, f in failures] or ["None."]
     lines += ["", "Figures: " + ", ".join(f"[{n}]({n}.png)" for n in summary["cables"]), ""]
     return "\n".join(lines)
+
+
+def _damper_name(spec) -> str:
+    return next((a.name for a in spec.campaign.setup(spec.setup).attachments if isinstance(a, Damper)), "")
 
 
 def _damper_markdown(dampers: dict) -> list[str]:
