@@ -173,7 +173,14 @@ def analyse_series(y: np.ndarray, temperature: np.ndarray, *, training: int = TR
     counted in units of s w_i in the sums, the fits are weighted by 1/w_i²
     (:mod:`.damper_history` passes the per-record 1σ of the damper's
     coefficient). An event's size is Δ / (1 + μ) (y a relative change), or
-    e^Δ − 1 when ``logarithmic`` (y a logarithm), its 1σ to first order.
+    e^Δ − 1 when ``logarithmic`` (y the logarithm of a damper's
+    coefficient), its 1σ to first order. With ``logarithmic`` the step's 1σ
+    takes the larger of the robust scatter and the standard deviation of
+    the weighted residuals: a coefficient's per-record 1σ is itself uncertain,
+    its weighted residuals a heavy-tailed mixture whose median absolute
+    residual understates their spread (on synthetic histories, a 30 % loss
+    sized within its 1σ / 2σ in 64 / 93 % of 200 cases with the robust
+    scatter alone, 67 / 94 % with the larger).
 
     Returns
     -------
@@ -312,7 +319,8 @@ def _fit_step(y: np.ndarray, x: np.ndarray, first: int, guess: int, alarm: int, 
     residuals = yw - design @ coefficients
     covariance = np.linalg.pinv(design.T @ design)
     dof = residuals.size / max(residuals.size - design.shape[1], 1)  # residuals are smaller than the errors
-    variance = _scale(residuals) ** 2 * dof * covariance[1, 1] * _correlation_factor(residuals)
+    spread = max(_scale(residuals), float(np.std(residuals))) if logarithmic else _scale(residuals)
+    variance = spread ** 2 * dof * covariance[1, 1] * _correlation_factor(residuals)
     mu, delta, sigma = float(coefficients[0]), float(coefficients[1]), float(np.sqrt(variance))
     if logarithmic:  # y = ln(value): after / before − 1 = e^Δ − 1
         return Event(int(tau), float(np.expm1(delta)), float(np.exp(delta)) * sigma, int(alarm))
