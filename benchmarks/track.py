@@ -142,16 +142,20 @@ def damper_losses(n: int, seed: int = 17) -> list[tuple[str, str]]:
     from stcs_ident.track.damper_history import analyse_coefficient
 
     out = []
-    for label, c in (("10-min records, 1σ 9 %", {"sigma": 0.09, "spread": 0.5}),
-                     ("+ weather the oil does not follow", {"sigma": 0.09, "spread": 0.5, "unfollowed": 1.0}),
-                     ("60-s records, 1σ 40 %", {"sigma": 0.40, "spread": 1.0})):
+    for label, c, weighted in (
+            ("10-min records, 1σ 9 %", {"sigma": 0.09, "spread": 0.5}, True),
+            ("+ weather the oil does not follow", {"sigma": 0.09, "spread": 0.5, "unfollowed": 1.0}, True),
+            ("10-min records, spread 1.0", {"sigma": 0.09, "spread": 1.0}, True),
+            ("    unweighted", {"sigma": 0.09, "spread": 1.0}, False),
+            ("60-s records, 1σ 40 %", {"sigma": 0.40, "spread": 1.0}, True),
+            ("    unweighted", {"sigma": 0.40, "spread": 1.0}, False)):
         rng = np.random.default_rng(seed)
         delays, z, missed = [], [], 0
         for _ in range(n):
             at = 144 * 7 + int(rng.integers(0, 144))
             coefficient, sigma, air, times = coefficient_history(rng, days=14, loss=0.3, at=at, **c)
-            events = [e for e in analyse_coefficient(coefficient, sigma, air, REFERENCE, times=times).events
-                      if e.alarm >= at]
+            events = [e for e in analyse_coefficient(coefficient, sigma, air, REFERENCE, times=times,
+                                                     weighted=weighted).events if e.alarm >= at]
             if not events or events[0].alarm > at + 144:
                 missed += 1
                 continue

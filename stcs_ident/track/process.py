@@ -89,8 +89,8 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
                    planes=[str(p) for p in spectra.mode_planes],
                    frequencies=[float(f) for f in spectra.frequencies],
                    frequency_sigma=[float(s) for s in spectra.uncertainty],
-                   damping=_floats(spectra.damping, len(spectra.modes)),
-                   damping_sigma=_floats(spectra.damping_uncertainty, len(spectra.modes)))
+                   damping=_floats(getattr(spectra, "damping", None), len(spectra.modes)),
+                   damping_sigma=_floats(getattr(spectra, "damping_uncertainty", None), len(spectra.modes)))
         # Per record: the plausibility check is off (a cable that lost half its tension is a finding to report,
         # not a unit slip to refuse), and the tolerances of EI and the length stay out of the record's σ: they
         # shift every record of the cable alike, a common bias that is no change (docs/track.md).
