@@ -158,7 +158,7 @@ def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_
                    tests=(Test("T", "S", 4.0e6),))
     calls.clear()
     row = process_record(CableSpec("stay", str(tmp_path), two, "S", 4.0e6), str(tmp_path / "records" / "r.h5"), "x")
-    assert calls == ["tension"] and "2 dampers" in row["coefficient_reason"]
+    assert calls == ["tension"] and "2 dampers (D1, D2)" in row["coefficient_reason"]
 
 
 # -- the store, the run, the report --------------------------------------------------------------------------

@@ -99,7 +99,7 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
             row.update(_joint_fit(campaign, test.name, spectra))
         elif dampers:
             row["coefficient_reason"] = (f"{len(dampers)} dampers ({', '.join(d.name for d in dampers)}): "
-                                         "one coefficient per cable is tracked")
+                                         "a coefficient is tracked on a cable with one damper")
         if math.isnan(row["coefficient"]):
             result = identify(campaign, [test.name], "tension", picked={test.name: spectra}, tolerances=False,
                               check_plausibility=False)
@@ -110,7 +110,6 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     except Exception as err:  # noqa: BLE001 (one record never stops an archive: its row says what happened)
         row["reason"] = one_line(f"{type(err).__name__}: {err}")
     return row
-
 
 
 def _floats(values, n: int) -> list[float]:
@@ -126,6 +125,9 @@ def _joint_fit(campaign, test: str, spectra) -> dict:
             result = identify(campaign, [test], "tension,coefficient", picked={test: spectra}, tolerances=False,
                               check_plausibility=False)
         unidentifiable = [w for w in caught if issubclass(w.category, IdentifiabilityWarning)]
+        for w in caught:  # the others go on as the tension-only fit's would
+            if not issubclass(w.category, IdentifiabilityWarning):
+                warnings.warn(w.message, w.category, stacklevel=2)
         if unidentifiable:
             raise ComputationError(f"not identifiable: {unidentifiable[0].message}")
         if not result.tests[0].damping:  # the frequencies alone: the coefficient only through the shifts
