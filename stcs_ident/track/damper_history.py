@@ -26,8 +26,11 @@ squares weighted by 1/w_i². A record with a broad 1σ then moves the sums
 little, a sharp one more; the floor at half the median keeps a record
 whose 1σ came out too small from counting for more than four typical ones.
 Unweighted, the records with the broadest 1σ set the robust scatter s and
-the sums lose the sharp records' evidence (a 30 % loss was found later and
-its size less well; ``tests/test_track_dampers.py`` runs both).
+the sums lose the sharp records' evidence: on synthetic histories with the
+1σ spread e^±1 (``benchmarks/track.py --damper-false-alarms`` runs both), a
+30 % loss was found within a day in 89 of 100 (weighted: 100) and 6 false
+events came in 100 healthy cable-months (weighted: none); with 60-s records
+(1σ 40 %), 23 found of 100 (weighted: 53), 26 false events (none).
 
 Detection is the tension's (:mod:`.events`: training on the first day,
 Page's two-sided CUSUM with the same k, h, clip and confirmation, the
