@@ -67,6 +67,11 @@ def run(args: argparse.Namespace) -> int:
                                for e in cable["events"]) or "no lasting change"
             print(f"{name}: {cable['processed']} of {counted(cable['records'], 'record')} with a tension, "
                   f"{cable['failed']} failed; {events}")
+            if "damper" in cable:
+                damper = cable["damper"]
+                changes = "; ".join(f"{100 * e['change']:+.1f} ± {100 * e['uncertainty']:.1f} % from "
+                                    f"{e['start_time']}" for e in damper["events"]) or "no lasting change"
+                print(f"{name} damper: {damper['records']} records with a coefficient; {changes}")
         print(f"wrote {out}")
     return 0
 

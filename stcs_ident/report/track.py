@@ -6,7 +6,9 @@
     OUT/events.csv               one row per lasting change
     OUT/cables.csv               one row per cable
     OUT/<cable>.png              tension (as identified and normalised for temperature, 1σ band,
-                                 events marked), temperature, and the frequency of each mode
+                                 events marked), temperature, the frequency of each mode and, for a
+                                 cable with one damper, its coefficient (fitted, normalised, level,
+                                 damper events marked)
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.files import write_atomic, write_csv, write_figure
+from ..core.model import Damper
 from .plots import Drawn, new_figure
 
 __all__ = ["plot_cable_history", "records_csv_table", "write_report"]
@@ -42,7 +45,9 @@ def write_report(result, out: str | Path | None = None) -> Path:
     write_csv(events, out / "events.csv", index=False)
     for spec in result.specs:
         rows, history = result.histories[spec.name]
-        write_figure(plot_cable_history(spec, result.table, rows, history)["figure"], out / f"{spec.name}.png")
+        damper = getattr(result, "dampers", {}).get(spec.name)
+        write_figure(plot_cable_history(spec, result.table, rows, history, damper=damper)["figure"],
+                     out / f"{spec.name}.png")
     write_atomic(out / "report.md", _markdown(result.summary(), cables, events))
     return out
 
@@ -50,11 +55,13 @@ def write_report(result, out: str | Path | None = None) -> Path:
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     """The records table (``records.parquet``) with plain cells for CSV.
 
-    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``) become their values joined by
+    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``, ``damping``,
+    ``damping_sigma``) become their values joined by
     ``;`` and ``start_time`` an ISO 8601 string; every other column is as in the Parquet table.
     """
     plain = table.copy()
-    for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float)):
+    for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float),
+                       ("damping", float), ("damping_sigma", float)):
         if name in plain:  # str of a float is its shortest round-trip form
             plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
     if "start_time" in plain:
@@ -62,7 +69,7 @@ def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     return plain
 
 
-def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Drawn:
+def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, damper=None) -> Drawn:
     """One cable's history: tension (identified, normalised, level, events), temperature, frequency / mode.
 
     Parameters
@@ -74,10 +81,14 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
     rows : the labels of this cable's rows in ``table``
     history : the cable's tension history (``normalised``, ``mean_temperature``, ``events``)
     fig : matplotlib.figure.Figure, optional
+    damper : (row labels, History), optional
+        The damper's coefficient history (``coefficient``, ``coefficient_sigma``, ``coefficient_level`` of
+        ``table``): a fourth panel.
 
     Returns
     -------
-    dict with the figure, the three axes (``axes``: tension, temperature, frequency) and the frequency
+    dict with the figure, the axes (``axes``: tension, temperature, frequency, and the damper's coefficient
+    when given) and the frequency
     panel's lines by mode (``modes``: {mode: Line2D}, an out-of-plane mode under ``"<mode> out"``); past mode 10
     the colours repeat with another marker.
     """
@@ -89,8 +100,12 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
         ax.text(0.5, 0.5, f"{spec.name}: no record with a tension (the failed records and their reasons are "
                 "listed in report.md)", ha="center", va="center", transform=ax.transAxes)
         return Drawn({"figure": fig, "axes": (ax,), "modes": {}})
-    fig = fig or new_figure(figsize=(10, 7.5), layout="constrained")
-    top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.2, 2))
+    if damper is None:
+        fig = fig or new_figure(figsize=(10, 7.5), layout="constrained")
+        top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.2, 2))
+    else:
+        fig = fig or new_figure(figsize=(10, 10), layout="constrained")
+        top, middle, bottom, lowest = fig.subplots(4, 1, sharex=True, height_ratios=(3, 1.2, 2, 2.5))
     t = data["start_time"].dt.tz_convert(None) if len(data) else data["start_time"]
     kN = 1e-3
     tension, sigma = data["tension"].to_numpy() * kN, data["tension_sigma"].to_numpy() * kN
@@ -124,11 +139,47 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None) -> Dr
         drawn[key] = bottom.plot(times, np.asarray(freq) / mode, marker, color=colours[i % 10],
                                  ms=2 if marker == "." else 3, mew=0.6, label=f"mode {key}")[0]
     bottom.set_ylabel("frequency / mode number (Hz)")
-    bottom.set_xlabel("time (UTC)")
     if modes:
         bottom.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=7, ncol=1 + len(modes) // 12,
                       markerscale=2)
-    return Drawn({"figure": fig, "axes": (top, middle, bottom), "modes": drawn})
+    axes = (top, middle, bottom)
+    if damper is not None:
+        _damper_panel(lowest, spec, table, *damper)
+        axes += (lowest,)
+    axes[-1].set_xlabel("time (UTC)")
+    return Drawn({"figure": fig, "axes": axes, "modes": drawn})
+
+
+def _damper_panel(ax, spec, table: pd.DataFrame, rows, history) -> None:
+    """The damper's coefficient per record (1σ bars), normalised to the mean temperature, its level and the
+    damper events."""
+    data = table.loc[rows]
+    if not len(data):
+        ax.text(0.5, 0.5, "damper: no record with a coefficient (the reasons are in records.parquet, "
+                "coefficient_reason)", ha="center", va="center", transform=ax.transAxes, fontsize=8)
+        ax.set_ylabel("damper (kN s/m)")
+        return
+    t = data["start_time"].dt.tz_convert(None)
+    k = 1e-3
+    ax.errorbar(t, data["coefficient"] * k, yerr=data["coefficient_sigma"] * k, fmt=".", ms=3, lw=0.4,
+                color="tab:blue", alpha=0.35, label="fitted, 1σ")
+    ax.plot(t, history.normalised * k, ".", ms=2.5, color="tab:purple",
+            label=f"normalised to {history.mean_temperature:.1f} °C" if np.isfinite(history.mean_temperature)
+            else "no temperature: not normalised")
+    ax.plot(t, data["coefficient_level"] * k, "-", color="k", lw=1, label="level between changes")
+    for e in history.events:
+        ax.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
+        ax.annotate(f" {100 * e.change:+.1f} ± {100 * e.uncertainty:.1f} %", (t.iloc[e.index], 0.97),
+                    xycoords=("data", "axes fraction"), va="top", ha="left", color="tab:red", fontsize=8)
+    shown = np.concatenate([history.normalised, data["coefficient"].to_numpy()]) * k
+    low, high = np.nanpercentile(shown, [1, 99])
+    ax.set_ylim(max(0.0, low - 0.5 * (high - low)), high + 0.5 * (high - low))  # a wild record off the scale
+    ax.set_ylabel("damper (kN s/m)")
+    thermal = (f"{100 * history.thermal_coefficient:+.2f} % per °C; " if history.state == "monitoring"
+               and np.isfinite(history.mean_temperature) else "")
+    ax.set_title(f"damper {_damper_name(spec)}: {len(data)} records with a coefficient; {thermal}{history.state}",
+                 fontsize=9)
+    ax.legend(loc="lower left", fontsize=8, ncol=3)
 
 
 def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
@@ -145,15 +196,44 @@ def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
         lines.append(f"| {c['cable']} | {c['records']} | {c['processed']} | {c['failed']} | "
                      f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} | {c['state']} |")
     lines += ["", "## Lasting changes", ""]
-    if events.empty:
+    if (events["kind"] != "damper").sum() == 0:
         lines.append("None found.")
     else:
         lines += ["| cable | from | change | 1σ | alarm at |", "|---|---|---|---|---|"]
-        for _, e in events.iterrows():
+        for _, e in events[events["kind"] != "damper"].iterrows():
             lines.append(f"| {e['cable']} | {e['start_time']} | {100 * e['change']:+.2f} % | "
                          f"{100 * e['uncertainty']:.2f} % | {e['alarm_time']} |")
+    dampers = {name: c["damper"] for name, c in summary["cables"].items() if "damper" in c}
+    if dampers:
+        lines += _damper_markdown(dampers)
     failures = [(name, f) for name, c in summary["cables"].items() for f in c["failures"]]
     lines += ["", "## Records without a tension", ""]
     lines += [f"- {name}/{f['record']}: {f['reason']}" for name, f in failures] or ["None."]
     lines += ["", "Figures: " + ", ".join(f"[{n}]({n}.png)" for n in summary["cables"]), ""]
     return "\n".join(lines)
+
+
+def _damper_name(spec) -> str:
+    return next((a.name for a in spec.campaign.setup(spec.setup).attachments if isinstance(a, Damper)), "")
+
+
+def _damper_markdown(dampers: dict) -> list[str]:
+    lines = ["", "## The dampers", "",
+             ("Per record, the damper's coefficient is fitted jointly with the tension from the frequencies and "
+              "damping ratios; its logarithm is normalised for a linear temperature effect and its lasting "
+              "changes found by the same CUSUM as the tension's, each record weighted by its 1σ."), "",
+             "| cable | reference (kN s/m) | records with a coefficient | without | per °C | state | events |",
+             "|---|---|---|---|---|---|---|"]
+    for name, d in dampers.items():
+        thermal = "" if d["thermal_coefficient"] is None else f"{100 * d['thermal_coefficient']:+.2f} %"
+        lines.append(f"| {name} | {d['reference_coefficient'] / 1e3:.1f} | {d['records']} | {len(d['failures'])} | "
+                     f"{thermal} | {d['state']} | {len(d['events'])} |")
+    lines += ["", "### Damper events", ""]
+    found = [(name, e) for name, d in dampers.items() for e in d["events"]]
+    if not found:
+        lines.append("None found.")
+    else:
+        lines += ["| cable | from | change | 1σ | alarm at |", "|---|---|---|---|---|"]
+        lines += [f"| {name} | {e['start_time']} | {100 * e['change']:+.1f} % | {100 * e['uncertainty']:.1f} % | "
+                  f"{e['alarm_time']} |" for name, e in found]
+    return lines

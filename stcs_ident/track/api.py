@@ -13,7 +13,9 @@
 3. Per cable, its rows (one per record of the archive) into one part when
    they changed, and the history of the records that gave a tension:
    normalised for temperature and its lasting changes found
-   (:mod:`.events`). With ``cables``, the other cables keep their rows.
+   (:mod:`.events`); for a cable with one damper, the history of its
+   coefficient too, normalised for temperature with its lasting changes
+   (:mod:`.damper_history`). With ``cables``, the other cables keep their rows.
 4. The table (``records.parquet``) and a :class:`~.result.TrackResult`
    (the summary of the interface's JSON, the tables); the report is drawn
    from it by :func:`stcs_ident.report.track.write_report`.
@@ -34,8 +36,10 @@ import pandas as pd
 
 from ..core.errors import InputError, TrackWarning
 from ..core.files import remove_stale
+from ..core.model import Damper, has_dampers
 from ..core.version import __version__
 from .archive import CableSpec, cable_names, content_id, discover
+from .damper_history import analyse_coefficient
 from .events import analyse_history
 from .process import MAX_MODES, process_record
 from .result import TrackResult
@@ -68,6 +72,8 @@ def cable_version(spec: CableSpec) -> str:
     test's setup and tension, the reader options, the modes picked per record and the toolkit's version."""
     shaping = (replace(spec.campaign, directory=None), spec.setup, spec.reference_tension, spec.channels,
                spec.record_format, MAX_MODES, __version__)
+    if has_dampers(spec.campaign.setup(spec.setup).attachments):  # rows from before the coefficient lack it
+        shaping += ("damper coefficient",)
     return hashlib.sha256(repr(shaping).encode("utf-8")).hexdigest()[:16]
 
 
@@ -131,8 +137,9 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
             path.unlink(missing_ok=True)
     table = sort_rows(pd.concat([*tables, others], ignore_index=True).drop(columns="part"))
     table, histories = _histories(specs, table)
+    table, dampers = _damper_histories(specs, table)
     write_table(out, table)
-    return TrackResult(str(archive), out, tuple(specs), table, histories, counts=counts)
+    return TrackResult(str(archive), out, tuple(specs), table, histories, counts=counts, dampers=dampers)
 
 
 def _other_cables(archive, specs: list[CableSpec], known: pd.DataFrame):
@@ -234,6 +241,37 @@ def _histories(specs: list[CableSpec], table: pd.DataFrame):
         table.loc[rows, "level"] = spec.reference_tension * (1 + history.level)
         histories[spec.name] = (rows, history)
     return table, histories
+
+
+def _damper_histories(specs: list[CableSpec], table: pd.DataFrame):
+    """The table with each record's normalised coefficient and its level, and each damped cable's coefficient
+    History (:mod:`.damper_history`): the cables whose setup has one damper."""
+    table = table.copy()
+    table["coefficient_normalised"] = np.nan
+    table["coefficient_level"] = np.nan
+    dampers = {}
+    for spec in specs:
+        damper = reference_damper(spec)
+        if damper is None:
+            continue
+        mine = (table["cable"] == spec.name) & (table["status"] == "ok")
+        usable = mine & (table["coefficient"] > 0) & (table["coefficient_sigma"] > 0)
+        rows = table.loc[table.index[usable]].sort_values("start_time", kind="stable").index
+        starts = table.loc[rows, "start_time"]
+        history = analyse_coefficient(table.loc[rows, "coefficient"].to_numpy(),
+                                      table.loc[rows, "coefficient_sigma"].to_numpy(),
+                                      table.loc[rows, "temperature"].to_numpy(), damper.coefficient,
+                                      times=(starts - starts.min()).dt.total_seconds().to_numpy(dtype=float))
+        table.loc[rows, "coefficient_normalised"] = history.normalised
+        table.loc[rows, "coefficient_level"] = damper.coefficient * (1 + history.level)
+        dampers[spec.name] = (rows, history)
+    return table, dampers
+
+
+def reference_damper(spec: CableSpec) -> Damper | None:
+    """The cable's damper whose coefficient is tracked: the one damper of its setup (None: none, or several)."""
+    found = [a for a in spec.campaign.setup(spec.setup).attachments if isinstance(a, Damper)]
+    return found[0] if len(found) == 1 else None
 
 
 def _part_writer(out: Path, bar) -> Callable[[list], None]:

@@ -11,6 +11,21 @@ values) by weighted least squares on the picked frequencies
 (:func:`~stcs_ident.identify.identify`, each mode against its plane's
 model), its 1σ from the fit.
 
+Each mode's damping ratio and its 1σ (``damping``, ``damping_sigma``, aligned
+with ``modes``; NaN where the spectra estimated none) are kept as the spectra
+gave them. For a cable whose setup has one :class:`~stcs_ident.core.model.Damper`,
+its coefficient is then fitted jointly with the tension from the
+frequencies and the damping ratios (``identify(..., "tension,coefficient")``,
+as ``identify --params tension,coefficient`` does), with its 1σ
+(``coefficient``, ``coefficient_sigma``); the tension of that joint fit is
+the row's. A joint fit that stops at a bound, is not identifiable or fails
+otherwise leaves the coefficient NaN with its reason
+(``coefficient_reason``) and the tension of the tension-only fit. A setup
+with several dampers is not fitted for a coefficient (identify would free
+one per damper, which one record's damping ratios rarely separate):
+``coefficient_reason`` says so. Without a damper the columns are NaN and
+the reason empty.
+
 Whatever goes wrong with one record (unreadable, no start time, no mode
 found, a fit that fails) makes a row with status ``failed`` and the reason;
 the other records go on.
@@ -19,12 +34,13 @@ the other records go on.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
 from ..core.errors import ComputationError, InputError, one_line
-from ..core.model import Test
-from ..identify import identify
+from ..core.model import Damper, Test
+from ..identify import IdentifiabilityWarning, identify
 from ..io.records import read_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec
@@ -38,7 +54,12 @@ __all__ = ["COLUMNS", "process_record"]
 MAX_MODES = 15
 
 COLUMNS = ("cable", "record", "record_id", "start_time", "temperature", "status", "reason", "n_modes", "modes",
-           "planes", "frequencies", "frequency_sigma", "tension", "tension_sigma")
+           "planes", "frequencies", "frequency_sigma", "tension", "tension_sigma", "damping", "damping_sigma",
+           "coefficient", "coefficient_sigma", "coefficient_reason")
+#: The columns added with the damper's history: a part written before them reads with these defaults
+#: (:mod:`.store`).
+DAMPER_COLUMNS = {"damping": list, "damping_sigma": list, "coefficient": math.nan, "coefficient_sigma": math.nan,
+                  "coefficient_reason": ""}
 
 
 def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
@@ -46,7 +67,9 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     relative = Path(path).relative_to(spec.directory).as_posix()
     row = {"cable": spec.name, "record": relative, "record_id": record_id, "start_time": None,
            "temperature": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
-           "planes": [], "frequencies": [], "frequency_sigma": [], "tension": math.nan, "tension_sigma": math.nan}
+           "planes": [], "frequencies": [], "frequency_sigma": [], "tension": math.nan, "tension_sigma": math.nan,
+           "damping": [], "damping_sigma": [], "coefficient": math.nan, "coefficient_sigma": math.nan,
+           "coefficient_reason": ""}
     try:
         record = read_record(path, positions=dict(spec.channels) or None, directions=dict(spec.directions) or None,
                              **dict(spec.record_format))
@@ -65,17 +88,55 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
         row.update(n_modes=len(spectra.modes), modes=[int(m) for m in spectra.modes],
                    planes=[str(p) for p in spectra.mode_planes],
                    frequencies=[float(f) for f in spectra.frequencies],
-                   frequency_sigma=[float(s) for s in spectra.uncertainty])
+                   frequency_sigma=[float(s) for s in spectra.uncertainty],
+                   damping=_floats(getattr(spectra, "damping", None), len(spectra.modes)),
+                   damping_sigma=_floats(getattr(spectra, "damping_uncertainty", None), len(spectra.modes)))
         # Per record: the plausibility check is off (a cable that lost half its tension is a finding to report,
         # not a unit slip to refuse), and the tolerances of EI and the length stay out of the record's σ: they
         # shift every record of the cable alike, a common bias that is no change (docs/track.md).
-        result = identify(campaign, [test.name], "tension", picked={test.name: spectra}, tolerances=False,
-                          check_plausibility=False)
-        tension, sigma = result.value("tension")
-        row.update(tension=tension, tension_sigma=sigma, status="ok")
+        dampers = [a for a in spec.campaign.setup(spec.setup).attachments if isinstance(a, Damper)]
+        if len(dampers) == 1:
+            row.update(_joint_fit(campaign, test.name, spectra))
+        elif dampers:
+            row["coefficient_reason"] = (f"{len(dampers)} dampers ({', '.join(d.name for d in dampers)}): "
+                                         "a coefficient is tracked on a cable with one damper")
+        if math.isnan(row["coefficient"]):
+            result = identify(campaign, [test.name], "tension", picked={test.name: spectra}, tolerances=False,
+                              check_plausibility=False)
+            row["tension"], row["tension_sigma"] = result.value("tension")
+        row["status"] = "ok"
     except (InputError, ComputationError, FloatingPointError) as err:
         row["reason"] = one_line(str(err))
     except Exception as err:  # noqa: BLE001 (one record never stops an archive: its row says what happened)
         row["reason"] = one_line(f"{type(err).__name__}: {err}")
     return row
 
+
+def _floats(values, n: int) -> list[float]:
+    """``values`` (or NaN each when there are none) as a list of ``n`` floats."""
+    return [math.nan] * n if values is None else [float(v) for v in values]
+
+
+def _joint_fit(campaign, test: str, spectra) -> dict:
+    """The tension and the damper's coefficient fitted together, or the coefficient's reason for failing."""
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", IdentifiabilityWarning)
+            result = identify(campaign, [test], "tension,coefficient", picked={test: spectra}, tolerances=False,
+                              check_plausibility=False)
+        unidentifiable = [w for w in caught if issubclass(w.category, IdentifiabilityWarning)]
+        for w in caught:  # the others go on as the tension-only fit's would
+            if not issubclass(w.category, IdentifiabilityWarning):
+                warnings.warn(w.message, w.category, stacklevel=2)
+        if unidentifiable:
+            raise ComputationError(f"not identifiable: {unidentifiable[0].message}")
+        if not result.tests[0].damping:  # the frequencies alone: the coefficient only through the shifts
+            raise ComputationError("no damping ratio measured")
+        tension, tension_sigma = result.value("tension")
+        coefficient, sigma = result.value("coefficient")
+        if not (math.isfinite(coefficient) and math.isfinite(sigma) and sigma > 0):
+            raise ComputationError(f"no finite coefficient ({coefficient:g} ± {sigma:g})")
+    except (InputError, ComputationError, FloatingPointError) as err:  # a bound included (BoundError)
+        return {"coefficient_reason": one_line(str(err))}
+    return {"tension": tension, "tension_sigma": tension_sigma, "coefficient": coefficient,
+            "coefficient_sigma": sigma}

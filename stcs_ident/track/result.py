@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..core.model import Damper
 from ..core.result import Result
 from ..core.settings import Settings
 from .archive import CableSpec
@@ -22,8 +23,9 @@ from .events import History
 
 __all__ = ["TrackResult"]
 
-#: Columns of the ``events`` table.
-EVENT_COLUMNS = ["cable", "start_time", "change", "uncertainty", "alarm_time"]
+#: Columns of the ``events`` table: ``kind`` is ``tension`` or ``damper`` (a lasting change of the damper's
+#: coefficient, after / before − 1).
+EVENT_COLUMNS = ["cable", "start_time", "change", "uncertainty", "alarm_time", "kind"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -44,7 +46,8 @@ class TrackResult(Result):
         ``size`` and ``mtime_ns``), with each record's
         ``tension_normalised`` (to the cable's mean temperature) and the
         ``level`` between lasting changes (N; NaN for a record without a
-        tension).
+        tension), and for a damped cable ``coefficient_normalised`` and
+        ``coefficient_level`` (N s/m; NaN for a record without a coefficient).
     histories : dict
         {cable: (row labels of ``table`` with a tension, in time order,
         :class:`~stcs_ident.track.events.History`)}.
@@ -54,6 +57,10 @@ class TrackResult(Result):
     settings : Settings
         The model settings every record was identified with.
     notes : tuple of Note
+    dampers : dict
+        {cable: (row labels of ``table`` with a coefficient, in time order, the coefficient's
+        :class:`~stcs_ident.track.events.History` from :mod:`~stcs_ident.track.damper_history`)}, for the
+        cables whose setup has one damper.
     """
 
     archive: str
@@ -64,6 +71,7 @@ class TrackResult(Result):
     counts: dict[str, int] = field(default_factory=dict)
     settings: Settings = field(default_factory=Settings)
     notes: tuple = ()
+    dampers: dict[str, tuple[pd.Index, History]] = field(default_factory=dict)
 
     main_table = "cables"
 
@@ -89,29 +97,48 @@ class TrackResult(Result):
             "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
             "state": history.state,
-            "events": [{"start_time": pd.Timestamp(times[e.index]).isoformat(),
-                        "change": e.change, "uncertainty": e.uncertainty,
-                        "alarm_time": pd.Timestamp(times[e.alarm]).isoformat()} for e in history.events],
+            "events": _events(history, times, "tension"),
             "failures": [{"record": r, "reason": why} for r, why in
                          zip(mine.loc[failed, "record"], mine.loc[failed, "reason"])],
+            **({"damper": self._damper_summary(spec)} if spec.name in self.dampers else {}),
+        }
+
+    def _damper_summary(self, spec: CableSpec) -> dict:
+        rows, history = self.dampers[spec.name]
+        mine = self.table[(self.table["cable"] == spec.name) & (self.table["status"] == "ok")]
+        missing = mine[~(mine["coefficient"] > 0)]
+        return {
+            "reference_coefficient": _reference_coefficient(spec),
+            "records": len(rows),
+            "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
+            "scatter": None if math.isnan(history.scatter) else history.scatter,
+            "state": history.state,
+            "events": _events(history, self.table.loc[rows, "start_time"].to_numpy(), "damper"),
+            "failures": [{"record": r, "reason": why} for r, why in
+                         zip(missing["record"], missing["coefficient_reason"])],
         }
 
     def summary(self) -> dict:
         """The ``track`` JSON of the interface (plain data): the archive and, per cable, its counts,
-        reference tension, EI held, thermal coefficient, scatter, events and failed records."""
+        reference tension, EI held, thermal coefficient, scatter, events and failed records; for a cable with
+        one damper, ``damper``: its reference coefficient, the records with a coefficient, the coefficient's
+        thermal coefficient (relative, per °C), scatter, state, events (``kind`` ``damper``) and the records
+        with a tension but no coefficient (``failures``, the reason)."""
         return {"archive": str(self.archive), "cables": self.cables}
 
     def tables(self) -> dict[str, pd.DataFrame]:
-        """``cables`` (one row per cable, the main table), ``events`` (one row per lasting change) and
+        """``cables`` (one row per cable, the main table; with a damped cable among them, the damper's columns,
+        empty for a cable without one damper), ``events`` (one row per lasting change of a tension or a damper's coefficient, ``kind``) and
         ``records`` (one row per record: :attr:`table`)."""
         cables = self.cables
         summary = pd.DataFrame([
             {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
              "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
              "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"],
-             "events": len(c["events"]), "state": c["state"]}
+             "events": len(c["events"]), "state": c["state"], **_damper_columns(c, bool(self.dampers))}
             for name, c in cables.items()])
-        events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items() for e in c["events"]],
+        events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items()
+                               for e in c["events"] + c.get("damper", {}).get("events", [])],
                               columns=EVENT_COLUMNS)
         return {"cables": summary, "events": events, "records": self.table}
 
@@ -124,6 +151,29 @@ class TrackResult(Result):
         status = self.table.loc[self.table["cable"].isin([s.name for s in self.specs]), "status"]
         events = sum(len(h.events) for _, h in self.histories.values())
         n = len(self.specs)
-        return (f"{self.archive}: {n} cable{'s' if n != 1 else ''}, {len(self.table)} records "
+        line = (f"{self.archive}: {n} cable{'s' if n != 1 else ''}, {len(self.table)} records "
                 f"({int((status == 'ok').sum())} with a tension, {int((status != 'ok').sum())} failed), "
                 f"{events} lasting change{'s' if events != 1 else ''}")
+        if self.dampers:
+            damper = sum(len(h.events) for _, h in self.dampers.values())
+            line += f", {damper} of a damper"
+        return line
+
+
+def _damper_columns(cable: dict, any_damper: bool) -> dict:
+    if not any_damper:
+        return {}
+    d = cable.get("damper", {})
+    return {"reference_coefficient_Nsm": d.get("reference_coefficient"),
+            "damper_thermal_coefficient_per_C": d.get("thermal_coefficient"), "damper_scatter": d.get("scatter"),
+            "damper_events": len(d["events"]) if d else None, "damper_state": d.get("state")}
+
+
+def _events(history: History, times, kind: str) -> list[dict]:
+    return [{"start_time": pd.Timestamp(times[e.index]).isoformat(), "change": e.change,
+             "uncertainty": e.uncertainty, "alarm_time": pd.Timestamp(times[e.alarm]).isoformat(), "kind": kind}
+            for e in history.events]
+
+
+def _reference_coefficient(spec: CableSpec) -> float:
+    return next(float(a.coefficient) for a in spec.campaign.setup(spec.setup).attachments if isinstance(a, Damper))

@@ -15,7 +15,10 @@ records are simply not known: they are processed again.
 for the user to open (pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps
 the types (times, lists of modes, planes and frequencies) and is read column
 by column. A part written before the ``planes`` column reads with every mode
-in-plane (what it was processed as). The files are written and read by :mod:`~stcs_ident.io.tables`;
+in-plane (what it was processed as); one written before the damper's columns
+(``damping``, ``damping_sigma``, ``coefficient``, ``coefficient_sigma``,
+``coefficient_reason``) reads with NaN damping ratios, one per mode, and no
+coefficient (nothing was fitted). The files are written and read by :mod:`~stcs_ident.io.tables`;
 this module keeps the rows' types, the parts' names and their order.
 """
 
@@ -33,7 +36,7 @@ import pandas as pd
 
 from ..core.errors import TrackWarning
 from ..io.tables import instant_column, read_parquet_files, write_parquet
-from .process import COLUMNS
+from .process import COLUMNS, DAMPER_COLUMNS
 
 __all__ = ["append_part", "cable_key", "processed_table", "read_parts", "replace_parts", "write_table"]
 
@@ -55,11 +58,12 @@ def cable_key(cable: str) -> str:
 def _frame(rows: list[dict]) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(ROW_COLUMNS))
     frame["start_time"] = instant_column(frame["start_time"])  # the readers' rule for times (core/times.py)
-    for name in ("temperature", "tension", "tension_sigma"):
+    for name in ("temperature", "tension", "tension_sigma", "coefficient", "coefficient_sigma"):
         frame[name] = frame[name].astype(float)
     for name in ("n_modes", "size", "mtime_ns"):
         frame[name] = frame[name].astype("int64")
     frame["version"] = frame["version"].astype(str)
+    frame["coefficient_reason"] = frame["coefficient_reason"].fillna("").astype(str)
     return frame
 
 
@@ -93,6 +97,8 @@ def read_parts(out: str | os.PathLike) -> tuple[pd.DataFrame, list[Path], list[P
     for path, frame in frames:
         if "planes" not in frame and "modes" in frame:  # a part written before the planes: every mode in-plane
             frame = frame.assign(planes=[["in"] * len(m) for m in frame["modes"]])
+        if "modes" in frame:  # a part written before the damper's columns: no damping ratio, no coefficient
+            frame = _with_damper_columns(frame)
         missing = [c for c in ROW_COLUMNS if c not in frame]
         cables = set(frame["cable"].map(cable_key)) if "cable" in frame else set()
         if missing or cables - {PART.match(path.name)["cable"]}:
@@ -109,6 +115,12 @@ def read_parts(out: str | os.PathLike) -> tuple[pd.DataFrame, list[Path], list[P
     else:
         rows = pd.concat([f[list(ROW_COLUMNS)].assign(part=p.name) for p, f in read], ignore_index=True)
     return rows, [p for p, _ in read], [p for p, _ in unreadable]
+
+
+def _with_damper_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    missing = {name: ([[float("nan")] * len(m) for m in frame["modes"]] if default is list else default)
+               for name, default in DAMPER_COLUMNS.items() if name not in frame}
+    return frame.assign(**missing) if missing else frame
 
 
 def _written(name: str) -> tuple[int, str]:
