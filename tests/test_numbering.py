@@ -123,3 +123,25 @@ def test_damped_families_from_the_undamped_grid_match_the_exact_complex_ones(eta
     assert np.max(np.abs(exact / undamped - 1)) > 5e-3  # the damper moves the frequencies: it is not ignored
     # 1e-3: a third of the numbering's model tolerance (measured: at most 8e-4 on a 49 x 15 grid, 25 modes)
     assert np.max(np.abs(got / exact - 1)) < 1e-3
+
+
+def test_the_search_grid_is_solved_once_per_model_and_gives_the_same_numbers(monkeypatch):
+    """A monitoring archive numbers every record of a cable against one nominal model: its grid's families
+    are kept (numbering._FAMILIES) and not solved again; the numbers are the same either way."""
+    import stcs_ident.spectra.numbering as numbering
+
+    cable = Cable(length=80.0, mass_per_length=50.0, EI=1.0e5, EA=2.0e9, inclination=math.radians(25.0))
+    atts = [Attachment("W", 7.0, 30.0)]
+    true = natural_frequencies(cable, atts, 3.1e6, 12)
+    monkeypatch.setattr(numbering, "_FAMILIES", {})
+    calls = []
+    solve = numbering._families
+    monkeypatch.setattr(numbering, "_families", lambda *a: calls.append(1) or solve(*a))
+    first = number_modes(true[1:], np.full(11, 1e-3), cable, atts, 3.0e6)
+    again = number_modes(true[1:] * 1.002, np.full(11, 1e-3), cable, atts, 3.0e6)
+    assert len(calls) == 1  # the second record's grid came from the first's
+    monkeypatch.setattr(numbering, "_FAMILIES", {})
+    fresh = number_modes(true[1:] * 1.002, np.full(11, 1e-3), cable, atts, 3.0e6)
+    assert len(calls) == 2
+    assert np.array_equal(first.modes, np.arange(2, 13)) and np.array_equal(again.modes, fresh.modes)
+    assert again.tension_ratio == fresh.tension_ratio and np.array_equal(again.predicted, fresh.predicted)

@@ -180,7 +180,28 @@ def _grid(f, cable, attachments, tension, options: NumberingOptions, tension_mod
     ei_ratio = (np.geomspace(*options.EI_range, _grid_points(options.EI_range, EI_STEP)) if cable.EI > 0
                 else np.array([1.0]))
     n_modes = _modes_needed(f, cable, attachments, tension, options.tension_range[0], tension_model)
-    return t_ratio, ei_ratio, _families(cable, attachments, tension, t_ratio, ei_ratio, n_modes, tension_model)
+    try:
+        key = (cable, tuple(attachments), float(tension), t_ratio.tobytes(), ei_ratio.tobytes(), n_modes,
+               tension_model[0], tuple(sorted(tension_model[1].items())))
+        hash(key)
+    except TypeError:  # an unhashable model (none today): solved every time
+        key = None
+    fam = _FAMILIES.get(key) if key is not None else None
+    if fam is None:
+        fam = _families(cable, attachments, tension, t_ratio, ei_ratio, n_modes, tension_model)
+        fam.flags.writeable = False
+        if key is not None:
+            _FAMILIES[key] = fam
+            while len(_FAMILIES) > MAX_GRIDS:
+                del _FAMILIES[next(iter(_FAMILIES))]
+    return t_ratio, ei_ratio, fam
+
+
+#: The search grids' families solved in this process, by model and grid: a monitoring archive numbers every
+#: record of a cable against the same nominal model, whose grid is then solved once per worker (the same
+#: arrays, so the same numbers, in whatever order or batch the records come). At most this many kept.
+MAX_GRIDS = 16
+_FAMILIES: dict = {}
 
 
 #: With a dashpot, the exact (complex) families are solved on a coarser grid of this many tension and EI ratios
