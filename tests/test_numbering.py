@@ -128,7 +128,7 @@ def test_damped_families_from_the_undamped_grid_match_the_exact_complex_ones(eta
 def test_the_search_grid_is_solved_once_per_model_and_gives_the_same_numbers(monkeypatch):
     """A monitoring archive numbers every record of a cable against one nominal model: its grid's families
     are kept (numbering._FAMILIES) and not solved again; the numbers are the same either way."""
-    import stcs_ident.spectra.numbering as numbering
+    from stcs_ident.spectra import numbering
 
     cable = Cable(length=80.0, mass_per_length=50.0, EI=1.0e5, EA=2.0e9, inclination=math.radians(25.0))
     atts = [Attachment("W", 7.0, 30.0)]
