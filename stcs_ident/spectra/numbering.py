@@ -29,6 +29,7 @@ from scipy.interpolate import BSpline, make_interp_spline
 from ..core.errors import InputError, NumberingWarning
 from ..core.model import Attachment, Cable
 from ..forward import batch_frequencies
+from ..forward.damped import batch_complex_modes
 from .options import NumberingOptions
 
 
@@ -410,18 +411,49 @@ class _FamilySurface:
 
 
 def _family(x, cable, attachments, tension, tension_model, n_modes):
+    """The exact family at the log ratios ``x``. With a dashpot, its complex roots are refined from the last
+    family solved for the same model (forward.damped's warm start: a candidate's ratios, and the next record's
+    of a monitoring archive, move each root by a small part of its spacing; the start's checks send anything
+    else to the certified solve), which costs a tenth of the solve from the undamped roots; the roots agree
+    with it to 1e-9 (the secant's stop)."""
     t = math.exp(x[0])
     EI = cable.EI * math.exp(x[1]) if len(x) > 1 else cable.EI
-    return batch_frequencies(cable, attachments, tension * t, n_modes, EI=EI, tension_model=tension_model[0],
-                             **tension_model[1])
+    kwargs = {"EI": EI, "tension_model": tension_model[0], **tension_model[1]}
+    if any(getattr(a, "coefficient", 0.0) for a in attachments):
+        key = (cable, tuple(attachments), n_modes, tension_model[0], tuple(sorted(tension_model[1].items())))
+        try:
+            start = _ROOTS.get(key)
+        except TypeError:  # an unhashable model: solved as without a dashpot's warm start
+            key = start = None
+        if start is not None:
+            s = batch_complex_modes(cable, attachments, tension * t, n_modes, certify=False, start=start,
+                                    lost="nan", **kwargs)
+            if np.all(np.isfinite(s)):
+                _ROOTS[key] = s
+                return np.abs(s) / (2 * math.pi)
+        if key is not None:
+            s = batch_complex_modes(cable, attachments, tension * t, n_modes, **kwargs)
+            _ROOTS[key] = s
+            while len(_ROOTS) > MAX_GRIDS:
+                del _ROOTS[next(iter(_ROOTS))]
+            return np.abs(s) / (2 * math.pi)
+    return batch_frequencies(cable, attachments, tension * t, n_modes, **kwargs)
+
+
+#: The complex roots of the last exact family solved per damped model in this process (:func:`_family`).
+_ROOTS: dict = {}
 
 
 def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
-    """Enough modes that the softest family in the search reaches past the highest peak."""
+    """Enough modes that the softest family in the search reaches past the highest peak (counted without the
+    dashpots: a dashpot only raises the frequencies, towards those with its node pinned, so the count is
+    never short, and it needs no complex solve)."""
     n = 8
+    off = {"coefficients": np.zeros(len(attachments))} if any(getattr(a, "coefficient", 0.0)
+                                                              for a in attachments) else {}
     while True:
         soft = batch_frequencies(cable, attachments, tension * lowest_ratio, n, EI=cable.EI * 0.2,
-                                 tension_model=tension_model[0], **tension_model[1])
+                                 tension_model=tension_model[0], **tension_model[1], **off)
         if soft[-1] > 1.2 * f.max() or n > 400:
             return n
         n = int(n * 1.6)
