@@ -52,11 +52,19 @@ import numpy as np
 
 from .decay_fit import pole_statistics
 from .options import FitOptions
+from .whittle import (
+    TINY,
+    BandProblem,
+    band_design,
+    fejer_lorentzian,
+    grid_start,
+    neg_log_likelihood,
+    null_neg_log_likelihood,
+)
 
-__all__ = ["AmbientFit", "fit_ambient"]
+__all__ = ["AmbientFit", "fejer_lorentzian", "fit_ambient"]
 
 # The iterations and the start's ζ grid are :class:`.options.FitOptions`.
-_TINY = np.finfo(float).tiny
 SERIAL_BLAS_SIZE = 2048  # elements: OpenBLAS runs a complex matrix-vector product this small on one thread
 
 
@@ -101,59 +109,8 @@ class AmbientFit:
     misfit: float = 1.0
 
 
-def fejer_lorentzian(
-    z: complex, phase: np.ndarray, n: int, derivative: bool = True
-) -> tuple[np.ndarray, np.ndarray | None]:
-    """H(u) = 2G(u) − 1 and dH/dz at u = exp(z − iφ), for the pole z = sΔt (see the module docstring).
-
-    With ``derivative=False`` only H (and None): the start grid and the
-    fixed neighbours need no derivative.
-    """
-    log_u = z - 1j * phase
-    u = np.exp(log_u)
-    one_minus = -np.expm1(log_u)
-    trunc = -np.expm1(n * log_u)  # 1 − u^N
-    g = 1.0 / one_minus - u * trunc / (n * one_minus**2)
-    if not derivative:
-        return 2.0 * g - 1.0, None
-    # dG/du, then du/dz = u.
-    dg_du = (
-        1.0 / one_minus**2 - (trunc - n * np.exp(n * log_u)) / (n * one_minus**2) - 2 * u * trunc / (n * one_minus**3)
-    )
-    return 2.0 * g - 1.0, 2.0 * dg_du * u
-
-
-@dataclass
-class _Problem:
-    periodogram: np.ndarray  # I_k
-    phase: np.ndarray  # 2πk/N
-    n_samples: int
-    dt: float
-    fixed: np.ndarray  # (m, q) fixed real basis columns: neighbours, constant, slope
-    nonnegative: np.ndarray  # (2 + q,) bool: linear coefficients that are powers (mode, neighbours, constant)
-
-
-def _design(theta_nl: np.ndarray, problem: _Problem, derivative: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-    """Real basis (m, 2 + q) of the expected periodogram and its derivative wrt (f, σ) for the mode term."""
-    z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
-    h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples, derivative)
-    # α Re H + β Im H with |β| ≤ α, written as p (Re H + Im H) + q (Re H − Im H) with p, q ≥ 0.
-    basis = np.empty((h.size, 2 + problem.fixed.shape[1]))
-    np.add(h.real, h.imag, out=basis[:, 0])
-    np.subtract(h.real, h.imag, out=basis[:, 1])
-    basis[:, 2:] = problem.fixed
-    if not derivative:
-        return basis, None
-    deriv = np.empty((h.size, 2, 2))
-    for j, d in enumerate((2j * np.pi * problem.dt, -problem.dt)):
-        dh_d = dh * d
-        np.add(dh_d.real, dh_d.imag, out=deriv[:, 0, j])
-        np.subtract(dh_d.real, dh_d.imag, out=deriv[:, 1, j])
-    return basis, deriv
-
-
-def _expected(theta: np.ndarray, problem: _Problem):
-    basis, deriv = _design(theta[:2], problem)
+def _expected(theta: np.ndarray, problem: BandProblem):
+    basis, deriv = band_design(theta[:2], problem)
     lin = theta[2:]
     mean = basis @ lin
     grad = np.empty((basis.shape[0], 2 + basis.shape[1]))
@@ -161,87 +118,6 @@ def _expected(theta: np.ndarray, problem: _Problem):
     grad[:, 1] = deriv[:, :, 1] @ lin[:2]
     grad[:, 2:] = basis
     return mean, grad
-
-
-def _neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
-    lowest = mean.min()
-    if lowest <= 0 or (np.isnan(lowest) and np.any(mean <= 0)):  # (min is nan if any entry is)
-        return np.inf
-    terms = np.log(mean)
-    terms += periodogram / mean
-    return float(terms.sum())
-
-
-def _linear_start(theta_nl: np.ndarray, problem: _Problem) -> tuple[np.ndarray, float]:
-    """Linear coefficients for given (f, σ)."""
-    basis, _ = _design(theta_nl, problem, derivative=False)
-    return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=3)  # a start only
-
-
-def _null_neg_log_likelihood(problem: _Problem) -> float:
-    """Whittle -log-likelihood of the background and neighbours alone (no mode)."""
-    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[2:], iterations=12)[1]
-
-
-def _whittle_linear(
-    basis: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray, iterations: int = 8
-) -> tuple[np.ndarray, float]:
-    """Whittle fit of a mean linear in its coefficients, by damped Fisher scoring (iteratively reweighted LS).
-
-    It starts from the flat mean (the last-but-one column is the constant
-    of the background) and halves each step until the mean stays positive
-    and the likelihood does not fall, so it never ends worse than the flat
-    background. Coefficients that are powers stay ≥ 0: a neighbour's tail
-    taken negative would carve a bump out of a constant and mimic a mode.
-    """
-    lin = np.zeros(basis.shape[1])
-    lin[-2] = np.mean(periodogram)
-    mean = basis @ lin
-    nll = _neg_log_likelihood(mean, periodogram)
-    for _ in range(iterations):
-        target = _weighted_least_squares(basis, periodogram, 1.0 / mean, nonnegative)
-        step = target - lin
-        for _ in range(20):
-            trial = lin + step
-            trial_mean = basis @ trial
-            trial_nll = _neg_log_likelihood(trial_mean, periodogram)
-            if trial_nll <= nll:
-                lin, mean, nll = trial, trial_mean, trial_nll
-                break
-            step = step / 2
-        else:
-            break
-    return lin, nll
-
-
-def _weighted_least_squares(basis, target, weight, nonnegative) -> np.ndarray:
-    """min ||w (basis c − target)|| with c ≥ 0 where `nonnegative`, by dropping the most negative column in turn.
-
-    A small active-set loop (the columns are few); the normal equations are
-    solved with column scaling and a tiny ridge.
-    """
-    # Rows of a_t are the weighted columns (sub_t @ sub_t.T: the normal matrix of the free ones). Called
-    # thousands of times per record: few numpy calls per pass, the same arithmetic as the plain form.
-    a_t = np.multiply(basis.T, weight, order="C")
-    b = target * weight
-    n_columns = basis.shape[1]
-    free = np.ones(n_columns, dtype=bool)
-    bounded = nonnegative.copy()  # free columns that must stay >= 0
-    sub_t = a_t
-    for _ in range(n_columns):
-        normal = sub_t @ sub_t.T
-        scale = np.sqrt(np.maximum(normal.diagonal(), _TINY))
-        normal /= scale[:, None] * scale
-        normal.flat[:: scale.size + 1] += 1e-12  # the ridge
-        coef = np.zeros(n_columns)
-        coef[free] = np.linalg.solve(normal, (sub_t @ b) / scale) / scale
-        candidate = np.where(bounded, coef, 0.0)
-        worst = int(np.argmin(candidate))
-        if not candidate[worst] < 0:
-            break
-        free[worst] = bounded[worst] = False
-        sub_t = a_t[free]
-    return coef
 
 
 def _fisher(grad: np.ndarray, mean: np.ndarray) -> np.ndarray:
@@ -256,7 +132,7 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     step = np.zeros(theta.size)
     sub = fisher
     for _ in range(theta.size):
-        scale = np.sqrt(np.maximum(sub.diagonal(), _TINY))
+        scale = np.sqrt(np.maximum(sub.diagonal(), TINY))
         step = np.zeros(theta.size)
         step[free] = np.linalg.lstsq(sub / (scale[:, None] * scale), score[free] / scale, rcond=1e-12)[0] / scale
         blocked = np.flatnonzero(free & bounded & (theta + step < 0) & (theta <= 1e-12 * np.abs(theta).max()))
@@ -267,14 +143,14 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     return step
 
 
-def _scoring(theta: np.ndarray, problem: _Problem, limits,
+def _scoring(theta: np.ndarray, problem: BandProblem, limits,
              max_iterations: int) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
     """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits).
 
     Returns θ, whether it converged, and the expected periodogram and its gradient at θ.
     """
     mean, grad = _expected(theta, problem)
-    nll = _neg_log_likelihood(mean, problem.periodogram)
+    nll = neg_log_likelihood(mean, problem.periodogram)
     for _ in range(max_iterations):
         score = grad.T @ ((problem.periodogram - mean) / mean**2)
         fisher = _fisher(grad, mean)
@@ -286,7 +162,7 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits,
             return theta, False, mean, grad  # samples): not converged, and the caller's checks reject the fit
         if not np.all(np.isfinite(step)):
             return theta, False, mean, grad
-        if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], _TINY)) < 1e-4):
+        if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], TINY)) < 1e-4):
             return theta, True, mean, grad
         for _ in range(30):
             trial = theta + step
@@ -294,7 +170,7 @@ def _scoring(theta: np.ndarray, problem: _Problem, limits,
             inside = limits[0][0] < trial[0] < limits[0][1] and limits[1][0] < trial[1] < limits[1][1]
             if inside:
                 new_mean, new_grad = _expected(trial, problem)
-                new_nll = _neg_log_likelihood(new_mean, problem.periodogram)
+                new_nll = neg_log_likelihood(new_mean, problem.periodogram)
                 if new_nll <= nll:
                     theta, mean, grad, nll = trial, new_mean, new_grad, new_nll
                     break
@@ -410,7 +286,7 @@ def fit_ambient(
     fixed = _fixed_basis(k * df, f_initial, half_width, neighbours, k, n_samples, dt)
     # Linear coefficients: mode (p, q), neighbours, constant, slope; powers are ≥ 0.
     nonnegative = np.array([True, True] + [True] * len(neighbours) + [True, False])
-    problem = _Problem(np.abs(y) ** 2, 2 * np.pi * k / n_samples, n_samples, dt, fixed, nonnegative)
+    problem = BandProblem(np.abs(y) ** 2, 2 * np.pi * k / n_samples, n_samples, dt, fixed, nonnegative)
     # Starting frequencies: the overview's, and the band's maximum after smoothing over 3 bins (a narrow
     # peak) and over a quarter of the overview's width (a broad one, whose bins scatter).
     starts = [f_initial]
@@ -422,7 +298,7 @@ def fit_ambient(
         (f_initial - half_width, f_initial + half_width),
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
     )
-    theta = _grid_start(starts, problem, limits, options.ambient_start_damping)
+    theta = grid_start(starts, problem, limits, options.ambient_start_damping)
     theta, ok, mean, grad = _scoring(theta, problem, limits, options.ambient_max_iterations)
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
@@ -432,8 +308,8 @@ def fit_ambient(
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
         return None
-    null = _null_neg_log_likelihood(problem)
-    significance = np.sqrt(max(2.0 * (null - _neg_log_likelihood(mean, problem.periodogram)), 0.0))
+    null = null_neg_log_likelihood(problem)
+    significance = np.sqrt(max(2.0 * (null - neg_log_likelihood(mean, problem.periodogram)), 0.0))
     variance_y = 2.0 * (theta[2] + theta[3])  # c(0) = 2α of the modal term in y, α = p + q
     shape = u * noise_scale
     shape = shape / np.linalg.norm(shape)
@@ -455,23 +331,6 @@ def _smoothed_peak(periodogram: np.ndarray, freq: np.ndarray, width: float) -> f
     n = max(1, round(width / (freq[1] - freq[0])))
     smooth = np.convolve(periodogram, np.ones(n) / n, mode="same")
     return float(freq[int(np.argmax(smooth))])
-
-
-def _grid_start(starts: list[float], problem: _Problem, limits, damping_grid) -> np.ndarray:
-    """The best (least -log-likelihood) of the starting frequencies × `damping_grid` (ζ), linear terms fitted."""
-    best, best_nll = None, np.inf
-    for f_start in starts:
-        for zeta in damping_grid:
-            theta_nl = np.array([f_start, zeta * 2 * np.pi * f_start])
-            if not limits[1][0] < theta_nl[1] < limits[1][1]:
-                continue
-            lin, nll = _linear_start(theta_nl, problem)
-            if nll < best_nll:
-                best, best_nll = np.concatenate([theta_nl, lin]), nll
-    if best is None:
-        theta_nl = np.array([starts[0], limits[1][1] / 2])
-        best = np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
-    return best
 
 
 def _result(theta, cov, amplitude, shape, significance, ok, misfit=1.0) -> AmbientFit:

@@ -1,0 +1,254 @@
+"""The Whittle likelihood of one band's periodogram, as :mod:`.ambient_fit` fits it: the expected
+periodogram of a mode (the Fejér-convolved SDOF spectrum, :func:`fejer_lorentzian`) on a fixed background,
+its linear coefficients by damped Fisher scoring with powers held ≥ 0, and the start grid of (f, ζ), every
+candidate of which is evaluated at once (:func:`grid_start`). The model and its references are in
+:mod:`.ambient_fit`'s docstring.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["TINY", "BandProblem", "band_design", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
+           "null_neg_log_likelihood"]
+
+TINY = np.finfo(float).tiny
+
+
+def fejer_lorentzian(
+    z: complex, phase: np.ndarray, n: int, derivative: bool = True
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """H(u) = 2G(u) − 1 and dH/dz at u = exp(z − iφ), for the pole z = sΔt (see the module docstring).
+
+    With ``derivative=False`` only H (and None): the start grid and the
+    fixed neighbours need no derivative.
+    """
+    log_u = z - 1j * phase
+    u = np.exp(log_u)
+    one_minus = -np.expm1(log_u)
+    trunc = -np.expm1(n * log_u)  # 1 − u^N
+    g = 1.0 / one_minus - u * trunc / (n * one_minus**2)
+    if not derivative:
+        return 2.0 * g - 1.0, None
+    # dG/du, then du/dz = u.
+    dg_du = (
+        1.0 / one_minus**2 - (trunc - n * np.exp(n * log_u)) / (n * one_minus**2) - 2 * u * trunc / (n * one_minus**3)
+    )
+    return 2.0 * g - 1.0, 2.0 * dg_du * u
+
+
+@dataclass
+class BandProblem:
+    periodogram: np.ndarray  # I_k
+    phase: np.ndarray  # 2πk/N
+    n_samples: int
+    dt: float
+    fixed: np.ndarray  # (m, q) fixed real basis columns: neighbours, constant, slope
+    nonnegative: np.ndarray  # (2 + q,) bool: linear coefficients that are powers (mode, neighbours, constant)
+
+
+def band_design(theta_nl: np.ndarray, problem: BandProblem, derivative: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """Real basis (m, 2 + q) of the expected periodogram and its derivative wrt (f, σ) for the mode term."""
+    z = complex(-theta_nl[1] * problem.dt, 2 * np.pi * theta_nl[0] * problem.dt)
+    h, dh = fejer_lorentzian(z, problem.phase, problem.n_samples, derivative)
+    # α Re H + β Im H with |β| ≤ α, written as p (Re H + Im H) + q (Re H − Im H) with p, q ≥ 0.
+    basis = np.empty((h.size, 2 + problem.fixed.shape[1]))
+    np.add(h.real, h.imag, out=basis[:, 0])
+    np.subtract(h.real, h.imag, out=basis[:, 1])
+    basis[:, 2:] = problem.fixed
+    if not derivative:
+        return basis, None
+    deriv = np.empty((h.size, 2, 2))
+    for j, d in enumerate((2j * np.pi * problem.dt, -problem.dt)):
+        dh_d = dh * d
+        np.add(dh_d.real, dh_d.imag, out=deriv[:, 0, j])
+        np.subtract(dh_d.real, dh_d.imag, out=deriv[:, 1, j])
+    return basis, deriv
+
+
+def neg_log_likelihood(mean: np.ndarray, periodogram: np.ndarray) -> float:
+    lowest = mean.min()
+    if lowest <= 0 or (np.isnan(lowest) and np.any(mean <= 0)):  # (min is nan if any entry is)
+        return np.inf
+    terms = np.log(mean)
+    terms += periodogram / mean
+    return float(terms.sum())
+
+
+def _linear_start(theta_nl: np.ndarray, problem: BandProblem) -> tuple[np.ndarray, float]:
+    """Linear coefficients for given (f, σ)."""
+    basis, _ = band_design(theta_nl, problem, derivative=False)
+    return _whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=3)  # a start only
+
+
+def null_neg_log_likelihood(problem: BandProblem) -> float:
+    """Whittle -log-likelihood of the background and neighbours alone (no mode)."""
+    return _whittle_linear(problem.fixed, problem.periodogram, problem.nonnegative[2:], iterations=12)[1]
+
+
+def _whittle_linear(
+    basis: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray, iterations: int = 8
+) -> tuple[np.ndarray, float]:
+    """Whittle fit of a mean linear in its coefficients, by damped Fisher scoring (iteratively reweighted LS).
+
+    It starts from the flat mean (the last-but-one column is the constant
+    of the background) and halves each step until the mean stays positive
+    and the likelihood does not fall, so it never ends worse than the flat
+    background. Coefficients that are powers stay ≥ 0: a neighbour's tail
+    taken negative would carve a bump out of a constant and mimic a mode.
+    """
+    lin = np.zeros(basis.shape[1])
+    lin[-2] = np.mean(periodogram)
+    mean = basis @ lin
+    nll = neg_log_likelihood(mean, periodogram)
+    for _ in range(iterations):
+        target = _weighted_least_squares(basis, periodogram, 1.0 / mean, nonnegative)
+        step = target - lin
+        for _ in range(20):
+            trial = lin + step
+            trial_mean = basis @ trial
+            trial_nll = neg_log_likelihood(trial_mean, periodogram)
+            if trial_nll <= nll:
+                lin, mean, nll = trial, trial_mean, trial_nll
+                break
+            step = step / 2
+        else:
+            break
+    return lin, nll
+
+
+def _weighted_least_squares(basis, target, weight, nonnegative) -> np.ndarray:
+    """min ||w (basis c − target)|| with c ≥ 0 where `nonnegative`, by dropping the most negative column in turn.
+
+    A small active-set loop (the columns are few); the normal equations are
+    solved with column scaling and a tiny ridge.
+    """
+    # Rows of a_t are the weighted columns (sub_t @ sub_t.T: the normal matrix of the free ones). Called
+    # thousands of times per record: few numpy calls per pass, the same arithmetic as the plain form.
+    a_t = np.multiply(basis.T, weight, order="C")
+    b = target * weight
+    n_columns = basis.shape[1]
+    free = np.ones(n_columns, dtype=bool)
+    bounded = nonnegative.copy()  # free columns that must stay >= 0
+    sub_t = a_t
+    for _ in range(n_columns):
+        normal = sub_t @ sub_t.T
+        scale = np.sqrt(np.maximum(normal.diagonal(), TINY))
+        normal /= scale[:, None] * scale
+        normal.flat[:: scale.size + 1] += 1e-12  # the ridge
+        coef = np.zeros(n_columns)
+        coef[free] = np.linalg.solve(normal, (sub_t @ b) / scale) / scale
+        candidate = np.where(bounded, coef, 0.0)
+        worst = int(np.argmin(candidate))
+        if not candidate[worst] < 0:
+            break
+        free[worst] = bounded[worst] = False
+        sub_t = a_t[free]
+    return coef
+
+
+def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) -> np.ndarray:
+    """The best (least -log-likelihood) of the starting frequencies × `damping_grid` (ζ), linear terms fitted
+    (all of them at once: :func:`_whittle_linear_many`; the first of equal ones)."""
+    grid = [np.array([f_start, zeta * 2 * np.pi * f_start]) for f_start in starts for zeta in damping_grid]
+    grid = [theta_nl for theta_nl in grid if limits[1][0] < theta_nl[1] < limits[1][1]]
+    if grid:
+        bases = _designs(np.array(grid), problem)
+        lin, nll = _whittle_linear_many(bases, problem.periodogram, problem.nonnegative, iterations=3)  # starts only
+        best = int(np.argmin(np.where(np.isnan(nll), np.inf, nll)))
+        if nll[best] < np.inf:
+            return np.concatenate([grid[best], lin[best]])
+    theta_nl = np.array([starts[0], limits[1][1] / 2])
+    return np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
+
+
+def _designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
+    """:func:`band_design`'s basis (no derivative) of many (f, σ) rows at once, (c, m, 2 + q)."""
+    z = (-thetas[:, 1] * problem.dt + 2j * np.pi * thetas[:, 0] * problem.dt)[:, None]
+    h, _ = fejer_lorentzian(z, problem.phase[None, :], problem.n_samples, derivative=False)
+    bases = np.empty(h.shape + (2 + problem.fixed.shape[1],))
+    np.add(h.real, h.imag, out=bases[:, :, 0])
+    np.subtract(h.real, h.imag, out=bases[:, :, 1])
+    bases[:, :, 2:] = problem.fixed
+    return bases
+
+
+def _whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
+                         iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_whittle_linear` of many bases (c, m, q) at once: coefficients (c, q) and -log-likelihoods (c,).
+
+    The same steps candidate by candidate (the flat start, the weighted least squares with the active set,
+    the step halved until the likelihood does not fall, a candidate whose step cannot be made to stops), in
+    a few array operations for all: the start grid of every band's fit, a third of an ambient record's
+    picking, was numpy's per-call overhead on 6 × 6 systems."""
+    c, _, q = bases.shape
+    lin = np.zeros((c, q))
+    lin[:, -2] = np.mean(periodogram)
+    mean = np.einsum("cmq,cq->cm", bases, lin)
+    nll = _neg_log_likelihood_many(mean, periodogram)
+    active = np.ones(c, dtype=bool)
+    for _ in range(iterations):
+        if not active.any():
+            break
+        with np.errstate(divide="ignore", invalid="ignore"):
+            target = _weighted_least_squares_many(bases, periodogram, 1.0 / mean, nonnegative)
+        step = target - lin
+        accepted = np.zeros(c, dtype=bool)
+        for _ in range(20):
+            todo = active & ~accepted
+            if not todo.any():
+                break
+            trial = lin[todo] + step[todo]
+            trial_mean = np.einsum("cmq,cq->cm", bases[todo], trial)
+            trial_nll = _neg_log_likelihood_many(trial_mean, periodogram)
+            with np.errstate(invalid="ignore"):
+                ok = trial_nll <= nll[todo]
+            rows = np.flatnonzero(todo)
+            lin[rows[ok]], mean[rows[ok]], nll[rows[ok]] = trial[ok], trial_mean[ok], trial_nll[ok]
+            accepted[rows[ok]] = True
+            step[rows[~ok]] /= 2
+        active &= accepted
+    return lin, nll
+
+
+def _neg_log_likelihood_many(mean: np.ndarray, periodogram: np.ndarray) -> np.ndarray:
+    """:func:`neg_log_likelihood` of each row of ``mean``."""
+    bad = np.any(mean <= 0, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.sum(np.log(mean) + periodogram / mean, axis=1)
+    out[bad] = np.inf
+    return out
+
+
+def _weighted_least_squares_many(bases, target, weight, nonnegative) -> np.ndarray:
+    """:func:`_weighted_least_squares` of many bases (c, m, q) and weights (c, m) at once. A dropped column is
+    zeroed: its row and column of the normal matrix are then zero but for the ridge, and its coefficient 0."""
+    c, _, q = bases.shape
+    a_t = np.transpose(bases, (0, 2, 1)) * weight[:, None, :]  # (c, q, m)
+    full = a_t @ np.transpose(a_t, (0, 2, 1))  # the normal matrix of all columns; a free set's is its sub-block
+    full_rhs = np.einsum("cqm,cm->cq", a_t, target[None, :] * weight)
+    free = np.ones((c, q), dtype=bool)
+    bounded = np.broadcast_to(nonnegative, (c, q)).copy()
+    running = np.ones(c, dtype=bool)
+    coef = np.zeros((c, q))
+    diagonal = np.arange(q)
+    for _ in range(q):
+        rows = np.flatnonzero(running)
+        mask = free[rows]
+        normal = full[rows] * (mask[:, :, None] & mask[:, None, :])
+        scale = np.sqrt(np.maximum(normal[:, diagonal, diagonal], TINY))
+        normal /= scale[:, :, None] * scale[:, None, :]
+        normal[:, diagonal, diagonal] += 1e-12  # the ridge
+        rhs = full_rhs[rows] * mask / scale
+        coef[rows] = np.linalg.solve(normal, rhs[:, :, None])[:, :, 0] / scale * mask
+        candidate = np.where(bounded[rows], coef[rows], 0.0)
+        worst = np.argmin(candidate, axis=1)
+        negative = candidate[np.arange(rows.size), worst] < 0
+        running[rows[~negative]] = False
+        drop = rows[negative]
+        free[drop, worst[negative]] = bounded[drop, worst[negative]] = False
+        if not running.any():
+            break
+    return coef
