@@ -128,19 +128,20 @@ def test_damped_families_from_the_undamped_grid_match_the_exact_complex_ones(eta
 def test_the_search_grid_is_solved_once_per_model_and_gives_the_same_numbers(monkeypatch):
     """A monitoring archive numbers every record of a cable against one nominal model: its grid's families
     are kept (numbering._FAMILIES) and not solved again; the numbers are the same either way."""
+    from stcs_ident.core.memo import BoundedCache
     from stcs_ident.spectra import numbering
 
     cable = Cable(length=80.0, mass_per_length=50.0, EI=1.0e5, EA=2.0e9, inclination=math.radians(25.0))
     atts = [Attachment("W", 7.0, 30.0)]
     true = natural_frequencies(cable, atts, 3.1e6, 12)
-    monkeypatch.setattr(numbering, "_FAMILIES", {})
+    monkeypatch.setattr(numbering, "_FAMILIES", BoundedCache(numbering.MAX_GRIDS))
     calls = []
     solve = numbering._families
     monkeypatch.setattr(numbering, "_families", lambda *a: calls.append(1) or solve(*a))
     first = number_modes(true[1:], np.full(11, 1e-3), cable, atts, 3.0e6)
     again = number_modes(true[1:] * 1.002, np.full(11, 1e-3), cable, atts, 3.0e6)
     assert len(calls) == 1  # the second record's grid came from the first's
-    monkeypatch.setattr(numbering, "_FAMILIES", {})
+    monkeypatch.setattr(numbering, "_FAMILIES", BoundedCache(numbering.MAX_GRIDS))
     fresh = number_modes(true[1:] * 1.002, np.full(11, 1e-3), cable, atts, 3.0e6)
     assert len(calls) == 2
     assert np.array_equal(first.modes, np.arange(2, 13)) and np.array_equal(again.modes, fresh.modes)

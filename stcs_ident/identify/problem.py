@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core import kinds
 from ..core.errors import ComputationError, InputError, ModelError
+from ..core.memo import BoundedCache, model_key
 from ..core.model import Campaign, has_dampers
 from ..core.parameters import Parameter, overrides_for
 from ..core.planes import PLANES
@@ -234,15 +235,15 @@ class Problem:
                 # Warm-started from the last row solved: a fit's next trial point, or a Jacobian's steps, moves
                 # each root by a small part of its spacing (forward.damped._warm checks that, else solves cold).
                 # The start is scaled by √(H / H_last): the tension moves every root about so.
-                key = _roots_key(cable, atts, plane, n_modes, self.tension_model)
-                last = _LAST_ROOTS.get(key, _LAST_ROOTS.get(key[:1] + key[2:]))  # else another setup's, if any
+                key = model_key(cable, tuple(atts), plane, n_modes, self.tension_model)
+                any_setup = model_key(cable, plane, n_modes, self.tension_model)
+                last = _LAST_ROOTS.get(key, _LAST_ROOTS.get(any_setup))  # else another setup's, if any
                 start = None if last is None else last[1][None, :] * np.sqrt(np.reshape(tension, (-1, 1)) / last[0])
                 s = batch_complex_modes(cable, atts, tension, n_modes, tension_model=self.tension_model,
                                         certify=FIT_CERTIFY, plane=plane, start=start, lost="nan", **overrides)
                 if np.all(np.isfinite(s[-1])) and np.all(s[-1].imag > 0):
-                    _LAST_ROOTS[key] = _LAST_ROOTS[key[:1] + key[2:]] = (float(np.ravel(tension)[-1]), s[-1].copy())
-                    while len(_LAST_ROOTS) > MAX_WARM_STARTS:
-                        del _LAST_ROOTS[next(iter(_LAST_ROOTS))]
+                    for k in (key, any_setup):
+                        _LAST_ROOTS.put(k, (float(np.ravel(tension)[-1]), s[-1].copy()))
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
             return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
                                      plane=plane, **overrides), None
@@ -313,7 +314,7 @@ class Problem:
 #: its attachments, the start of a setup not solved yet (a hypothesis's added mass moves the roots a little; the
 #: warm start's checks refuse what moved too far). At most this many.
 MAX_WARM_STARTS = 64
-_LAST_ROOTS: dict = {}
+_LAST_ROOTS = BoundedCache(MAX_WARM_STARTS)
 
 
 def reset_warm_starts() -> None:
@@ -322,15 +323,6 @@ def reset_warm_starts() -> None:
     this process solved before (a warm start that succeeds where the cold solve of a trial point fails can
     lead a fit elsewhere; the fitted values agree to about 1e-9 where the fit is well posed)."""
     _LAST_ROOTS.clear()
-
-
-def _roots_key(cable, atts, plane: str, n_modes: int, tension_model: str):
-    try:
-        key = (cable, tuple(atts), plane, n_modes, tension_model)
-        hash(key)
-    except TypeError:  # an unhashable attachment (none today): the roots are kept per object
-        key = (id(cable), tuple(id(a) for a in atts), plane, n_modes, tension_model)
-    return key
 
 
 def _dashpots(atts, overrides) -> bool:

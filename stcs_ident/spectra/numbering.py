@@ -27,7 +27,8 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from ..core.errors import InputError, NumberingWarning
-from ..core.model import Attachment, Cable
+from ..core.memo import BoundedCache, model_key
+from ..core.model import Attachment, Cable, has_dampers
 from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
 from .options import NumberingOptions
@@ -181,20 +182,13 @@ def _grid(f, cable, attachments, tension, options: NumberingOptions, tension_mod
     ei_ratio = (np.geomspace(*options.EI_range, _grid_points(options.EI_range, EI_STEP)) if cable.EI > 0
                 else np.array([1.0]))
     n_modes = _modes_needed(f, cable, attachments, tension, options.tension_range[0], tension_model)
-    try:
-        key = (cable, tuple(attachments), float(tension), t_ratio.tobytes(), ei_ratio.tobytes(), n_modes,
-               tension_model[0], tuple(sorted(tension_model[1].items())))
-        hash(key)
-    except TypeError:  # an unhashable model (none today): solved every time
-        key = None
-    fam = _FAMILIES.get(key) if key is not None else None
+    key = model_key(cable, tuple(attachments), float(tension), t_ratio.tobytes(), ei_ratio.tobytes(), n_modes,
+                    tension_model[0], tuple(sorted(tension_model[1].items())))
+    fam = _FAMILIES.get(key)
     if fam is None:
         fam = _families(cable, attachments, tension, t_ratio, ei_ratio, n_modes, tension_model)
         fam.flags.writeable = False
-        if key is not None:
-            _FAMILIES[key] = fam
-            while len(_FAMILIES) > MAX_GRIDS:
-                del _FAMILIES[next(iter(_FAMILIES))]
+        _FAMILIES.put(key, fam)
     return t_ratio, ei_ratio, fam
 
 
@@ -202,7 +196,7 @@ def _grid(f, cable, attachments, tension, options: NumberingOptions, tension_mod
 #: record of a cable against the same nominal model, whose grid is then solved once per worker (the same
 #: arrays, so the same numbers, in whatever order or batch the records come). At most this many kept.
 MAX_GRIDS = 16
-_FAMILIES: dict = {}
+_FAMILIES = BoundedCache(MAX_GRIDS)
 
 
 #: With a dashpot, the exact (complex) families are solved on a coarser grid of this many tension and EI ratios
@@ -230,7 +224,7 @@ def _families(cable, attachments, tension, t_ratio, ei_ratio, n_modes, tension_m
                                  tension_model=tension_model[0], **tension_model[1], **extra)
 
     coarse = [min(n, r.size) for n, r in zip(DAMPED_GRID, (t_ratio, ei_ratio))]
-    if not any(getattr(a, "coefficient", 0.0) for a in attachments) or t_ratio.size * ei_ratio.size <= np.prod(coarse):
+    if not has_dampers(attachments) or t_ratio.size * ei_ratio.size <= np.prod(coarse):
         return solve(t_ratio, ei_ratio)
     off = {"coefficients": np.zeros(len(attachments))}
     t_c, e_c = (np.geomspace(r[0], r[-1], n) for n, r in zip(coarse, (t_ratio, ei_ratio)))
@@ -419,29 +413,22 @@ def _family(x, cable, attachments, tension, tension_model, n_modes):
     t = math.exp(x[0])
     EI = cable.EI * math.exp(x[1]) if len(x) > 1 else cable.EI
     kwargs = {"EI": EI, "tension_model": tension_model[0], **tension_model[1]}
-    if any(getattr(a, "coefficient", 0.0) for a in attachments):
-        key = (cable, tuple(attachments), n_modes, tension_model[0], tuple(sorted(tension_model[1].items())))
-        try:
-            start = _ROOTS.get(key)
-        except TypeError:  # an unhashable model: solved as without a dashpot's warm start
-            key = start = None
+    if has_dampers(attachments):
+        key = model_key(cable, tuple(attachments), n_modes, tension_model[0], tuple(sorted(tension_model[1].items())))
+        start = _ROOTS.get(key)
+        s = None
         if start is not None:
             s = batch_complex_modes(cable, attachments, tension * t, n_modes, certify=False, start=start,
                                     lost="nan", **kwargs)
-            if np.all(np.isfinite(s)):
-                _ROOTS[key] = s
-                return np.abs(s) / (2 * math.pi)
-        if key is not None:
+        if s is None or not np.all(np.isfinite(s)):
             s = batch_complex_modes(cable, attachments, tension * t, n_modes, **kwargs)
-            _ROOTS[key] = s
-            while len(_ROOTS) > MAX_GRIDS:
-                del _ROOTS[next(iter(_ROOTS))]
-            return np.abs(s) / (2 * math.pi)
+        _ROOTS.put(key, s)
+        return np.abs(s) / (2 * math.pi)
     return batch_frequencies(cable, attachments, tension * t, n_modes, **kwargs)
 
 
 #: The complex roots of the last exact family solved per damped model in this process (:func:`_family`).
-_ROOTS: dict = {}
+_ROOTS = BoundedCache(MAX_GRIDS)
 
 
 def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
@@ -449,8 +436,7 @@ def _modes_needed(f, cable, attachments, tension, lowest_ratio, tension_model):
     dashpots: a dashpot only raises the frequencies, towards those with its node pinned, so the count is
     never short, and it needs no complex solve)."""
     n = 8
-    off = {"coefficients": np.zeros(len(attachments))} if any(getattr(a, "coefficient", 0.0)
-                                                              for a in attachments) else {}
+    off = {"coefficients": np.zeros(len(attachments))} if has_dampers(attachments) else {}
     while True:
         soft = batch_frequencies(cable, attachments, tension * lowest_ratio, n, EI=cable.EI * 0.2,
                                  tension_model=tension_model[0], **tension_model[1], **off)
