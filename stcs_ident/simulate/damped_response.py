@@ -156,7 +156,9 @@ def superpose_damped(modes: DampedModes, sampling_rate: float, n_samples: int, p
     p = s0.size
     dt = 1.0 / sampling_rate
     read = (modes.shapes(positions) * modes.weights[None, :]).T  # (p, n_channels): a = Re(modal @ read)
-    to_modal = modes.to_modal  # (r, p)
+    # (r, 2p): the real and imaginary parts side by side. A real force times a complex matrix is not a BLAS
+    # product in numpy (it ran 0.02-0.25 s a block, erratically); two real ones are.
+    to_modal = np.hstack([modes.to_modal.real, modes.to_modal.imag])
     drifting = relative_tension is not None
     seg = max(1, min(round(DRIFT_SEGMENT * sampling_rate), _BLOCK)) if drifting else _BLOCK
     log1p_d = np.log1p(relative_tension) if drifting else None
@@ -169,30 +171,40 @@ def superpose_damped(modes: DampedModes, sampling_rate: float, n_samples: int, p
     eta = np.zeros(p, dtype=complex)  # η at the segment's first sample
     filt_state = None
     if force_sqrt is not None:
-        eta, filt_state = _stationary_start(poles_over(0, min(seg, n_samples)), dt, to_modal,
+        eta, filt_state = _stationary_start(poles_over(0, min(seg, n_samples)), dt, modes.to_modal,
                                             force_sqrt @ force_sqrt.T, force_filter, rng)
 
     order = sorted(range(len(kicks)), key=lambda i: kicks[i][0])
     next_kick = 0
     out = np.empty((n_samples, len(positions)))
+    if force_sqrt is not None:  # buffers reused block after block: fresh large arrays cost page faults each time
+        r = force_sqrt.shape[0]
+        white, force, parts = np.empty((seg, r)), np.empty((seg, r)), np.empty((2 * p, seg))
+        u, path = np.empty((p, seg), dtype=complex), np.empty((p, seg), dtype=complex)
     for start in range(0, n_samples, seg):
         stop = min(start + seg, n_samples)
         n = stop - start
         s = poles_over(start, stop)
         lam = np.exp(s * dt)
         if force_sqrt is not None:
-            force = rng.standard_normal((n, force_sqrt.shape[0])) @ force_sqrt.T
+            rng.standard_normal(out=white[:n])
+            np.matmul(white[:n], force_sqrt.T, out=force[:n])
+            held = force[:n]
             if force_filter is not None:
-                force, filt_state = lfilter(force_filter[0], force_filter[1], force, axis=0, zi=filt_state)
-            u = force @ to_modal  # (n, p) modal forces
+                held, filt_state = lfilter(force_filter[0], force_filter[1], held, axis=0, zi=filt_state)
+            np.matmul(to_modal.T, held.T, out=parts[:, :n])  # modes along rows: each one's path is contiguous
+            u[:, :n].real, u[:, :n].imag = parts[:p, :n], parts[p:, :n]
             beta = _hold_gain(s, lam)
-            path = np.empty((n, p), dtype=complex)
             for j in range(p):
-                nxt, _ = lfilter([beta[j]], [1.0, -lam[j]], u[:, j], zi=[lam[j] * eta[j]])
-                path[0, j] = eta[j]
-                path[1:, j] = nxt[:-1]
+                nxt, _ = lfilter([beta[j]], [1.0, -lam[j]], u[j, :n], zi=[lam[j] * eta[j]])
+                path[j, 0] = eta[j]
+                path[j, 1:n] = nxt[:-1]
                 eta[j] = nxt[-1]
-            modal = s * (s * path + u)
+            modal = path[:, :n]
+            modal *= s[:, None]
+            modal += u[:, :n]
+            modal *= s[:, None]  # s (s η + u): the acceleration of each modal coordinate
+            modal = modal.T
         else:
             steps = np.arange(n)[:, None]
             modal = s * s * (eta[None, :] * np.exp(s[None, :] * steps * dt))
@@ -205,7 +217,7 @@ def superpose_damped(modes: DampedModes, sampling_rate: float, n_samples: int, p
             modal[after] += s * s * jump * np.exp(np.outer(t[after] - t0, s))
             eta += jump * np.exp(s * (t_next - t0))
             next_kick += 1
-        out[start:stop] = np.real(modal @ read)
+        out[start:stop] = modal.real @ read.real - modal.imag @ read.imag
         if progress is not None:
             progress(stop, n_samples)
     return out
