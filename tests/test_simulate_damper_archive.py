@@ -274,13 +274,24 @@ def test_an_undamped_cable_beside_damped_ones_is_simulated_as_alone(damped_archi
             np.testing.assert_array_equal(one["acceleration"][()], two["acceleration"][()])
 
 
+def test_workers_share_the_records_and_give_the_same_archive(damped_archive, tmp_path):
+    """Each record has its own random stream and the cable's temperatures, tensions and coefficients are drawn
+    before any record: two workers write the fixture's archive byte for byte in its records and truth."""
+    out, truth = damped_archive
+    changes = [DamperChange(**{k: v for k, v in c.items() if v is not None}) for c in truth["damper_changes"]]
+    two = simulate_archive({"C1": ONE, "C2": ONE, "C3": TWO, "C4": BARE}, tmp_path / "b", options=SMALL,
+                           change=TensionChange(**truth["change"]), damper_changes=changes, seed=5, workers=2)
+    assert json.loads((two / "truth.json").read_text()) == truth
+    assert _records_hash(two, truth) == _records_hash(out, truth)
+
+
 # ---------------------------------------------------------------- the command line
 
 
 def test_simulate_archive_with_damper_changes_on_the_command_line(tmp_path, capsys):
     out = tmp_path / "arch"
     code = main(["simulate", str(ROOT / "campaigns" / "damped-stay"), "--out", str(out), "--archive", "0.021",
-                 "--interval", "900", "--cables", "2", "--duration", "10", "--sampling-rate", "5",
+                 "--interval", "900", "--cables", "2", "--duration", "10", "--sampling-rate", "5", "--workers", "2",
                  "--damper-change", "C1,loss,2026-03-01T00:10:00,0.5,0.01",
                  "--damper-change", "C2:D1,seizure,2026-03-01T00:10:00Z", "--damper-temperature-coefficient", "0.02"])
     assert code == 0, capsys.readouterr().err

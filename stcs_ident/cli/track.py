@@ -83,6 +83,8 @@ def add_archive_options(sim) -> None:
                           "cable and first test), with daily temperature cycles and record-to-record scatter")
     arc.add_argument("--cables", type=int, default=1, metavar="N", help="cables C1 … CN, all of the campaign (1)")
     arc.add_argument("--interval", type=float, default=600.0, metavar="S", help="seconds between records (600)")
+    arc.add_argument("--workers", type=worker_count, default=1, metavar="N",
+                     help="local processes simulating the records (default 1; the archive is the same whatever N)")
     arc.add_argument("--tension-change", metavar="CABLE,TIME,REL",
                      help="a lasting relative tension change of one cable from an ISO 8601 time on")
     arc.add_argument("--damper-change", action="append", metavar="CABLE[:DAMPER],KIND,TIME[,FRACTION[,DAYS]]",
@@ -146,7 +148,8 @@ def simulate_archive_from_args(args, campaign) -> int:
     if options.n_records * args.cables > 10**6:
         raise InputError(f"gives {options.n_records * args.cables} records; at most 1,000,000", field="--archive")
     out = simulate_archive(dict.fromkeys(names, campaign), args.out, options=options, change=change,
-                           damper_changes=damper_changes, seed=args.seed, progress=_every(500))
+                           damper_changes=damper_changes, seed=args.seed, workers=args.workers,
+                           progress=_every(500))
     print(f"wrote {out}")
     return 0
 

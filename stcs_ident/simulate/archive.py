@@ -111,7 +111,8 @@ class ArchiveOptions:
 
 def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, *,
                      options: ArchiveOptions | None = None, change: TensionChange | None = None,
-                     damper_changes: Sequence[DamperChange] = (), seed: int = 0, progress: Callable[[int, int], None] | None = None) -> Path:
+                     damper_changes: Sequence[DamperChange] = (), seed: int = 0, workers: int = 1,
+                     progress: Callable[[int, int], None] | None = None) -> Path:
     """Write an archive ``out/<cable>/{campaign.toml, records/<day>/<cable>_<time>.h5}`` and ``out/truth.json``.
 
     Parameters
@@ -125,7 +126,9 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
         Leaks, slow losses and seizures of the cables' dampers (each cable named must have a damper); they
         may come with ``change`` and with each other (on one damper, their factors multiply).
     seed : int
-        The same seed gives the same archive.
+        The same seed gives the same archive, whatever ``workers``.
+    workers : int
+        Local processes simulating the records (each record has its own random stream).
     progress : callable(done, total), optional
 
     Returns
@@ -144,60 +147,103 @@ def simulate_archive(campaigns: Mapping[str, Campaign], out: str | os.PathLike, 
     out = Path(out)
     start = datetime.fromisoformat(options.start)
     times = [start + timedelta(seconds=k * options.interval) for k in range(options.n_records)]
-    total, done = len(campaigns) * len(times), 0
     truth: dict = {"options": _asdict(options), "change": None if change is None else _asdict(change),
                    "damper_changes": [_asdict(c) for c in damper_changes], "cables": {}}
     with whole_directory(out) as tmp:
+        jobs = []
         for index, (name, campaign) in enumerate(campaigns.items()):
-            rng = np.random.default_rng([seed, index])
-            temperature = _temperatures(times, options, rng)
-            test = campaign.tests[0]
-            reference = float(test.tension)
-            cable_dir = tmp / name
-            (cable_dir / "records").mkdir(parents=True)
-            write_atomic(cable_dir / "campaign.toml", campaign_to_toml(campaign, header=f"cable {name} of a "
+            (tmp / name / "records").mkdir(parents=True)
+            write_atomic(tmp / name / "campaign.toml", campaign_to_toml(campaign, header=f"cable {name} of a "
                                                                                           "simulated archive"))
-            attachments = campaign.setup(test.setup).attachments
-            damped = any(isinstance(a, Damper) for a in attachments)
-            positions = [f * campaign.cable.length for f in options.sensors]
-            rows = []
-            for k, (time, theta) in enumerate(zip(times, temperature)):
-                tension = reference * (1 + options.thermal_coefficient * (theta - options.temperature_mean))
-                tension *= 1 + options.scatter * rng.standard_normal()
-                if change is not None and change.cable == name and time >= datetime.fromisoformat(change.time):
-                    tension *= 1 + change.change
-                row = {}
-                atts = attachments
-                if damped:  # the dashpots at this time and temperature; a cable without one is as it was
-                    coefficients = damper_coefficients(name, attachments, time, float(theta),
-                                                       temperature_coefficient=options.damper_temperature_coefficient,
-                                                       reference_temperature=options.temperature_mean,
-                                                       changes=damper_changes)
-                    atts = tuple(_with(a, coefficient=coefficients[a.name]) if isinstance(a, Damper) else a
-                                 for a in attachments)
-                record, record_truth = simulate_record_with_truth(
-                    campaign.cable, atts, tension, positions, duration=options.duration,
-                    sampling_rate=options.sampling_rate, damping=options.damping,
-                    ambient=Ambient(options.rms_pressure), snr_db=options.snr_db, seed=[seed, index, k])
-                if damped:
-                    row = {"coefficients": coefficients, "frequencies": record_truth.frequencies.tolist(),
-                           "damping": record_truth.damping.tolist()}
-                record = _with(record, start_time=time.isoformat(), temperature=round(float(theta), 3))
-                day = cable_dir / "records" / time.strftime("%Y-%m-%d")
-                day.mkdir(exist_ok=True)
-                relative = f"records/{day.name}/{name}_{time.strftime('%Y%m%dT%H%M%S')}.h5"
-                write_record(record, cable_dir / relative)
-                rows.append({"record": relative, "start_time": time.isoformat(), "tension": tension,
-                             "temperature": float(theta), **row})
-                done += 1
-                if progress is not None:
-                    progress(done, total)
-            truth["cables"][name] = {"reference_tension": reference, "records": rows}
-            if damped:
+            jobs += _plan(name, index, campaign, times, options, change, damper_changes, seed)
+            truth["cables"][name] = {"reference_tension": float(campaign.tests[0].tension), "records": []}
+            attachments = campaign.setup(campaign.tests[0].setup).attachments
+            if any(isinstance(a, Damper) for a in attachments):
                 truth["cables"][name]["reference_coefficients"] = {a.name: a.coefficient for a in attachments
                                                                    if isinstance(a, Damper)}
+        for done, (name, row) in enumerate(_map(_simulate_one, [(tmp, job) for job in jobs], workers), 1):
+            truth["cables"][name]["records"].append(row)
+            if progress is not None:
+                progress(done, len(jobs))
         write_atomic(tmp / "truth.json", json.dumps(truth, indent=1) + "\n")
     return out
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One record to simulate: its cable, true configuration and random stream."""
+
+    name: str
+    campaign: Campaign
+    attachments: tuple
+    time: datetime
+    temperature: float
+    tension: float
+    coefficients: dict | None  # the dampers' true coefficients; None: no damper
+    options: ArchiveOptions
+    seed: list
+
+
+def _plan(name, index, campaign, times, options, change, damper_changes, seed) -> list[_Job]:
+    """The cable's records in time order: temperature, tension and dampers drawn here, in this order, so
+    that the archive does not depend on how its records are shared among workers."""
+    rng = np.random.default_rng([seed, index])
+    temperature = _temperatures(times, options, rng)
+    reference = float(campaign.tests[0].tension)
+    attachments = campaign.setup(campaign.tests[0].setup).attachments
+    damped = any(isinstance(a, Damper) for a in attachments)
+    jobs = []
+    for k, (time, theta) in enumerate(zip(times, temperature)):
+        tension = reference * (1 + options.thermal_coefficient * (theta - options.temperature_mean))
+        tension *= 1 + options.scatter * rng.standard_normal()
+        if change is not None and change.cable == name and time >= datetime.fromisoformat(change.time):
+            tension *= 1 + change.change
+        atts, coefficients = attachments, None
+        if damped:  # the dashpots at this time and temperature; a cable without one is as it was
+            coefficients = damper_coefficients(name, attachments, time, float(theta),
+                                               temperature_coefficient=options.damper_temperature_coefficient,
+                                               reference_temperature=options.temperature_mean,
+                                               changes=damper_changes)
+            atts = tuple(_with(a, coefficient=coefficients[a.name]) if isinstance(a, Damper) else a
+                         for a in attachments)
+        jobs.append(_Job(name, campaign, tuple(atts), time, float(theta), tension, coefficients, options,
+                         [seed, index, k]))
+    return jobs
+
+
+def _simulate_one(task: tuple[Path, _Job]) -> tuple[str, dict]:
+    """Simulate and write one record; (cable, its row of truth.json)."""
+    root, job = task
+    options, cable = job.options, job.campaign.cable
+    positions = [f * cable.length for f in options.sensors]
+    record, record_truth = simulate_record_with_truth(
+        cable, job.attachments, job.tension, positions, duration=options.duration,
+        sampling_rate=options.sampling_rate, damping=options.damping, ambient=Ambient(options.rms_pressure),
+        snr_db=options.snr_db, seed=job.seed)
+    record = _with(record, start_time=job.time.isoformat(), temperature=round(job.temperature, 3))
+    relative = f"records/{job.time.strftime('%Y-%m-%d')}/{job.name}_{job.time.strftime('%Y%m%dT%H%M%S')}.h5"
+    (root / job.name / relative).parent.mkdir(exist_ok=True)
+    write_record(record, root / job.name / relative)
+    row = {"record": relative, "start_time": job.time.isoformat(), "tension": job.tension,
+           "temperature": job.temperature}
+    if job.coefficients is not None:
+        row |= {"coefficients": job.coefficients, "frequencies": record_truth.frequencies.tolist(),
+                "damping": record_truth.damping.tolist()}
+    return job.name, row
+
+
+def _map(fn, items: list, workers: int):
+    """``fn`` over ``items`` in order, on ``workers`` local processes when more than one is useful."""
+    workers = max(1, int(workers))
+    if workers == 1 or len(items) < 2:
+        yield from map(fn, items)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    with ProcessPoolExecutor(min(workers, len(items)), mp_context=context) as pool:
+        yield from pool.map(fn, items, chunksize=max(1, min(16, len(items) // (8 * workers))))
 
 
 def _temperatures(times: Sequence[datetime], options: ArchiveOptions, rng: np.random.Generator) -> np.ndarray:
