@@ -74,7 +74,7 @@ def make_archive(path: Path, n_records: int, cables: dict) -> float:
     per_cable = n_records // len(cables)
     options = ArchiveOptions(days=per_cable * 600.0 / 86400.0, interval=600.0, duration=600.0, sampling_rate=100.0)
     started = time.perf_counter()
-    simulate_archive(cables, path, options=options, seed=1)
+    simulate_archive(cables, path, options=options, seed=1, workers=2)
     return time.perf_counter() - started
 
 
@@ -186,6 +186,10 @@ def main(argv=None) -> int:
     parser.add_argument("--damped", action="store_true",
                         help="archives of three damped stays (campaigns/damped-stay, the coefficient following the "
                              "temperature) instead of the hanger and the stay")
+    parser.add_argument("--archive", type=Path, metavar="DIR",
+                        help="track this archive (written by `stcs-ident simulate --archive`) as the large one instead "
+                             "of simulating it (--records is then its number of records)")
+    parser.add_argument("--keep", type=Path, metavar="DIR", help="copy the large run's `track` output to DIR")
     parser.add_argument("--damper-false-alarms", action="store_true",
                         help="only the damper's history: false damper events and 30 %% losses (synthetic)")
     args = parser.parse_args(argv)
@@ -211,16 +215,24 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         cables = damped_campaigns() if args.damped else campaigns(root / "campaigns")
-        for name, n in (("small", args.scaling), ("large", args.records)):
+        large_archive = args.archive or root / "large"
+        if args.archive:
+            args.records = sum(1 for _ in args.archive.glob("*/records/*/*.h5"))
+            print(f"archive large: {args.records} records of {args.archive}", flush=True)
+        for name, n in (("small", args.scaling), ("large", args.records))[:1 if args.archive else 2]:
             seconds = make_archive(root / name, n, cables)
             print(f"archive {name}: {n} records ({len(cables)} cables, 3 channels, 600 s at 100 Hz) simulated in "
-                  f"{seconds:.0f} s", flush=True)
+                  f"{seconds:.0f} s on 2 workers", flush=True)
         one, mem_one, code_one = run_track(root / "small", root / "out1", 1)
         two, mem_two, code_two = run_track(root / "small", root / "out2", 2)
-        large, mem_large, code_large = run_track(root / "large", root / "out3", 2)
+        large, mem_large, code_large = run_track(large_archive, root / "out3", 2)
         import pandas as pd
 
         table = pd.read_parquet(root / "out3" / "records.parquet")
+        if args.keep:
+            import shutil
+
+            shutil.copytree(root / "out3", args.keep)
         ok = int((table["status"] == "ok").sum())
         per_cable = table.groupby("cable")["status"].apply(lambda s: (s == "ok").mean())
     print(f"\n{'run':<34}{'records':>9}{'wall s':>9}{'rec/s':>8}{'rec/s/core':>12}{'peak MB':>9}{'exit':>6}")
