@@ -119,6 +119,32 @@ def test_a_deleted_record_leaves_the_table(archive, tmp_path):
     assert result.counts == {**NOTHING, "removed": 2, "unchanged": 3} and set(result.table["cable"]) == {"C1"}
 
 
+def test_a_first_run_hashes_each_record_in_its_worker_and_a_copy_is_still_found(archive, tmp_path, monkeypatch):
+    """No current row can be of a new file's content unless one is of its size: the plan leaves such files to
+    the workers, which read them anyway; a file of a current row's size (a copy, say) is hashed by the plan
+    and its row reused, as before."""
+    from stcs_ident.track import archive as archive_module
+    from stcs_ident.track import state
+
+    planned = []
+    monkeypatch.setattr(state, "content_id", lambda path: planned.append(path) or archive_module.content_id(path))
+    out = tmp_path / "out"
+    table = track(archive, out, workers=2).table
+    assert planned == []
+    paths = {(r.cable, r.record): archive / r.cable / r.record for r in table.itertuples()}
+    assert [archive_module.content_id(paths[(r.cable, r.record)]) for r in table.itertuples()] == \
+        list(table["record_id"]) and len(table) == 6
+    copy, original = archive / "C1" / "records" / "copy-of-first.h5", records(archive, "C1")[0]
+    shutil.copy(original, copy)
+    result = track(archive, out)
+    assert planned == [copy]
+    assert result.counts == {**NOTHING, "new": 1, "unchanged": 6}
+    rows = result.table.set_index("record")
+    assert rows.loc["records/copy-of-first.h5", "record_id"] == \
+        rows.loc[original.relative_to(archive / "C1").as_posix(), "record_id"]
+    assert_same_table(result.table, _clean(archive, tmp_path))
+
+
 def test_the_same_record_in_two_cables_keeps_a_row_in_each(archive, tmp_path):
     out = tmp_path / "out"
     shutil.copy(records(archive, "C1")[0], archive / "C2" / "records" / "0-from-C1.h5")

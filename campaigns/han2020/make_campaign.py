@@ -21,12 +21,12 @@ DATA = HERE / "data"
 TARGET = HERE / "campaign.toml"
 
 try:
-    from stcs_ident.io.campaign import campaign_to_toml, load_campaign
     from stcs_ident.core.model import Attachment, Cable, Campaign, Published, Setup, Test
+    from stcs_ident.io.campaign import campaign_to_toml, load_campaign
 except ImportError:  # run from a checkout without the package installed
     sys.path.insert(0, str(HERE.parents[1]))
-    from stcs_ident.io.campaign import campaign_to_toml, load_campaign
     from stcs_ident.core.model import Attachment, Cable, Campaign, Published, Setup, Test
+    from stcs_ident.io.campaign import campaign_to_toml, load_campaign
 
 # Table 1 of the paper, SI units.
 LENGTH = 19.715  # m, free length between anchorages

@@ -61,7 +61,12 @@ def process_batch(spec: CableSpec, items: list[tuple[str, str, int, int]]) -> li
     """Rows of a batch of one cable's records: (path, record id or "", size, mtime_ns) each."""
     rows = []
     for path, record_id, size, mtime in items:
-        row = process_record(spec, path, record_id or content_id(path))
+        if not record_id:  # hashed here, in the worker, while the file is read for the record
+            try:
+                record_id = content_id(path)
+            except OSError:  # gone since the plan: the record's row says why it failed
+                record_id = ""
+        row = process_record(spec, path, record_id)
         row.update(version=spec.version, size=size, mtime_ns=mtime)
         rows.append(row)
     return rows

@@ -16,6 +16,12 @@ settings that shape a row and the toolkit's version) and its status is
 - **retried**: a row that failed is processed again on every run (what made
   it fail may be gone: a file being copied, a path a worker could not see).
 
+A new slot is hashed here only when the cable has a current row of a file of
+its size (it may be a copy); otherwise its worker hashes it while reading it
+for the record (``record_id`` "" in the plan), and the run's row at that
+path is the slot's. The first run over an archive so reads each file once,
+in the workers, not once serially here and again there.
+
 A row whose path is no longer in the archive is **removed** from the table
 (its record is gone; the rows are never marked and kept). The table is so a
 function of the archive and the campaigns: the same as a first run on the
@@ -38,7 +44,8 @@ COUNTS = ("new", "changed", "stale", "removed", "retried", "unchanged")
 
 @dataclass
 class CablePlan:
-    """One cable's slots now: ``slots`` {path: (record id, size, mtime_ns)}, the records to process
+    """One cable's slots now: ``slots`` {path: (record id or "" when its worker hashes it, size, mtime_ns)},
+    the records to process
     (``pending``: (absolute path, record id, size, mtime_ns)), the counts of :data:`COUNTS`, and whether
     its parts need rewriting (``dirty``: rows to drop, reuse or update)."""
 
@@ -56,11 +63,19 @@ def plan_cable(spec: CableSpec, known: pd.DataFrame) -> CablePlan:
     by_slot: dict[str, list] = {}
     for row in mine.itertuples(index=False):
         by_slot.setdefault(row.record, []).insert(0, row)  # latest first
-    reusable = {r.record_id for r in mine.itertuples(index=False) if r.version == spec.version and r.status == "ok"}
+    current = [r for r in mine.itertuples(index=False) if r.version == spec.version and r.status == "ok"]
+    reusable = {r.record_id for r in current}
+    sizes = {int(r.size) if pd.notna(r.size) else -1 for r in current}  # -1: a row of unknown size
     for path in record_paths(spec):
         st = path.stat()
         relative = path.relative_to(spec.directory).as_posix()
         rows = by_slot.get(relative, [])
+        if not rows and -1 not in sizes and st.st_size not in sizes:  # new; no current row can be its content
+            plan.slots[relative] = ("", int(st.st_size), int(st.st_mtime_ns))
+            plan.counts["new"] += 1
+            plan.dirty = True
+            plan.pending.append((str(path), "", int(st.st_size), int(st.st_mtime_ns)))
+            continue
         cached = next((r.record_id for r in rows if r.size == st.st_size and r.mtime_ns == st.st_mtime_ns), None)
         record_id = cached or content_id(path)
         plan.slots[relative] = (record_id, int(st.st_size), int(st.st_mtime_ns))
@@ -92,9 +107,13 @@ def current_rows(plan: CablePlan, known: pd.DataFrame) -> pd.DataFrame:
         latest[(record, record_id)] = label
     by_content = {record_id: label for label, record_id, status in zip(mine.index, mine["record_id"], mine["status"])
                   if status == "ok"}
+    at_path = dict(zip(mine["record"], mine.index))  # the latest row of this version at each path
     labels, slots = [], []
     for relative, (record_id, size, mtime) in plan.slots.items():
-        label = latest.get((relative, record_id), by_content.get(record_id))
+        if not record_id:  # hashed by its worker: a new slot, so its row at that path is this run's
+            label = at_path.get(relative)
+        else:
+            label = latest.get((relative, record_id), by_content.get(record_id))
         if label is not None:
             labels.append(label)
             slots.append((relative, size, mtime))
