@@ -187,3 +187,21 @@ def test_compiled_kernel_matches_numpy_path(monkeypatch):
     assert not roots.use_kernel()
     for (c, a, H), f in zip(configs, compiled):
         assert_rel(f, natural_frequencies(c, a, H, 10), rtol=1e-11)
+
+
+def test_a_trial_frequency_exactly_at_a_segment_s_pole_gives_a_finite_matrix():
+    """At this ω the antisymmetric factor n_anti of the han2020 cable's whole segment (its clamped mode 18) is
+    exactly 0.0 in double precision (the numpy path's root search met it and stopped with "not finite"). The
+    segment is evaluated a relative 1e-13 above: a finite matrix, the count of the side above, and the
+    matrix of the nudged ω."""
+    args = (19.715, 37168.5400798671, 1735352.4903969201, 16.6)
+    omega = 1021.0890452317815
+    with np.errstate(divide="ignore"):
+        raw = BeamSegment.__new__(BeamSegment)
+        raw._compute(*args, omega)
+    assert raw.n_anti == 0.0  # the case itself, or this test no longer tests it
+    segment = BeamSegment(*args, omega)
+    assert np.all(np.isfinite(segment.matrix()))
+    below, above = (BeamSegment(*args, omega * (1 + d)).clamped_count() for d in (-1e-9, 1e-9))
+    assert (below, above) == (17, 18) and segment.clamped_count() == above
+    np.testing.assert_array_equal(segment.matrix(), BeamSegment(*args, omega * (1 + 1e-13)).matrix())

@@ -21,6 +21,7 @@ import pytest
 from stcs_ident.cli.main import main
 from stcs_ident.core.errors import ModelError
 from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
+from stcs_ident.forward.roots import use_kernel
 from stcs_ident.simulate.archive import ArchiveOptions, DamperChange, TensionChange, simulate_archive
 from stcs_ident.simulate.damper_history import DAMPER_TEMPERATURE_COEFFICIENT, SEIZURE_FACTOR
 from stcs_ident.simulate.simulate import Ambient, simulate_record
@@ -252,6 +253,9 @@ def _records_hash(out: Path, truth: dict) -> str:
 def test_an_undamped_archive_is_bit_for_bit_the_one_before_dampers(tmp_path):
     """The hash of this archive's records and truth rows as written by the code before damped archives
     (commit 0b26c3b); a simulator change that alters undamped records on purpose must renew it."""
+    if not use_kernel():
+        pytest.skip("the hash was recorded with the compiled kernel; the numpy path's frequencies differ from its "
+                    "in their last bits")
     campaign = Campaign("hanger", HANGER, (Setup("s", (Attachment("W1", 7.0, mass=5.0),)),),
                         (Test("t", "s", TENSION),))
     options = ArchiveOptions(days=0.125, interval=3600.0, duration=20.0, sampling_rate=100.0)

@@ -299,9 +299,12 @@ def negative_pivots(K):
     if not np.all(np.isfinite(K)):
         raise ComputationError("the dynamic stiffness matrix is not finite (attachments nearly coincident, or an "
                                "extreme parameter value)")
+    if K.shape[-1] == 0:  # no free unknown (a pinned string without attachments): no pivot, det 1
+        return np.zeros(K.shape[0], dtype=np.int64), np.ones(K.shape[0])
     if K.shape[0] <= SMALL_BATCH:
         lam = np.linalg.eigvalsh(K)
-        return np.count_nonzero(lam < 0, axis=-1), np.prod(lam, axis=-1)
+        with np.errstate(over="ignore"):  # a determinant beyond 1e308 is inf: the root search then bisects
+            return np.count_nonzero(lam < 0, axis=-1), np.prod(lam, axis=-1)
     A = K.copy()
     n = A.shape[-1]
     negative = np.zeros(A.shape[0], dtype=np.int64)
@@ -311,7 +314,8 @@ def negative_pivots(K):
         d = A[:, k, k]
         d = np.where(d == 0, floor, d)
         negative += d < 0
-        det *= d
+        with np.errstate(over="ignore"):  # as above
+            det *= d
         if k + 1 < n:
             l = A[:, k + 1:, k] / d[:, None]
             A[:, k + 1:, k + 1:] -= l[:, :, None] * A[:, None, k, k + 1:]

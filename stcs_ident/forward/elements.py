@@ -75,6 +75,17 @@ class BeamSegment:
     """
 
     def __init__(self, length, EI, H, m, omega):
+        with np.errstate(divide="ignore"):  # a division by an exactly zero n_sym or n_anti is done again below
+            self._compute(length, EI, H, m, omega)
+        pole = (self.n_sym == 0) | (self.n_anti == 0)
+        if np.any(pole):
+            # ω exactly at a pole of a segment's stiffness (its clamped mode): the matrix would be infinite.
+            # Evaluated a relative 1e-13 above it instead, count and matrix alike (a pole is no root of the
+            # cable: the count on either side is right, the matrix finite).
+            omega = np.where(pole, np.broadcast_to(omega, pole.shape) * (1 + 1e-13), omega)
+            self._compute(length, EI, H, m, omega)
+
+    def _compute(self, length, EI, H, m, omega):
         self.EI = EI
         self.half = half = 0.5 * length
         p, q = wavenumbers(EI, H, m, omega)
