@@ -127,12 +127,12 @@ def test_a_support_in_both_planes_is_not_taken_for_a_one_plane_one():
 def test_picked_spectra_keep_their_planes_when_doubtful_modes_are_left_out():
     from types import SimpleNamespace
 
-    from stcs_ident.diagnose.api import _without_doubtful
+    from stcs_ident.identify.measurement import without_doubtful
 
     spectra = SimpleNamespace(modes=(1, 2, 1, 2), frequencies=(1.1, 2.2, 1.0, 2.2), uncertainty=(1e-3,) * 4,
                               doubtful=(False, True, False, False), planes=("in", "in", "out", "out"),
                               mode_planes=("in", "in", "out", "out"))
-    out, notes = _without_doubtful(campaign(), {"T1": spectra})
+    out, notes = without_doubtful(campaign(), {"T1": spectra})
     m = out["T1"]
     assert m.planes.tolist() == ["in", "out", "out"] and m.modes.tolist() == [1, 1, 2]
     assert "modes 2 left out" in str(notes[0])

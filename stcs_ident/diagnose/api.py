@@ -26,8 +26,9 @@ from ..core.notes import Note
 from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
+from ..identify.measurement import without_doubtful
 from ..identify.plausibility import check_plausibility as plausible
-from ..identify.problem import Measurement, gather_measurements, mode_label, picked_planes, reset_warm_starts
+from ..identify.problem import Measurement, gather_measurements, picked_planes, reset_warm_starts
 from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
@@ -115,8 +116,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     names = parse_effects(effects)
     settings = Settings(tension_model=tension_model, max_effects=max_effects, all_hypotheses=all_hypotheses)
     given = dict(picked or {})
-    picked, excluded = _without_doubtful(campaign, given)
-    measurements, skipped = gather_measurements(campaign, tests, picked)
+    picked, excluded = without_doubtful(campaign, given)
+    measurements, skipped = gather_measurements(campaign, tests, picked, excluded)
     measured_tests = [m.test for m in measurements]
     seen = [as_measured(m) for m in measurements]  # the tests with the modes (and planes) measured
     notes: list[Note] = list(excluded)
@@ -274,31 +275,6 @@ def _seeds(fits: dict, effects: tuple[str, ...]) -> list[dict]:
         for point in [fit.values(), *fit.minima]:
             seeds.append({**others, **point})
     return seeds
-
-
-def _without_doubtful(campaign: Campaign, picked: Mapping[str, object]) -> tuple[dict, list[Note]]:
-    """Picked spectra without the modes whose number is doubtful (a wrong number would pass for a
-    model error), and a note for each test that lost some."""
-    out, notes = {}, []
-    known = {t.name for t in campaign.tests}
-    for name, spectra in picked.items():
-        doubtful = np.asarray(getattr(spectra, "doubtful", ()), bool)
-        if name not in known or not doubtful.any() or doubtful.size != len(spectra.modes):
-            out[name] = spectra
-            continue
-        keep = ~doubtful
-        test = campaign.test(name)
-        if keep.any():
-            planes = picked_planes(spectra)
-            out[name] = Measurement(test, np.asarray(spectra.modes)[keep], np.asarray(spectra.frequencies)[keep],
-                                    np.asarray(spectra.uncertainty)[keep], "spectra",
-                                    planes=None if planes is None else np.asarray(planes)[keep])
-        labels = np.array([mode_label(int(k), str(p))[5:] for k, p in
-                           zip(spectra.modes, picked_planes(spectra) or ("in",) * len(spectra.modes))])
-        lost = ", ".join(labels[doubtful])
-        notes.append(Note.make("doubtful_modes", "{test}: modes {modes} left out (their numbers are doubtful)",
-                               test=name, modes=lost))
-    return out, notes
 
 
 def _fit_job(job) -> tuple[tuple[str, ...], HypothesisFit, float]:

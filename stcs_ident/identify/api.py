@@ -12,6 +12,7 @@ from ..core.model import Campaign
 from ..core.notes import Note
 from ..core.parameters import parse_parameters
 from ..core.settings import Settings
+from .measurement import without_doubtful
 from .nuisance import nuisance_parameters
 from .problem import Problem, gather_measurements, reset_warm_starts
 from .result import IdentificationResult
@@ -48,6 +49,9 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     picked : mapping, optional
         {test: spectra or :class:`~stcs_ident.identify.problem.Measurement`}
         replacing a test's table (its uncertainties become the weights).
+        Modes of spectra (given or computed from a test's record) whose
+        number is doubtful are left out, with a ``doubtful_modes`` note; a
+        test with none sure is skipped, or refused when named in ``tests``.
     bounds : mapping, optional
         {parameter: (lower, upper)} in variable units; they win over the
         campaign's ``[bounds]``, which win over the kinds' defaults.
@@ -102,7 +106,8 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     """
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
-    measurements, skipped = gather_measurements(campaign, tests, picked)
+    picked, doubt = without_doubtful(campaign, picked)
+    measurements, skipped = gather_measurements(campaign, tests, picked, doubt)
     held = None
     if params is None:
         params, held = default_params(measurements)
@@ -131,6 +136,8 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         result = replace(result, skipped=tuple(skipped), notes=result.notes + (note,))
     if held is not None:
         result = replace(result, notes=result.notes + (held,))
+    if doubt:
+        result = replace(result, notes=result.notes + tuple(doubt))
     if result.failure is not None:
         raise BoundError(str(result.failure), result)
     return result

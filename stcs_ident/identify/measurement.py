@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.errors import InputError
 from ..core.model import Campaign, Test
+from ..core.notes import Note
 from ..core.planes import PLANE_NAMES, PLANES
 
 
@@ -178,15 +179,56 @@ def picked_planes(picked) -> tuple[str, ...] | None:
     return None
 
 
+def without_doubtful(campaign: Campaign, picked: Mapping[str, object] | None) -> tuple[dict, list[Note]]:
+    """Picked spectra without the modes whose number the numbering calls doubtful, and a note per test that lost
+    some.
+
+    A doubtful number is one that another family of modes, at another tension, gives the peaks almost as well
+    (:mod:`~stcs_ident.spectra.numbering`): fitted, a wrong one passes for a tension tens of percent off with a
+    small σ, or for a model error. A test keeps its sure modes (with their planes and damping ratios); one with
+    none left maps to None, which :func:`gather_measurements` skips, or refuses when the test was named.
+    """
+    out, notes = {}, []
+    known = {t.name for t in campaign.tests}
+    for name, spectra in (picked or {}).items():
+        flags = getattr(spectra, "doubtful", None)
+        doubtful = np.asarray(() if flags is None else flags, bool)
+        if name not in known or not doubtful.any() or doubtful.size != len(spectra.modes):
+            out[name] = spectra
+            continue
+        keep = ~doubtful
+        planes = picked_planes(spectra) or ("in",) * len(spectra.modes)
+        labels = np.array([mode_label(int(k), str(p))[5:] for k, p in zip(spectra.modes, planes)])
+        if keep.any():
+            zeta, zeta_unc = getattr(spectra, "damping", None), getattr(spectra, "damping_uncertainty", None)
+            if zeta is None or zeta_unc is None:
+                zeta = zeta_unc = None
+            out[name] = Measurement(
+                campaign.test(name), np.asarray(spectra.modes)[keep], np.asarray(spectra.frequencies)[keep],
+                np.asarray(spectra.uncertainty)[keep], "spectra",
+                None if zeta is None else np.asarray(zeta, float)[keep],
+                None if zeta is None else np.asarray(zeta_unc, float)[keep], planes=np.asarray(planes)[keep])
+            notes.append(Note.make("doubtful_modes", "{test}: modes {modes} left out (their numbers are doubtful)",
+                                   test=name, modes=", ".join(labels[doubtful])))
+        else:
+            out[name] = None
+            notes.append(Note.make("doubtful_modes", "{test}: every mode left out (modes {modes}: their numbers "
+                                   "are doubtful)", test=name, modes=", ".join(labels)))
+    return out, notes
+
+
 def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
-                        picked: Mapping[str, object] | None = None) -> tuple[list[Measurement], list[tuple[str, str]]]:
+                        picked: Mapping[str, object] | None = None,
+                        notes: list[Note] | None = None) -> tuple[list[Measurement], list[tuple[str, str]]]:
     """The measurements of the selected tests, and the tests skipped with why.
 
     A test is measured by ``picked[name]`` when given (spectra or a
     :class:`Measurement`), else by its table of frequencies, else by the
-    spectra of its record (computed here). A test with none of these is
-    skipped when all tests are used, and is an error when it was selected
-    by name.
+    spectra of its record (computed here). A test with none of these, or
+    whose ``picked[name]`` is None (every number doubtful:
+    :func:`without_doubtful`), is skipped when all tests are used, and is
+    an error when it was selected by name. The spectra computed here lose
+    their doubtful modes too, with a note appended to ``notes`` (when given).
 
     Raises
     ------
@@ -202,14 +244,23 @@ def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
     selected = [campaign.test(n) for n in tests] if tests else list(campaign.tests)
     out, skipped = [], []
     for test in selected:
-        if test.name in picked:
+        if test.name not in picked and test.frequencies is None and test.record is not None:
+            from ..spectra.pipeline import analyse_test  # lazily: reads the record
+
+            sure, lost = without_doubtful(campaign, {test.name: analyse_test(campaign, test)})
+            picked.update(sure)
+            if notes is not None:
+                notes.extend(lost)
+        if test.name in picked and picked[test.name] is None:  # every number doubtful (:func:`without_doubtful`)
+            if tests:
+                raise InputError("the mode number of every peak picked from it is doubtful (another family of "
+                                 "modes, at another tension, fits them almost as well): nothing sure to identify "
+                                 "from", field=f"test[{test.name}].record")
+            skipped.append((test.name, "every picked mode's number is doubtful"))
+        elif test.name in picked:
             out.append(as_measurement(test, picked[test.name]))
         elif test.frequencies is not None:
             out.append(table_measurement(test))
-        elif test.record is not None:
-            from ..spectra.pipeline import analyse_test  # lazily: reads the record
-
-            out.append(as_measurement(test, analyse_test(campaign, test)))
         elif tests:
             raise InputError("has neither measured frequencies nor a record: nothing to identify from",
                              field=f"test[{test.name}].frequencies")

@@ -6,8 +6,13 @@ at the reference tension (:func:`~stcs_ident.spectra.pipeline.analyse_record`):
 numbers come from the model's family of modes, not from the order of the
 peaks, so a mode missing from one record does not renumber the others; each
 mode is of one plane (``planes``: ``"in"`` or ``"out"``, from the channels'
-directions), numbered within it. The tension is then fitted alone (EI and everything else held at the campaign's
-values) by weighted least squares on the picked frequencies
+directions), numbered within it. A mode whose number the numbering calls
+doubtful (another family of modes, at another tension, fits the peaks
+almost as well: a short record with one or a few peaks) is kept in the row
+and flagged (``doubtful``), but left out of the fits; a record whose every
+number is doubtful gives no tension (status ``failed``, the reason says
+so) rather than one of several, each with a small σ. The tension is then fitted alone (EI and everything else
+held at the campaign's values) by weighted least squares on the picked frequencies
 (:func:`~stcs_ident.identify.identify`, each mode against its plane's
 model), its 1σ from the fit.
 
@@ -54,7 +59,7 @@ __all__ = ["COLUMNS", "process_record"]
 MAX_MODES = 15
 
 COLUMNS = ("cable", "record", "record_id", "start_time", "temperature", "status", "reason", "n_modes", "modes",
-           "planes", "frequencies", "frequency_sigma", "tension", "tension_sigma", "damping", "damping_sigma",
+           "planes", "frequencies", "frequency_sigma", "doubtful", "tension", "tension_sigma", "damping", "damping_sigma",
            "coefficient", "coefficient_sigma", "coefficient_reason")
 #: The columns added with the damper's history: a part written before them reads with these defaults
 #: (:mod:`.store`).
@@ -67,7 +72,7 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     relative = Path(path).relative_to(spec.directory).as_posix()
     row = {"cable": spec.name, "record": relative, "record_id": record_id, "start_time": None,
            "temperature": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
-           "planes": [], "frequencies": [], "frequency_sigma": [], "tension": math.nan, "tension_sigma": math.nan,
+           "planes": [], "frequencies": [], "frequency_sigma": [], "doubtful": [], "tension": math.nan, "tension_sigma": math.nan,
            "damping": [], "damping_sigma": [], "coefficient": math.nan, "coefficient_sigma": math.nan,
            "coefficient_reason": ""}
     try:
@@ -89,8 +94,10 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
                    planes=[str(p) for p in spectra.mode_planes],
                    frequencies=[float(f) for f in spectra.frequencies],
                    frequency_sigma=[float(s) for s in spectra.uncertainty],
+                   doubtful=_flags(getattr(spectra, "doubtful", None), len(spectra.modes)),
                    damping=_floats(getattr(spectra, "damping", None), len(spectra.modes)),
                    damping_sigma=_floats(getattr(spectra, "damping_uncertainty", None), len(spectra.modes)))
+        _some_sure(row)
         # Per record: the plausibility check is off (a cable that lost half its tension is a finding to report,
         # not a unit slip to refuse), and the tolerances of EI and the length stay out of the record's σ: they
         # shift every record of the cable alike, a common bias that is no change (docs/track.md).
@@ -110,6 +117,21 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     except Exception as err:  # noqa: BLE001 (one record never stops an archive: its row says what happened)
         row["reason"] = one_line(f"{type(err).__name__}: {err}")
     return row
+
+
+def _some_sure(row: dict) -> None:
+    """Refuse a record whose every mode number the numbering calls doubtful (another family of modes, at another
+    tension, fits the peaks almost as well): its tension would be one of several, each stated with a small σ.
+    With some sure, :func:`~stcs_ident.identify.identify` leaves the doubtful ones out of its fit itself."""
+    if row["doubtful"] and all(row["doubtful"]):
+        peaks = ", ".join(f"{f:.3f}" for f in row["frequencies"])
+        raise ComputationError(f"the mode number of every peak ({peaks} Hz) is doubtful: another family of modes "
+                               "fits almost as well, at another tension")
+
+
+def _flags(values, n: int) -> list[bool]:
+    """``values`` (or False each when there are none) as a list of ``n`` booleans."""
+    return [False] * n if values is None else [bool(v) for v in values]
 
 
 def _floats(values, n: int) -> list[float]:

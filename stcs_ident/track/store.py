@@ -99,6 +99,8 @@ def read_parts(out: str | os.PathLike) -> tuple[pd.DataFrame, list[Path], list[P
             frame = frame.assign(planes=[["in"] * len(m) for m in frame["modes"]])
         if "modes" in frame:  # a part written before the damper's columns: no damping ratio, no coefficient
             frame = _with_damper_columns(frame)
+        if "doubtful" not in frame and "modes" in frame:  # before the flags: a row of another version, redone
+            frame = frame.assign(doubtful=[[False] * len(m) for m in frame["modes"]])
         missing = [c for c in ROW_COLUMNS if c not in frame]
         cables = set(frame["cable"].map(cable_key)) if "cable" in frame else set()
         if missing or cables - {PART.match(path.name)["cable"]}:
