@@ -86,6 +86,28 @@ def test_spectra_without_nominal_frequencies_draw_no_markers():
     assert plot_test_spectra(spectra)["nominal"] is None
 
 
+def test_a_record_picked_per_plane_draws_each_plane_with_its_own_modes_and_nominal_model():
+    spectra = _spectra()
+    out = SimpleNamespace(frequency_axis=spectra.peaks.frequency_axis, combined_spectrum=spectra.peaks.combined_spectrum,
+                          channel_spectra=spectra.peaks.channel_spectra[:, :1], channel_names=["B1"], kind="ambient")
+    spectra.modes, spectra.frequencies = (1, 2, 3, 1, 2), np.array([7.1, 14.3, 21.6, 7.3, 14.6])
+    spectra.doubtful, spectra.mode_planes = (False, False, False, False, True), ("in",) * 3 + ("out",) * 2
+    spectra.unassigned, spectra.unassigned_planes = ((30.0, 0.01),), ("out",)
+    spectra.plane_peaks = (("in", spectra.peaks), ("out", out))
+    spectra.plane_nominal = (("in", np.array([7.0, 14.1])), ("out", np.array([7.2, 14.4, 21.7])))
+    drawn = plot_test_spectra(spectra)
+    axes = drawn["axes"]
+    assert drawn["planes"] == ["in", "out"] and len(axes) == 4
+    by_axes = [[t.get_text() for t in drawn["labels"] if t.axes is ax] for ax in axes]
+    assert by_axes == [["1", "2", "3"], [], ["1", "2?"], []]
+    assert "in-plane: 3 modes" in axes[0].get_title() and "out-of-plane: 2 modes" in axes[2].get_title()
+    nominal = [line for line in axes[2].get_lines() if line.get_marker() == "v"]
+    np.testing.assert_array_equal(nominal[0].get_xdata(), [7.2, 14.4, 21.7])  # the out-of-plane model's
+    dotted = [line for ax in (axes[0], axes[2]) for line in ax.get_lines() if line.get_linestyle() == ":"]
+    assert [line.axes for line in dotted] == [axes[2]]  # the unassigned peak on its own plane's panel
+    assert [t.get_text() for t in axes[3].get_legend().get_texts()] == ["B1"]
+
+
 def test_track_modes_past_ten_keep_distinct_colour_and_marker():
     n, modes = 24, tuple(range(1, 15))
     t = pd.date_range("2026-03-01", periods=n, freq="h", tz="UTC")

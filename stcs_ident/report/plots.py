@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.files import write_figure
+from ..core.planes import PLANE_NAMES
 
 
 class Drawn(dict):
@@ -49,7 +50,9 @@ def plot_test_spectra(spectra, fig=None) -> Drawn:
     its noise floor, averaged over the channels (1 where there is only
     noise), on which peaks are picked. A blue triangle at its top marks each
     frequency of the nominal model the peaks were numbered against, so that
-    how far the cable is from its model shows at a glance.
+    how far the cable is from its model shows at a glance. A record picked
+    per plane (channel directions) gets the pair of panels per plane, each
+    with its own channels, modes, unnumbered peaks and nominal model.
 
     Parameters
     ----------
@@ -58,47 +61,71 @@ def plot_test_spectra(spectra, fig=None) -> Drawn:
 
     Returns
     -------
-    dict with the figure, both axes, the spectrum lines, the peak labels
-    (``labels``: list of matplotlib Text, one per picked peak) and the
-    nominal model's markers (``nominal``: Line2D, or None without them).
+    dict with the figure, the axes (combined and channels of the first plane, then of the next), the first
+    plane's spectrum lines, the peak labels (``labels``: list of matplotlib Text, one per picked peak, every
+    plane's), the first plane's nominal model's markers (``nominal``: Line2D, or None without them) and the
+    planes drawn (``planes``: None for a record without directions).
     """
-    fig = fig or new_figure(figsize=(10, 6.5), layout="constrained")
-    ax_c, ax_ch = fig.subplots(2, 1, sharex=True)
-    result = spectra.peaks
+    planes = list(getattr(spectra, "plane_peaks", ()) or ())
+    if len(planes) < 2:
+        planes = [(None, spectra.peaks)]
+    fig = fig or new_figure(figsize=(10, 6.5 if len(planes) == 1 else 11.0), layout="constrained")
+    axes = fig.subplots(2 * len(planes), 1, sharex=True, height_ratios=[3, 2] * len(planes))
+    mode_planes = getattr(spectra, "mode_planes", None) or ("in",) * len(spectra.modes)
+    unassigned_planes = getattr(spectra, "unassigned_planes", None) or ("in",) * len(spectra.unassigned)
+    nominal_by_plane = dict(getattr(spectra, "plane_nominal", ()) or ())
+    drawn = {"labels": [], "planes": None if planes[0][0] is None else [p for p, _ in planes]}
+    for n, (plane, result) in enumerate(planes):
+        ax_c, ax_ch = axes[2 * n], axes[2 * n + 1]
+        mine = [i for i, q in enumerate(mode_planes) if plane is None or q == plane]
+        nominal_f = nominal_by_plane.get(plane, getattr(spectra, "nominal_frequencies", None) if n == 0 else None)
+        combined, channel_lines, nominal = _spectra_pair(ax_c, ax_ch, spectra, result, mine, drawn["labels"],
+                                                          [f for (f, _), q in zip(spectra.unassigned, unassigned_planes)
+                                                           if plane is None or q == plane], nominal_f)
+        what = "" if plane is None else f"{PLANE_NAMES[plane]}: "
+        ax_c.set_title(f"{spectra.name}: {what}{len(mine)} modes picked ({result.kind}); "
+                       "red = mode number, orange ? = doubtful, dotted = unassigned"
+                       + ("; green dashed = structural" if getattr(spectra, "structural", ()) else "")
+                       + ("; blue ▼ = nominal model" if nominal is not None else ""), fontsize=9)
+        if n == 0:
+            drawn.update(combined=combined, channels=channel_lines, nominal=nominal)
+    axes[-1].set_xlabel("frequency (Hz)")
+    return Drawn({"figure": fig, "axes": tuple(axes), **drawn})
+
+
+def _spectra_pair(ax_c, ax_ch, spectra, result, mine, labels, unassigned, nominal_f):
+    """One plane's combined spectrum (its modes labelled) over its channels' PSDs: (combined line, channel lines,
+    nominal markers or None)."""
     f = result.frequency_axis
     combined = ax_c.semilogy(f, result.combined_spectrum, color="k", lw=0.8, label="combined spectrum")[0]
-    channel_lines = []
-    names = [n for n in result.channel_names] if hasattr(result, "channel_names") else None
-    for i in range(result.channel_spectra.shape[1]):
-        label = names[i] if names else f"channel {i + 1}"
-        channel_lines.append(ax_ch.semilogy(f, result.channel_spectra[:, i], lw=0.7, label=label)[0])
-    labels = []
-    top = np.interp(spectra.frequencies, f, result.combined_spectrum) if len(f) else []
-    for k, fk, yk, doubt in zip(spectra.modes, spectra.frequencies, top, spectra.doubtful):
+    names = list(result.channel_names) if hasattr(result, "channel_names") else None
+    channel_lines = [ax_ch.semilogy(f, result.channel_spectra[:, i], lw=0.7,
+                                    label=names[i] if names else f"channel {i + 1}")[0]
+                     for i in range(result.channel_spectra.shape[1])]
+    freqs = np.asarray(spectra.frequencies, float)[mine]
+    top = np.interp(freqs, f, result.combined_spectrum) if len(f) else []
+    for i, fk, yk in zip(mine, freqs, top):
+        doubt = spectra.doubtful[i]
         ax_c.axvline(fk, color="tab:red", lw=0.5, alpha=0.5)
-        text = f"{k}?" if doubt else f"{k}"
-        labels.append(ax_c.annotate(text, (fk, yk), xytext=(0, 6), textcoords="offset points", ha="center",
-                                    fontsize=8, color="tab:red" if not doubt else "tab:orange"))
-    for fu, _ in spectra.unassigned:
+        labels.append(ax_c.annotate(f"{spectra.modes[i]}?" if doubt else f"{spectra.modes[i]}", (fk, yk),
+                                    xytext=(0, 6), textcoords="offset points", ha="center", fontsize=8,
+                                    color="tab:orange" if doubt else "tab:red"))
+    for fu in unassigned:
         ax_c.axvline(fu, color="0.6", lw=0.5, ls=":")
+    for fs, _, _ in getattr(spectra, "structural", ()) or ():  # the deck's or a pylon's: never numbered
+        ax_c.axvline(fs, color="tab:green", lw=0.8, ls="--")
     if len(top):
         low, high = ax_c.get_ylim()
         ax_c.set_ylim(low, max(high, 3.0 * float(np.max(top))))  # headroom for the labels on a log axis
-    nominal = _nominal_markers(ax_c, spectra, f)
+    nominal = _nominal_markers(ax_c, nominal_f, f)
     ax_c.set_ylabel("combined spectrum\n(PSD / noise floor, channel mean)")
-    ax_c.set_title(f"{spectra.name}: {len(spectra.modes)} modes picked ({result.kind}); "
-                   "red = mode number, orange ? = doubtful, dotted = unassigned"
-                   + ("; blue ▼ = nominal model" if nominal is not None else ""), fontsize=9)
     ax_ch.set_ylabel("channel PSD (m/s²)²/Hz")
-    ax_ch.set_xlabel("frequency (Hz)")
     ax_ch.legend(fontsize=7, ncols=4, loc="upper right")
-    return Drawn({"figure": fig, "axes": (ax_c, ax_ch), "combined": combined, "channels": channel_lines, "labels": labels,
-            "nominal": nominal})
+    return combined, channel_lines, nominal
 
 
-def _nominal_markers(ax, spectra, f):
+def _nominal_markers(ax, nominal, f):
     """Triangles at the top of ``ax`` at the nominal model's frequencies inside the plotted band (or None)."""
-    nominal = getattr(spectra, "nominal_frequencies", None)
     if nominal is None or not len(f):
         return None
     shown = np.asarray(nominal, float)

@@ -70,6 +70,8 @@ class TestSpectra(PickingResult):
         modes moving the anchorage, their harmonics): never numbered
     unassigned_planes : the plane of each of ``unassigned`` (None: all in-plane)
     plane_peaks : (plane, PeakResult) per plane, for a record with channel directions (``peaks`` is the first)
+    plane_nominal : (plane, nominal frequencies) per plane, as ``plane_peaks`` (``nominal_frequencies`` is the
+        first's)
     plane_options : the options of the planes and of the structural peaks used
     plane_notes : what the analysis has to say (:attr:`notes`)
     """
@@ -98,6 +100,7 @@ class TestSpectra(PickingResult):
     structural: tuple[tuple[float, float, str], ...] = ()
     unassigned_planes: tuple[str, ...] | None = None
     plane_peaks: tuple[tuple[str, PeakResult], ...] = ()
+    plane_nominal: tuple[tuple[str, np.ndarray], ...] = ()
     plane_options: PlaneOptions = field(default_factory=PlaneOptions)
     plane_notes: tuple[Note, ...] = ()
 
@@ -311,6 +314,7 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
                          for plane, k, reason in outcome.structural),
         unassigned_planes=tuple(plane for plane, _ in outcome.unassigned),
         plane_peaks=tuple(peaks.items()), plane_options=plane_options, plane_notes=notes,
+        plane_nominal=tuple((plane, np.asarray(outcome.nominal[plane], float)) for plane in peaks),
     )
 
 
