@@ -94,8 +94,7 @@ def test_a_missing_damper_is_named_sized_and_placed(bench_records, bench):
 
 @pytest.mark.slow
 def test_a_healthy_damped_hanger_has_no_cause(bench_records):
-    cause = _cause(_diagnose(bench_records, "hanger", _campaign("hanger", with_damper=True), None, seed=3,
-                             ))
+    cause = _cause(_diagnose(bench_records, "hanger", _campaign("hanger", with_damper=True), None, seed=3))
     assert cause["effects"] == [], cause["statement"]
 
 
