@@ -92,6 +92,23 @@ def test_a_day_of_records_is_not_enough_history_not_a_change():
     assert analyse_history(tension[:20], air[:20], REFERENCE).state == NOT_ENOUGH_HISTORY
 
 
+def test_a_history_shorter_than_a_day_is_not_normalised_by_a_part_of_a_cycle():
+    """Temperature terms fitted on two hours of a falling temperature take the records' drift for a thermal
+    effect: the temperature terms wait for a whole training window, and until then the normalised tension is the
+    identified one (before: b = −0.075 %/°C fitted here on a tension that does not follow the temperature)."""
+    rng = np.random.default_rng(11)
+    hours = np.arange(12) / 6.0
+    air = 10.5 - 1.15 * hours  # °C, the morning of the damped stay's figure: one way only
+    tension = REFERENCE * (1 + 0.002 * hours / 2 + 5e-4 * rng.standard_normal(12))  # a slow drift, no thermal term
+    history = analyse_history(tension, air, REFERENCE, times=hours * 3600.0)
+    assert history.state == NOT_ENOUGH_HISTORY and history.thermal_coefficient == 0.0
+    np.testing.assert_allclose(history.normalised, tension, rtol=1e-12)
+    # a whole day of the same records' kind: the thermal coefficient is fitted again
+    day, day_air, times = _history(np.random.default_rng(12), days=1, interval=600.0, swing=5e-3, scatter=3e-4,
+                                   lag=0.0)
+    assert analyse_history(day, day_air, REFERENCE, times=times).thermal_coefficient != 0.0
+
+
 def test_healthy_one_day_histories_of_ten_minute_records_report_nothing_even_without_times():
     """The issue's case: a day of 10-minute records, the call without times (TRAINING records, a day of them).
     Before, 18 of these 100 histories reported a lasting change (b fitted on half the day)."""
