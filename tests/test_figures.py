@@ -114,7 +114,8 @@ def test_track_modes_past_ten_keep_distinct_colour_and_marker():
     table = pd.DataFrame({"start_time": t, "tension": 1.3e6, "tension_sigma": 2e3, "level": 1.3e6,
                           "temperature": 12.0, "modes": [modes] * n,
                           "frequencies": [tuple(3.1 * k for k in modes)] * n})
-    history = SimpleNamespace(normalised=table["tension"].to_numpy(), mean_temperature=12.0, events=[])
+    history = SimpleNamespace(normalised=table["tension"].to_numpy(), mean_temperature=12.0, events=[],
+                              thermal_coefficient=-5e-4, thermal_lag=0.0)
     spec = SimpleNamespace(name="C1", reference_tension=1.3e6, campaign=SimpleNamespace(cable=SimpleNamespace(EI=5e5)))
     drawn = plot_cable_history(spec, table, table.index, history)
     styles = [(line.get_color(), line.get_marker()) for line in drawn["modes"].values()]

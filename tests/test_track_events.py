@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from stcs_ident.core.errors import InputError
+from stcs_ident.report.track import _normalised_label
 from stcs_ident.track.events import MONITORING, NOT_ENOUGH_HISTORY, analyse_history
 
 STEP = -0.015
@@ -106,7 +107,11 @@ def test_a_history_shorter_than_a_day_is_not_normalised_by_a_part_of_a_cycle():
     # a whole day of the same records' kind: the thermal coefficient is fitted again
     day, day_air, times = _history(np.random.default_rng(12), days=1, interval=600.0, swing=5e-3, scatter=3e-4,
                                    lag=0.0)
-    assert analyse_history(day, day_air, REFERENCE, times=times).thermal_coefficient != 0.0
+    whole = analyse_history(day, day_air, REFERENCE, times=times)
+    assert whole.thermal_coefficient != 0.0
+    # the figure's legend says which (report.track)
+    assert _normalised_label(history) == "not normalised yet (less than a day)"
+    assert _normalised_label(whole) == f"normalised to {whole.mean_temperature:.1f} °C"
 
 
 def test_healthy_one_day_histories_of_ten_minute_records_report_nothing_even_without_times():

@@ -112,8 +112,7 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, dampe
     top.fill_between(t, tension - sigma, tension + sigma, color="tab:blue", alpha=0.25, lw=0, label="1σ")
     top.plot(t, tension, ".", ms=2.5, color="tab:blue", label="identified")
     top.plot(t, history.normalised * kN, ".", ms=2.5, color="tab:orange",
-             label=f"normalised to {history.mean_temperature:.1f} °C" if np.isfinite(history.mean_temperature)
-             else "no temperature: not normalised")
+             label=_normalised_label(history))
     top.plot(t, data["level"].to_numpy() * kN, "-", color="k", lw=1, label="level between changes")
     for e in history.events:
         top.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
@@ -164,8 +163,7 @@ def _damper_panel(ax, spec, table: pd.DataFrame, rows, history) -> None:
     ax.errorbar(t, data["coefficient"] * k, yerr=data["coefficient_sigma"] * k, fmt=".", ms=3, lw=0.4,
                 color="tab:blue", alpha=0.35, label="fitted, 1σ")
     ax.plot(t, history.normalised * k, ".", ms=2.5, color="tab:purple",
-            label=f"normalised to {history.mean_temperature:.1f} °C" if np.isfinite(history.mean_temperature)
-            else "no temperature: not normalised")
+            label=_normalised_label(history))
     ax.plot(t, data["coefficient_level"] * k, "-", color="k", lw=1, label="level between changes")
     for e in history.events:
         ax.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
@@ -237,3 +235,13 @@ def _damper_markdown(dampers: dict) -> list[str]:
         lines += [f"| {name} | {e['start_time']} | {100 * e['change']:+.1f} % | {100 * e['uncertainty']:.1f} % | "
                   f"{e['alarm_time']} |" for name, e in found]
     return lines
+
+
+def _normalised_label(history) -> str:
+    """The legend of a history's normalised values: to which temperature, or why not (none recorded, or a history
+    shorter than its training window, whose temperature terms wait for a whole day: :mod:`..track.events`)."""
+    if not np.isfinite(history.mean_temperature):
+        return "no temperature: not normalised"
+    if history.thermal_coefficient == 0.0 and history.thermal_lag == 0.0:
+        return "not normalised yet (less than a day)"
+    return f"normalised to {history.mean_temperature:.1f} °C"
