@@ -339,3 +339,43 @@ def _half_power_edge(side: np.ndarray, half: float, height: float) -> int:
     if above.size:
         return int(np.argmin(side[1:stop])) + 1 if stop > 1 else 1
     return side.size - 1
+
+
+#: A detected peak within this share of the local spacing of the expected modes stands for the expected mode.
+EXPECTED_MATCH = 0.3
+#: An expected mode with no detected peak is proposed at the overview's highest bin within this share of the
+#: local spacing of it.
+EXPECTED_REACH = 0.25
+
+
+def expected_proposals(overview: Overview, threshold: np.ndarray, expected: np.ndarray, detected: list[Candidate],
+                       f_min: float, f_max: float) -> list[Candidate]:
+    """Proposals where a model expects a mode and no peak was detected (``find_peaks(expected=...)``).
+
+    On a short record the overview is coarse and noisy, and most of a long cable's modes stay below the
+    detection threshold (a 60-s record of a 120 m stay: 4 of its 19 modes). A detected mode's fit band (eight
+    half-power widths, ±1.7 Hz for ζ 1 % at 10 Hz) then holds the undetected modes beside it, and the one pole
+    fitted there lands between them with a 1σ that knows nothing of them (10.411 ± 0.035 Hz for modes at 9.600
+    and 10.566 Hz). A proposal at each expected mode gives every fit its neighbours as poles and the band its
+    limit between them; like the coarser overviews' proposals, each is reported only if its own fit confirms a
+    mode. Without a detected peak nothing is proposed: the record shows no cable to fit.
+    """
+    e = np.sort(np.asarray(expected, dtype=float))
+    if not detected or e.size == 0:
+        return []
+    f = overview.frequency
+    ratio = overview.combined / overview.combined_floor
+    gaps = np.diff(e)
+    spacing = np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf)) if e.size > 1 else e.copy()
+    out: list[Candidate] = []
+    for fe, gap in zip(e, spacing):
+        if not (f_min <= fe <= f_max) or any(abs(c.frequency - fe) < EXPECTED_MATCH * gap for c in detected):
+            continue
+        near = np.flatnonzero(np.abs(f - fe) <= EXPECTED_REACH * gap)
+        near = near[(near >= 1) & (near <= f.size - 2)]
+        if near.size == 0:
+            continue
+        k = int(near[np.argmax(ratio[near])])
+        out.append(replace(peak_candidate(overview, ratio, k, float(threshold[k]), float(overview.combined_dof[k])),
+                           proposal=True))
+    return out

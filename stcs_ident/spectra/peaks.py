@@ -109,7 +109,7 @@ from ..core.errors import InputError
 from ..core.record import Record, check_finite
 from .ambient_fit import AmbientFit, fit_ambient
 from .decay_fit import DecayFit, event_spectra, fit_decay
-from .detection import Candidate, detect_multiresolution
+from .detection import Candidate, detect_multiresolution, expected_proposals
 from .events import Event, detect_events, whole_record_event
 from .options import DecayCheckOptions, PickingOptions
 from .overview import Overview, ambient_overview, decay_overviews
@@ -135,6 +135,7 @@ def find_peaks(
     min_snr_db: float | None = None,
     overwrite: bool = False,
     options: PickingOptions | None = None,
+    expected=None,
 ) -> PeakResult:
     """Modal frequencies present in a record, with 1σ uncertainty, damping and the channels that saw them.
 
@@ -161,6 +162,14 @@ def find_peaks(
     options : PickingOptions, optional
         The tuning of every step (default: the calibrated values); recorded
         in the result.
+    expected : sequence of float, optional
+        Frequencies (Hz) where a model expects modes (the cable's nominal
+        family). On an ambient record, an expected mode with no detected peak
+        near it is proposed where the overview is highest around it, and
+        reported only if its fit confirms a mode
+        (:func:`.detection.expected_proposals`): on a short record most modes
+        are below the detection threshold, and a detected mode's fit band
+        would otherwise hold them unmodelled.
 
     Returns
     -------
@@ -190,6 +199,9 @@ def find_peaks(
     overview = overviews[0]
     candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db, options=options.detection,
                                                    floor_options=options.floor)
+    if expected is not None and not events:
+        candidates = sorted(candidates + expected_proposals(overview, threshold, _expected(expected), candidates,
+                                                            f_lo, f_hi), key=lambda c: c.frequency)
     refine = _refine_decays if events else _refine_ambient
     peaks = refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi), options)
     peaks = deduplicate(peaks, options.filters)
@@ -233,6 +245,13 @@ def _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db) -> tuple
     if min_snr_db is not None and not np.isfinite(min_snr_db):
         raise InputError(f"must be finite, got {min_snr_db!r}", field="min_snr_db")
     return f_lo, f_hi
+
+
+def _expected(expected) -> np.ndarray:
+    e = np.asarray(expected, dtype=float).ravel()
+    if not np.all(np.isfinite(e) & (e > 0)):
+        raise InputError(f"must be positive finite frequencies, got {expected!r}", field="expected")
+    return e
 
 
 def _refine_decays(x, fs, events, overview: Overview, candidates, names, band, options: PickingOptions) -> list[Peak]:

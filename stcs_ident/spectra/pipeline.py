@@ -239,7 +239,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                                  options=options, plane_options=plane_options, nominal_in=nominal)
         return _plane_spectra(test, record, path, outcome, options, plane_options)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
-    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True,  # the record is ours
+    result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True, expected=nominal,  # ours
                         options=options)
     freqs = np.array([p.frequency for p in result.peaks])
     unc = np.array([p.uncertainty for p in result.peaks])

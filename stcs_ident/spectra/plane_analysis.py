@@ -93,8 +93,8 @@ def analyse_planes(record: Record, cable, attachments, tension: float, *, max_mo
         if axial:
             axial_share[plane] = _axial_share(sub.acceleration, len(chans), fs, options)
             sub = plane_record(record, chans)
-        peaks[plane] = find_peaks(sub, *bands[plane], overwrite=True,
-                                  options=options)  # the plane's record is a copy, ours
+        peaks[plane] = find_peaks(sub, *bands[plane], overwrite=True, options=options,
+                                  expected=nominal[plane])  # the plane's record is a copy, ours
     out = PlanesOutcome(channels, peaks, {}, nominal)
     kept = {plane: set(range(len(result.peaks))) for plane, result in peaks.items()}
     structural: dict[tuple[str, int], str] = {}
