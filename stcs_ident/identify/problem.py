@@ -332,8 +332,7 @@ _SOLVED = BoundedCache(MAX_SOLVED)
 
 def _point(key, tension: np.ndarray, overrides: dict) -> tuple:
     """The key of one parameter point of a model: its tension and every override's value, exactly."""
-    values = tuple((name, np.asarray(v, float).tobytes() if not isinstance(v, dict) else repr(sorted(v.items())))
-                   for name, v in sorted(overrides.items()))
+    values = tuple((name, np.asarray(v, float).tobytes()) for name, v in sorted(overrides.items()))
     return key, np.asarray(tension, float).tobytes(), values
 
 

@@ -186,6 +186,7 @@ def find_peaks(
     elif not isinstance(options, PickingOptions):
         raise InputError(f"must be a PickingOptions, got {options!r}", field="options")
     f_lo, f_hi = _check_arguments(record, f_min, f_max, kind, max_peaks, min_snr_db)
+    expected = None if expected is None else _expected(expected)
     x = record.acceleration
     if overwrite and x.flags.writeable:
         x -= x.mean(axis=0)
@@ -200,8 +201,8 @@ def find_peaks(
     candidates, threshold = detect_multiresolution(overviews, f_lo, f_hi, min_snr_db, options=options.detection,
                                                    floor_options=options.floor)
     if expected is not None and not events:
-        candidates = sorted(candidates + expected_proposals(overview, threshold, _expected(expected), candidates,
-                                                            f_lo, f_hi), key=lambda c: c.frequency)
+        candidates = sorted(candidates + expected_proposals(overview, threshold, expected, candidates, f_lo, f_hi),
+                            key=lambda c: c.frequency)
     refine = _refine_decays if events else _refine_ambient
     peaks = refine(x, fs, events, overview, candidates, record.channel_names, (f_lo, f_hi), options)
     peaks = deduplicate(peaks, options.filters)
