@@ -327,7 +327,7 @@ BAD = {
     "position at end B": (edited("position = 10.0", "position = 20.0"), f"{W1}.position"),
     "position zero": (edited("position = 10.0", "position = 0.0"), f"{W1}.position"),
     "inclination 95": (edited("EI = 1.0e5", "EI = 1.0e5\ninclination = 95"), "cable.inclination"),
-    "inclination -90": (edited("EI = 1.0e5", "EI = 1.0e5\ninclination = -90.0"), "cable.inclination"),
+    "inclination -90.5": (edited("EI = 1.0e5", "EI = 1.0e5\ninclination = -90.5"), "cable.inclination"),
     "negative gravity": (edited("EI = 1.0e5", "EI = 1.0e5\ngravity = -9.81"), "cable.gravity"),
     # inconsistent
     "two attachments at one position": (

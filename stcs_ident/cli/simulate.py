@@ -57,7 +57,8 @@ def add_parser(sub) -> None:
                      help="every sensor's true axis turned by DEG from its stated direction (planes mix)")
     brg.add_argument("--deck-modes", metavar="F:A[:END],...",
                      help="deck modes moving an anchorage: frequency F Hz, rms acceleration A m/s2, end A or B "
-                          "(default B), vertical (in-plane and axial by the cable's inclination)")
+                          "(default B), vertical (in-plane and axial by the cable's inclination; a vertical cable's "
+                          "all axial)")
     brg.add_argument("--traffic", metavar="RATE[:B]",
                      help="vehicles per hour crossing: bursts that triple the deck motion, with broadband "
                           "anchorage motion of rms B m/s2 (default 0)")
@@ -149,13 +150,11 @@ def _directions(args) -> list | None:
 
 def _bridge(args, campaign):
     """``--misalignment``, ``--deck-modes`` and ``--traffic`` as BridgeConditions, or None."""
-    import math
-
     from ..core.errors import ModelError
     from ..simulate import BridgeConditions, StructuralMode, Traffic
 
-    theta = campaign.cable.inclination
-    vertical = (math.cos(theta), 0.0, math.sin(theta))  # a deck's vertical motion in the cable's frame
+    # a deck's vertical motion in the cable's frame (a vertical hanger's: all axial, exactly)
+    vertical = (campaign.cable.chord_cosine, 0.0, campaign.cable.chord_sine)
 
     def deck_mode(text):
         parts = text.split(":")

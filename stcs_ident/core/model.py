@@ -53,7 +53,8 @@ class Cable:
     EA : float or None
         Axial stiffness, N; ``None`` ignores sag-extensibility.
     inclination : float
-        Chord angle from horizontal, radians, |θ| < π/2.
+        Chord angle from horizontal, radians, |θ| <= π/2 (±π/2: a vertical cable, a hanger, without sag:
+        :attr:`chord_cosine` is then exactly 0).
     gravity : float
         m/s^2.
     boundary_a, boundary_b : Boundary
@@ -76,8 +77,9 @@ class Cable:
         if self.EA is not None:
             set_(self, "EA", in_band(self.EA, "cable.EA", "EA"))
         theta = finite_number(self.inclination, "cable.inclination")
-        if abs(theta) >= math.pi / 2:
-            raise ModelError("must satisfy |inclination| < 90 degrees", field="cable.inclination")
+        if abs(theta) > math.pi / 2:
+            raise ModelError(f"must satisfy |inclination| <= 90 degrees, got {math.degrees(theta):g}",
+                             field="cable.inclination")
         set_(self, "inclination", theta)
         set_(self, "gravity", in_band(self.gravity, "cable.gravity", "gravity", zero=True))
         for name in ("boundary_a", "boundary_b"):
@@ -85,9 +87,41 @@ class Cable:
                 raise ModelError("must be a Boundary", field=f"cable.{name}")
 
     @property
+    def chord_cosine(self) -> float:
+        """cos θ, exactly 0 for a vertical cable: the one place the inclination's cosine is taken (cos(π/2) is
+        6e-17 in floating point, which would give a vertical hanger a sag of 1e-17 of a horizontal one's and an
+        in-plane share of a deck's vertical motion). Snapped below :data:`VERTICAL_COSINE`."""
+        return chord_components(self.inclination)[0]
+
+    @property
+    def chord_sine(self) -> float:
+        """sin θ, exactly ±1 for a vertical cable (:attr:`chord_cosine`)."""
+        return chord_components(self.inclination)[1]
+
+    @property
+    def vertical(self) -> bool:
+        """Whether the chord is vertical (|θ| = 90°, to :data:`VERTICAL_COSINE`): no sag, no sag-extensibility,
+        the in-plane and out-of-plane families equal (bar the attachments' springs and dampers per plane)."""
+        return self.chord_cosine == 0.0
+
+    @property
     def weight_per_length(self) -> float:
-        """w = m g cos θ, the weight per unit length normal to the chord (N/m)."""
-        return self.mass_per_length * self.gravity * math.cos(self.inclination)
+        """w = m g cos θ, the weight per unit length normal to the chord (N/m); 0 for a vertical cable."""
+        return self.mass_per_length * self.gravity * self.chord_cosine
+
+
+#: |cos θ| below this is a vertical chord (cos θ = 0, sin θ = ±1 exactly). cos(π/2) = 6.1e-17; the nearest
+#: inclination a campaign can mean that is not vertical, 89.9999 degrees, has cos θ = 1.7e-6.
+VERTICAL_COSINE = 1e-12
+
+
+def chord_components(inclination: float) -> tuple[float, float]:
+    """(cos θ, sin θ) of a chord at ``inclination`` θ (radians), with a vertical chord exact: (0, ±1) when
+    |cos θ| < :data:`VERTICAL_COSINE`. Everything that projects onto the chord or normal to it takes these."""
+    c, s = math.cos(inclination), math.sin(inclination)
+    if abs(c) < VERTICAL_COSINE:
+        return 0.0, math.copysign(1.0, s)
+    return c, s
 
 
 def _check_point(obj, kind: str) -> str:

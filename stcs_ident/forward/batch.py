@@ -86,8 +86,11 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
         order = np.argsort(flat["positions"], axis=1)
         for k in per_att:
             flat[k] = np.take_along_axis(flat[k], order, axis=1)
-    theta, g = cable.inclination, cable.gravity
-    model = tension_model if cable.EA is not None else "none"
+    gcos = cable.gravity * cable.chord_cosine  # 0 for a vertical cable: no sag, no kinks
+    # No weight normal to the chord (a vertical cable, or no gravity): no sag, so no sag-extensibility
+    # (λ² = 0); the additional tension is coupled to nothing and is left out, as without EA (the in-plane
+    # family is then the out-of-plane one, exactly, bar the attachments' springs and dampers per plane).
+    model = tension_model if cable.EA is not None and gcos != 0 else "none"
     ends = (arrays["end_a"], arrays["end_b"], arrays["EI"])
     if not n:
         kinds = []
@@ -113,7 +116,7 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
             length=part["length"], mass_per_length=m, EI=part["EI"],
             tension=part["tension"],
             EA=_filled(count, cable.EA if cable.EA is not None else np.inf),
-            weight=m * g * math.cos(theta), gcos=_filled(count, g * math.cos(theta)),
+            weight=m * gcos, gcos=_filled(count, gcos),
             positions=part["positions"], masses=part["masses"], springs=part["stiffnesses"],
             end_a=part["end_a"], end_b=part["end_b"], dashpots=part["coefficients"],
         )

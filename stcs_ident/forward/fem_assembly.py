@@ -270,7 +270,7 @@ def _static_slopes(cable: Cable, atts: np.ndarray, tension: float) -> np.ndarray
     """
     length, w = cable.length, cable.weight_per_length
     xs = atts[:, 0]
-    loads = atts[:, 1] * cable.gravity * math.cos(cable.inclination)
+    loads = atts[:, 1] * cable.gravity * cable.chord_cosine
     breaks = np.concatenate(([0.0], xs, [length]))
     slope_a = (w * length / 2 + np.sum(loads * (length - xs)) / length) / tension
     start = slope_a - (w * breaks[:-1] + np.concatenate(([0.0], np.cumsum(loads)))) / tension
@@ -299,5 +299,5 @@ def _sag_vector(
     """
     g = np.zeros(dofs.n + 1)  # slot -1 collects the fixed dofs' entries
     np.add.at(g, dofs.element.ravel(), (cable.weight_per_length / tension * _element_load(h)).ravel())
-    g[dofs.disp[att_nodes]] += atts[:, 1] * cable.gravity * math.cos(cable.inclination) / tension
+    g[dofs.disp[att_nodes]] += atts[:, 1] * cable.gravity * cable.chord_cosine / tension
     return g[:-1]

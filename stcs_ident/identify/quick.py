@@ -251,7 +251,7 @@ def _check(length, mass, frequencies, modes, EI, EA, inclination, boundary, unce
     EI = None if EI is None else in_band(EI, "EI", "EI", zero=True)
     EA = None if EA is None else in_band(EA, "EA", "EA")
     inclination = finite_number(inclination, "inclination")
-    if abs(inclination) >= 90:
+    if abs(inclination) > 90:
         raise InputError(f"must be between -90 and 90 degrees, got {inclination:g}", field="inclination")
     if boundary not in BOUNDARIES:
         raise InputError(f"must be one of {', '.join(BOUNDARIES)}, got {boundary!r}", field="boundary")

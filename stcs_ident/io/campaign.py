@@ -196,11 +196,11 @@ def _parse_cable(table: dict[str, Any]) -> Cable:
 
 
 def _inclination(value: Any) -> float:
-    """Check the chord angle in degrees, |value| < 90."""
+    """Check the chord angle in degrees, |value| <= 90 (±90: a vertical cable, a hanger)."""
     degrees = _number(value, "cable.inclination")
-    if not abs(degrees) < 90:
+    if not abs(degrees) <= 90:
         raise CampaignError(
-            f"must satisfy |inclination| < 90 degrees, got {value!r}", field="cable.inclination"
+            f"must satisfy |inclination| <= 90 degrees, got {value!r}", field="cable.inclination"
         )
     return degrees
 
