@@ -28,6 +28,7 @@ from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
 from ..identify.measurement import without_doubtful
 from ..identify.plausibility import check_plausibility as plausible
+from ..identify.plausibility import check_records
 from ..identify.problem import Measurement, gather_measurements, picked_planes, reset_warm_starts
 from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
@@ -116,6 +117,8 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     names = parse_effects(effects)
     settings = Settings(tension_model=tension_model, max_effects=max_effects, all_hypotheses=all_hypotheses)
     given = dict(picked or {})
+    if check_plausibility:  # the records' own scale first: a slip bends the numbering to the wrong nominal
+        check_records(campaign, given, settings.tension_model)
     picked, excluded = without_doubtful(campaign, given)
     measurements, skipped = gather_measurements(campaign, tests, picked, excluded)
     measured_tests = [m.test for m in measurements]

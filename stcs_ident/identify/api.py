@@ -106,6 +106,10 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     """
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
+    if check_plausibility:  # the records' own scale first: a slip bends the numbering to the wrong nominal
+        from .plausibility import check_records
+
+        check_records(campaign, picked, tension_model)
     picked, doubt = without_doubtful(campaign, picked)
     measurements, skipped = gather_measurements(campaign, tests, picked, doubt)
     held = None

@@ -15,6 +15,12 @@ within the band). A user who means it passes
 
 :func:`implausible` gives the same findings without refusing (``forward``
 prints them as a warning line).
+
+On the record path the measured modes are numbered against the nominal
+family, which a slip has already bent: :func:`check_records` judges each
+record instead by its peaks' own harmonic series
+(:mod:`stcs_ident.spectra.scale_check`), before the numbers are used, and
+names a sampling rate typed a round factor off as well as the unit slips.
 """
 
 from __future__ import annotations
@@ -28,13 +34,14 @@ import numpy as np
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..forward import batch_frequencies
+from ..spectra.scale_check import SCALE_BAND, round_factor
 from .problem import Measurement
 
 #: Largest plausible ratio (either way) of the nominal to the measured frequency of the lowest measured mode.
 #: A correct campaign's stated tension is within tens of per cent of the truth, and f ∝ √T gives a ratio
 #: within 1.3 for a true tension 0.6–1.7 × the stated one (more than a hidden mass or an end restraint
 #: moves the lowest mode); a unit slip is a factor √1000 ≈ 31.6 or more.
-BAND = 1.3
+BAND = SCALE_BAND
 #: Tension factor (true / stated) of a unit slip in a test's ``tension`` (N): the hint it gives.
 TENSION_SLIPS = {1e3: "kN", 1e6: "MN", 9.80665e3: "tonnes-force", 9.80665: "kgf", 1e-3: "mN, or N where kN was meant"}
 #: Mass factor (true / stated) of a unit slip in ``cable.mass_per_length`` (kg/m): the hint it gives.
@@ -190,3 +197,72 @@ def check_plausibility(campaign: Campaign, measurements: Sequence[Measurement], 
     if found is not None:
         field, message = found
         raise InputError(f"{message} (if you mean it: --no-plausibility-check)", field=field)
+
+
+def record_findings(campaign: Campaign, picked) -> list[tuple[Finding, Measurement, object]]:
+    """Per picked test whose peaks' own series is implausibly far from the nominal family (the spectra's
+    ``implausible_scale``): the finding, the peaks as the series numbers them, and the check."""
+    out = []
+    names = {t.name for t in campaign.tests}
+    for name, spectra in (picked or {}).items():
+        bad = getattr(spectra, "implausible_scale", ())
+        if name not in names or not bad:
+            continue
+        check = max(bad, key=lambda c: abs(math.log(c.ratio)))
+        numbered = check.series.modes > 0
+        order = np.argsort(check.series.modes[numbered])
+        modes = check.series.modes[numbered][order]
+        freqs = np.asarray(check.frequencies, float)[numbered][order]
+        test = campaign.test(name)
+        m = Measurement(test, modes, freqs, np.maximum(1e-3 * freqs, 1e-12), "spectra",
+                        planes=np.full(modes.size, check.plane))
+        out.append((Finding(name, check.mode, check.nominal, check.measured, float(test.tension)), m, check))
+    return out
+
+
+def check_records(campaign: Campaign, picked, tension_model: str = "uniform") -> None:
+    """Refuse a campaign whose records' peaks form a series implausibly far from the nominal model (module
+    docstring): the field and the likely slip (a tension or mass unit, a sampling rate a round factor off).
+
+    Raises
+    ------
+    InputError
+        Naming the field (``test[<name>].tension``, ``cable.mass_per_length``, or the sampling rate: the
+        test's ``record_format.sampling_rate`` where the campaign gives it, else the record file's) and the
+        likely slip; the message ends with the override.
+    """
+    found = record_findings(campaign, picked)
+    if not found:
+        return
+    findings = [f for f, _, _ in found]
+    measurements = [m for _, m, _ in found]
+    first, _, check = max(found, key=lambda item: abs(math.log(item[2].ratio)))
+    spectra = picked[first.test]
+    tension_slips, mass_slips = likely_slips(campaign, measurements, findings, tension_model)
+    n_records = sum(1 for name in picked if name in {t.name for t in campaign.tests})
+    if len(findings) < n_records:
+        mass_slips = []  # a mass slip moves every record
+    guesses = [f"tension in {w}?" for w in tension_slips] + [f"cable.mass_per_length in {w}?" for w in mass_slips]
+    field, file = (f"test[{first.test}].tension" if tension_slips or not mass_slips else "cable.mass_per_length",
+                   None)
+    factor = round_factor(check.ratio)
+    if factor is not None:
+        given = next((g for option, g, _ in getattr(spectra, "record_replaced", ()) if option == "sampling_rate"),
+                     None)
+        rate = dict(campaign.record_reading(campaign.test(first.test))[1]).get("sampling_rate")
+        word = f"{factor:g}× too high" if factor > 1 else f"{1 / factor:g}× too low"
+        where = (f"test[{first.test}].record_format.sampling_rate ({rate:g} Hz)" if rate is not None else
+                 "the record's sampling rate")
+        guesses.insert(0, f"{where} {word}?")
+        if not tension_slips and not mass_slips:
+            field = (f"test[{first.test}].record_format.sampling_rate" if rate is not None or given is not None
+                     else "sampling_rate")
+            file = None if rate is not None else getattr(spectra, "record", None)
+    if not guesses:
+        guesses.append("check the units and values of the tension, cable.mass_per_length, cable.length and "
+                       "cable.EI, and the record's sampling rate")
+    scope = f"{len(findings)} of {n_records} records are off; " if n_records > 1 else ""
+    message = (f"the nominal model is implausibly far from the record ({scope}test {first.test}: "
+               f"{check.sentence()}, outside ×/÷ {BAND:g}) — {' or '.join(guesses)} "
+               "(if you mean it: --no-plausibility-check)")
+    raise InputError(message, field=field, file=file)

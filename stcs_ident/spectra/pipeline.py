@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from ..core.errors import InputError
+from ..core.errors import InputError, NumberingWarning
 from ..core.model import Campaign, Test
 from ..core.notes import Note
 from ..core.planes import NO_DIRECTIONS_NOTE, PLANE_NAMES, directions_note
@@ -30,6 +31,7 @@ from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes
 from .plane_options import PlaneOptions
+from .scale_check import ScaleCheck, check_scale, round_factor
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -74,6 +76,8 @@ class TestSpectra(PickingResult):
         first's)
     plane_options : the options of the planes and of the structural peaks used
     plane_notes : what the analysis has to say (:attr:`notes`)
+    scale : per plane, the peaks numbered from their own spacing against the nominal family
+        (:class:`.scale_check.ScaleCheck`); where one is implausible every number is doubtful
     """
 
     __test__ = False
@@ -103,6 +107,7 @@ class TestSpectra(PickingResult):
     plane_nominal: tuple[tuple[str, np.ndarray], ...] = ()
     plane_options: PlaneOptions = field(default_factory=PlaneOptions)
     plane_notes: tuple[Note, ...] = ()
+    scale: tuple[ScaleCheck, ...] = ()
 
     main_table = "modes"
 
@@ -172,7 +177,14 @@ class TestSpectra(PickingResult):
             "shape": [dict(s) for s in self.shapes] if self.shapes is not None else [{} for _ in self.modes],
             "structural": [{"frequency": f, "uncertainty": u, "reason": r} for f, u, r in self.structural],
             "plane_options": self.plane_options.summary(), "notes": [str(n) for n in self.notes],
+            "scale_check": [c.summary() for c in self.scale],
         }
+
+    @property
+    def implausible_scale(self) -> tuple[ScaleCheck, ...]:
+        """The planes whose peaks' own series is implausibly far from the nominal family (a unit or
+        sampling-rate slip: :mod:`.scale_check`)."""
+        return tuple(c for c in self.scale if c.implausible)
 
 
 def _ranges(modes) -> str:
@@ -237,7 +249,8 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     if record.channel_directions is not None:
         outcome = analyse_planes(record, cable, atts, test.tension, max_modes=max_modes, tension_model=tension_model,
                                  options=options, plane_options=plane_options, nominal_in=nominal)
-        return _plane_spectra(test, record, path, outcome, options, plane_options)
+        return _plane_spectra(test, record, path, outcome, options, plane_options, cable, atts, test.tension,
+                              tension_model)
     f_max = min(usable * record.sampling_rate, 1.3 * nominal[-1])
     result = find_peaks(record, f_min=0.5 * nominal[0], f_max=f_max, overwrite=True, expected=nominal,  # ours
                         options=options)
@@ -249,7 +262,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     peaks = result.peaks
     macs, shapes = _operating_shapes(record, [peaks[i] for i in order], [int(numbering.modes[i]) for i in order],
                                      numbering, cable, atts, test.tension, tension_model)
-    return TestSpectra(
+    spectra = TestSpectra(
         name=test.name, record=path,
         modes=tuple(int(numbering.modes[i]) for i in order),
         frequencies=freqs[order], uncertainty=unc[order],
@@ -264,6 +277,31 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
         plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),),
     )
+    check = check_scale("in", freqs, unc, _nominal_family(cable, atts, test.tension, tension_model, "in"))
+    return _with_scale(spectra, () if check is None else (check,))
+
+
+def _nominal_family(cable, atts, tension, tension_model: str, plane: str):
+    """``n -> the first n nominal frequencies`` of ``plane`` (Hz)."""
+    return lambda n: natural_frequencies(cable, atts, tension, max(int(n), 1), tension_model=tension_model,
+                                         plane=plane)
+
+
+def _with_scale(spectra: TestSpectra, checks: tuple[ScaleCheck, ...]) -> TestSpectra:
+    """``spectra`` with its scale checks; where one is implausible, every number doubtful, a warning and a note
+    (the peaks' own spacing says the nominal model is on another scale: :mod:`.scale_check`)."""
+    spectra = replace(spectra, scale=checks)
+    bad = spectra.implausible_scale
+    if not bad:
+        return spectra
+    text = "; ".join(c.sentence() for c in bad)
+    factor = next((round_factor(c.ratio) for c in bad if round_factor(c.ratio) is not None), None)
+    cause = (f"the sampling rate {factor:g}× off, or units?" if factor is not None else
+             "the units of the tension or the mass per length?")
+    message = f"{spectra.name}: {text}: {cause} every mode number is doubtful"
+    warnings.warn(message, NumberingWarning, stacklevel=3)
+    return replace(spectra, doubtful=(True,) * len(spectra.modes),
+                   plane_notes=spectra.plane_notes + (Note.plain("scale", message),))
 
 
 def _operating_shapes(record: Record, peaks, modes, numbering: Numbering, cable, atts, tension, tension_model):
@@ -283,7 +321,7 @@ def _operating_shapes(record: Record, peaks, modes, numbering: Numbering, cable,
 
 
 def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome, options: PickingOptions,
-                   plane_options: PlaneOptions) -> TestSpectra:
+                   plane_options: PlaneOptions, cable, atts, tension: float, tension_model: str) -> TestSpectra:
     """The TestSpectra of a record analysed per plane."""
     peaks = outcome.peaks
     chosen = [peaks[m.plane].peaks[m.index] for m in outcome.modes]
@@ -297,7 +335,7 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
     notes += tuple(Note.plain("misfit", f"{PLANE_NAMES[m.plane]} mode {m.mode}: 1σ widened by its own half-power "
                                         "half-width, its fit misfits its band (a resonance merged with it?)")
                    for m in outcome.modes if m.misfit)
-    return TestSpectra(
+    spectra = TestSpectra(
         name=test.name, record=path, modes=tuple(m.mode for m in outcome.modes),
         frequencies=np.array([p.frequency for p in chosen], float),
         uncertainty=np.array([m.uncertainty for m in outcome.modes], float),
@@ -316,6 +354,20 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
         plane_peaks=tuple(peaks.items()), plane_options=plane_options, plane_notes=notes,
         plane_nominal=tuple((plane, np.asarray(outcome.nominal[plane], float)) for plane in peaks),
     )
+    return _with_scale(spectra, _plane_scale(outcome, cable, atts, tension, tension_model))
+
+
+def _plane_scale(outcome: PlanesOutcome, cable, atts, tension: float, tension_model: str) -> tuple[ScaleCheck, ...]:
+    """Each plane's scale check on its peaks, the structural ones and the leaks left out."""
+    out = []
+    for plane, result in outcome.peaks.items():
+        aside = {k for p, k, _ in (*outcome.structural, *outcome.leaks) if p == plane}
+        kept = [p for k, p in enumerate(result.peaks) if k not in aside]
+        check = check_scale(plane, [p.frequency for p in kept], [p.uncertainty for p in kept],
+                            _nominal_family(cable, atts, tension, tension_model, plane))
+        if check is not None:
+            out.append(check)
+    return tuple(out)
 
 
 def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, progress=None,

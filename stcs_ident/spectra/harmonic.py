@@ -1,0 +1,229 @@
+"""The harmonic series of a set of peaks, found from the peaks alone: no nominal tension needed.
+
+A cable's modes form a series f_n = n f₀ √(1 + B n²): a taut string (B = 0)
+stretched by its bending stiffness (B = π² EI / (T L²) for pinned ends, the
+tensioned-beam closed form of docs/model.md; clamped ends and sag move the
+lowest modes by a few per cent, which the tolerance below absorbs). Given
+only the peak frequencies, :func:`harmonic_series` finds the series (f₀, B)
+and the mode number of each peak: the order-preserving assignment of least
+cost (the numbering's dynamic programme, :func:`.numbering.assign`), with a
+cost per family mode skipped inside the assigned span so that a sub-harmonic
+series (f₀/2 numbering every peak with an even number) never ties with the
+true one. Candidates start from each of the lowest peaks taken as mode
+1, 2, … and are refined by weighted least squares of (f/n)² = f₀² + f₀² B n²
+(linear in f₀² and f₀² B).
+
+Uses: the plausibility of a campaign on the record path (is the nominal model's
+scale that of the peaks? a unit or sampling-rate slip shows as a ratio far from
+1, before the nominal numbering bends the numbers to it), and the quick tension
+from one record (``tension --record``), which numbers the peaks this way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .numbering import assign
+
+__all__ = ["HarmonicSeries", "harmonic_series"]
+
+#: Relative misfit allowed per mode (clamped ends and sag move the lowest modes of a stay by up to a few per cent
+#: from the pinned beam-string form; attachments move single modes by as much).
+TOLERANCE = 0.02
+#: ... and at most this share of the series' spacing f₀ (a tolerance of 2 % at mode 30 would be 60 % of the spacing,
+#: and a sub-harmonic series would absorb any stray peak).
+SPACING_SHARE = 0.1
+#: Cost of a peak left out of the series (a squared standardised residual: beyond 3σ).
+UNASSIGNED_COST = 9.0
+#: Cost of a mode of the series skipped between the lowest and the highest assigned mode (a sub-harmonic series,
+#: f₀/2 numbering every peak 2n, skips one mode per peak: it must cost more than the true series, even where
+#: two stray peaks happen to fall on its odd modes).
+SKIP_COST = 2.0
+#: Another series whose fundamental differs by more than this (relative) and whose cost is within
+#: :data:`AMBIGUITY` of the best makes the series ambiguous.
+DISTINCT = 0.05
+AMBIGUITY = 2.0
+#: Highest mode number considered (a lowest peak above mode 150 of a cable is not a cable's series).
+MAX_MODE = 150
+#: Largest B considered: ξ = √(T L² / EI) ≥ 2 (the stiffest members a tension is measured on).
+MAX_INHARMONICITY = math.pi**2 / 4
+
+
+@dataclass(frozen=True)
+class HarmonicSeries:
+    """The series f_n = n f₀ √(1 + B n²) that the peaks form.
+
+    Attributes
+    ----------
+    fundamental : float
+        f₀, Hz: the series' scale (the taut-string fundamental of a pinned cable; with clamped ends it carries
+        their few per cent).
+    inharmonicity : float
+        B (0 for a taut string).
+    modes : ndarray of int
+        Per peak, in the order given: its mode number in the series (0: left out).
+    cost : float
+        The assignment's cost (squared standardised residuals, left-out peaks and skipped modes).
+    ambiguous : bool
+        Another series with a fundamental more than 5 % away fits almost as well (one peak, or peaks that
+        several spacings explain): its numbers are not to be trusted.
+    alternative : float or None
+        The fundamental of the best such other series, Hz.
+    """
+
+    fundamental: float
+    inharmonicity: float
+    modes: np.ndarray
+    cost: float
+    ambiguous: bool
+    alternative: float | None = None
+
+    def frequency(self, modes) -> np.ndarray:
+        """The series' frequencies of ``modes`` (Hz)."""
+        n = np.asarray(modes, float)
+        return n * self.fundamental * np.sqrt(1.0 + self.inharmonicity * n**2)
+
+    @property
+    def n_assigned(self) -> int:
+        """How many peaks the series numbers."""
+        return int(np.count_nonzero(self.modes))
+
+
+def harmonic_series(frequencies, uncertainties=None, *, tolerance: float = TOLERANCE) -> HarmonicSeries | None:
+    """The harmonic series of the peaks ``frequencies`` (Hz; 1σ ``uncertainties``, default none beyond the
+    tolerance): module docstring. None with no peak; one peak is mode 1 of an ambiguous series."""
+    f = np.asarray(frequencies, float).ravel()
+    u = np.zeros_like(f) if uncertainties is None else np.asarray(uncertainties, float).ravel()
+    if f.shape != u.shape:
+        raise ValueError("frequencies and uncertainties must have the same length")
+    keep = np.isfinite(f) & (f > 0) & np.isfinite(u)
+    if not keep.any():
+        return None
+    order = np.flatnonzero(keep)[np.argsort(f[keep])]
+    fs, us = f[order], u[order]
+    sigma = (us, tolerance)
+    modes = np.zeros(f.size, int)
+    if fs.size == 1:
+        modes[order] = 1
+        return HarmonicSeries(float(fs[0]), 0.0, modes, 0.0, True, float(fs[0]) / 2)
+    scored = _score_starts(fs, sigma, _starts(fs))
+    refined = []
+    for _, f0, b, _ in scored[:24]:
+        refined.append(_refine(fs, sigma, f0, b))
+    refined.sort(key=lambda s: s[0])
+    cost, f0, b, assigned = refined[0]
+    rivals = [r for r in refined[1:] if abs(r[1] / f0 - 1) > DISTINCT]
+    ambiguous = bool(rivals) and rivals[0][0] - cost <= AMBIGUITY or np.count_nonzero(assigned) < 2
+    modes[order] = assigned
+    return HarmonicSeries(float(f0), float(b), modes, float(cost), bool(ambiguous),
+                          float(rivals[0][1]) if rivals else None)
+
+
+def _score_starts(fs, sigma, starts: np.ndarray) -> list:
+    """A quick cost of every start (rows f₀, B) at once, best first: each peak taken as its nearest mode of the
+    series (closed form), a peak beyond :data:`UNASSIGNED_COST` or on a mode taken already left out, the
+    skipped modes counted. It only ranks the starts; the refinement assigns by the dynamic programme."""
+    f0, b = starts[:, :1], starts[:, 1:]
+    sigma = _sigma(fs, sigma, starts[:, 0])
+    x = fs[None, :] / f0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n_cont = np.where(b > 0, np.sqrt((np.sqrt(1 + 4 * b * x**2) - 1) / (2 * np.where(b > 0, b, 1))), x)
+    n = np.maximum(np.rint(n_cont), 1)
+    residual = ((fs[None, :] - n * f0 * np.sqrt(1 + b * n**2)) / sigma) ** 2
+    on = residual < UNASSIGNED_COST
+    on[:, 1:] &= n[:, 1:] != n[:, :-1]  # sorted peaks: a repeated mode is taken by its first peak only
+    cost = np.where(on, residual, UNASSIGNED_COST).sum(axis=1)
+    lowest = np.where(on, n, np.inf).min(axis=1)
+    highest = np.where(on, n, -np.inf).max(axis=1)
+    count = on.sum(axis=1)
+    skipped = np.where(count > 0, highest - lowest + 1 - count, 0)
+    total = cost + SKIP_COST * skipped
+    order = np.argsort(total, kind="stable")
+    return [(float(total[k]), float(starts[k, 0]), float(starts[k, 1]), None) for k in order]
+
+
+def _starts(fs: np.ndarray) -> np.ndarray:
+    """Rows (f₀, B): taut-string series with each of the three lowest peaks as mode 1, 2, …, :data:`MAX_MODE`
+    (deduplicated) and the spacing of neighbouring peaks as f₀ (a series whose low modes were not picked); and
+    stretched series through two of the three lowest peaks taken as low modes (a stiff member's)."""
+    candidates = []
+    for peak in fs[:3]:
+        candidates.extend(peak / np.arange(1, MAX_MODE + 1))
+    gaps = np.diff(fs)
+    candidates.extend(gaps[gaps > 0])
+    values = np.sort(np.asarray(candidates))
+    values = values[values >= fs[-1] / (2 * MAX_MODE)]
+    kept = [values[0]]
+    for v in values[1:]:
+        if v > kept[-1] * 1.002:
+            kept.append(v)
+    rows = [(v, 0.0) for v in kept]
+    low = fs[:3]
+    for i in range(low.size):
+        for j in range(i + 1, low.size):
+            for ni in range(1, 9):
+                for nj in range(ni + 1, ni + 9):
+                    yi, yj = (low[i] / ni) ** 2, (low[j] / nj) ** 2
+                    c = (yj - yi) / (nj**2 - ni**2)
+                    a = yi - c * ni**2
+                    if a > 0 and 0 < c / a <= MAX_INHARMONICITY:
+                        rows.append((math.sqrt(a), c / a))
+    return np.asarray(rows)
+
+
+def _sigma(fs, sigma, f0) -> np.ndarray:
+    """Each peak's σ for the series of fundamental ``f0`` (an array: one row per series): its own 1σ and the
+    model tolerance, at most :data:`SPACING_SHARE` of the spacing. ``sigma``: (the peaks' 1σ, the tolerance)."""
+    u, tolerance = sigma
+    f0 = np.asarray(f0, float)
+    model = np.minimum(tolerance * fs, SPACING_SHARE * (f0[..., None] if f0.ndim else f0))
+    return np.sqrt(u**2 + model**2)
+
+
+def _family(f0: float, b: float, top: float) -> np.ndarray:
+    n = np.arange(1, min(4 * MAX_MODE, int(top / f0) + 3) + 1, dtype=float)
+    return n * f0 * np.sqrt(1.0 + b * n**2)
+
+
+def _score(fs, sigma, f0, b) -> tuple[float, float, float, np.ndarray]:
+    """(cost with the skips, f₀, B, modes) of the series (f₀, B)."""
+    family = _family(f0, b, fs[-1] * (1 + 4 * TOLERANCE))
+    sigma = _sigma(fs, sigma, np.array(f0))
+    modes, cost = assign(fs, sigma, family[None, :], UNASSIGNED_COST)
+    modes = modes[0]
+    on = modes[modes > 0]
+    skipped = (on.max() - on.min() + 1 - on.size) if on.size else 0
+    return float(cost[0]) + SKIP_COST * skipped, f0, b, modes
+
+
+def _refine(fs, sigma, f0, b, iterations: int = 6):
+    """The start (f₀, B) assigned by the dynamic programme, then weighted least squares of (f/n)² = a + c n² on
+    the assigned peaks (a = f₀², c = f₀² B), re-assigned, until the numbers stand."""
+    best = _score(fs, sigma, f0, b)
+    modes = best[3]
+    for _ in range(iterations):
+        on = modes > 0
+        if np.count_nonzero(on) < 2:
+            break
+        n = modes[on].astype(float)
+        y = (fs[on] / n) ** 2
+        w = n**2 / (2 * fs[on] * _sigma(fs, sigma, np.array(f0))[on])  # 1 / σ of y
+        design = np.column_stack([np.ones_like(n), n**2])
+        coef = np.linalg.lstsq(design * w[:, None], y * w, rcond=None)[0]
+        a, c = coef
+        if c < 0 or not np.count_nonzero(np.unique(n)) > 2:
+            a, c = float(np.sum(w**2 * y) / np.sum(w**2)), 0.0
+        if not a > 0:
+            break
+        f0, b = math.sqrt(a), min(c / a, MAX_INHARMONICITY)
+        trial = _score(fs, sigma, f0, b)
+        if trial[0] >= best[0] - 1e-9 and np.array_equal(trial[3], modes):
+            best = trial if trial[0] < best[0] else best
+            break
+        if trial[0] < best[0]:
+            best = trial
+        modes = trial[3]
+    return best
