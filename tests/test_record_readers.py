@@ -100,13 +100,15 @@ def npz():
 
 
 def test_the_built_in_readers_are_registered_with_their_suffixes():
-    assert [r.name for r in readers()] == ["hdf5", "csv", "sep005", "matlab", "tdms", "uff"]
-    assert record_suffixes() == (".h5", ".hdf5", ".csv", ".txt", ".json", ".mat", ".tdms", ".uff", ".unv")
+    assert [r.name for r in readers()] == ["hdf5", "csv", "sep005", "matlab", "tdms", "uff", "toa5", "lvm"]
+    assert record_suffixes() == (".h5", ".hdf5", ".csv", ".txt", ".json", ".mat", ".tdms", ".uff", ".unv", ".dat",
+                                 ".lvm")
 
 
 @pytest.mark.parametrize(("name", "reader"), [("r.h5", "hdf5"), ("r.HDF5", "hdf5"), ("r.csv", "csv"),
                                               ("r.txt", "csv"), ("r.json", "sep005"), ("r.mat", "matlab"),
-                                              ("r.tdms", "tdms"), ("r.UFF", "uff"), ("r.unv", "uff")])
+                                              ("r.tdms", "tdms"), ("r.UFF", "uff"), ("r.unv", "uff"),
+                                              ("r.dat", "toa5"), ("r.LVM", "lvm")])
 def test_the_suffix_picks_the_reader_without_opening_the_file(tmp_path, name, reader):
     assert reader_for(tmp_path / name).name == reader  # the file does not exist: the suffix alone decided
 
@@ -157,7 +159,7 @@ def test_register_refuses_a_second_reader_of_a_name_and_a_bad_suffix(npz):
     bad.name, bad.suffixes = "other", ("npz",)
     with pytest.raises(TypeError, match="suffixes"):
         register(bad)
-    assert [r.name for r in readers()][-1] == "npz-toy" and len(readers()) == 7
+    assert [r.name for r in readers()][-1] == "npz-toy" and len(readers()) == 9
 
 
 # ---------------------------------------------------------------- one record, every format

@@ -83,6 +83,9 @@ def check_names(names: Any, n_channels: int, file: str | None) -> list[str]:
 
 
 def check_position_values(positions: Any, names: list[str], file: str | None) -> np.ndarray:
+    if np.iscomplexobj(positions):  # numpy would drop the imaginary part (a warning, not an error)
+        raise ModelError(f"positions must be real numbers (m from end A), got {np.asarray(positions).dtype}",
+                         field="channel_position", file=file)
     try:
         positions = np.asarray(positions, dtype=float)
     except (TypeError, ValueError):
@@ -169,6 +172,10 @@ class Record:
         (:mod:`stcs_ident.core.planes`); None when neither the file nor the
         campaign gives them: every channel is then read as in-plane
         (:attr:`directions`), and results say so.
+    notes : tuple of str
+        What the reader did that a user should know, one plain sentence each, without the file's name
+        (``"header line found at line 7 (0-based) after a preamble: give header_row = 7 to fix it"``,
+        ``"columns left out (not an acceleration unit): RECORD (RN), BattV (Volts)"``), for results to print.
     """
 
     acceleration: np.ndarray
@@ -181,10 +188,13 @@ class Record:
     temperature: float | None = None
     replaced: tuple[tuple[str, Any, Any], ...] = ()
     channel_directions: tuple[str | float, ...] | None = None
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         file = self.source
         object.__setattr__(self, "replaced", tuple(tuple(item) for item in self.replaced))
+        object.__setattr__(self, "notes", (self.notes,) if isinstance(self.notes, str) else
+                           tuple(str(note) for note in self.notes))
         acc = np.asarray(self.acceleration, dtype=float)
         object.__setattr__(self, "acceleration", check_shape(acc[:, None] if acc.ndim == 1 else acc, file))
         object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=file))

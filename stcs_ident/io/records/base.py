@@ -9,9 +9,10 @@ suffix (:func:`record_suffixes`). The shape is xarray's
 ``BackendEntrypoint`` (``open_dataset``, ``guess_can_open``).
 
 :func:`read_record` picks the reader by the file's suffix; where several
-readers share the suffix, or none has it, by content (the first bytes, as
-each reader's ``can_open`` says). A file no reader takes is refused with one
-line naming it.
+readers share the suffix, or none has it, or the suffix is one files of many
+formats have (``.dat``, a reader's ``generic_suffixes``), by content (the
+first bytes, as each reader's ``can_open`` says). A file no reader takes is
+refused with one line naming it.
 """
 
 from __future__ import annotations
@@ -50,10 +51,14 @@ class RecordReader:
         Short name of the format (``"hdf5"``), unique in the registry.
     suffixes : tuple of str
         File name endings, lower case with the dot (``(".h5", ".hdf5")``).
+    generic_suffixes : tuple of str
+        Those of ``suffixes`` that files of other formats have too (TOA5's ``.dat``): for such a file the
+        content decides first (:func:`reader_for`).
     """
 
     name: str = ""
     suffixes: tuple[str, ...] = ()
+    generic_suffixes: tuple[str, ...] = ()
 
     def can_open(self, path: str | os.PathLike) -> bool:
         """Whether the file's content is of this format (default: cannot tell, False).
@@ -130,7 +135,9 @@ def record_suffixes() -> tuple[str, ...]:
 
 
 def reader_for(path: str | os.PathLike) -> RecordReader:
-    """The reader of the file at ``path``: by suffix, by content where the suffix does not decide.
+    """The reader of the file at ``path``: by suffix, by content where the suffix does not decide (shared by
+    several readers, a generic suffix such as ``.dat``, or none); a file with a generic suffix that no reader
+    recognises goes to the reader of that suffix, which says what it expected.
 
     Raises
     ------
@@ -140,11 +147,14 @@ def reader_for(path: str | os.PathLike) -> RecordReader:
     file = os.fspath(path)
     lower = os.path.basename(file).lower()
     by_suffix = [reader for reader in _READERS.values() if any(lower.endswith(s) for s in reader.suffixes)]
-    if len(by_suffix) == 1:
+    generic = bool(by_suffix) and all(any(lower.endswith(s) for s in getattr(reader, "generic_suffixes", ()))
+                                      for reader in by_suffix)
+    if len(by_suffix) == 1 and not (generic and os.path.exists(file)):
         return by_suffix[0]
     if not os.path.exists(file):
         raise InputError("file not found", file=file)
-    for reader in by_suffix or _READERS.values():
+    others = [reader for reader in _READERS.values() if reader not in by_suffix] if generic else []
+    for reader in [*by_suffix, *others] if by_suffix else _READERS.values():
         if reader.can_open(file):
             return reader
     if by_suffix:  # a shared suffix, and no content recognised: the first reader says what is wrong

@@ -3,24 +3,33 @@
 A header line names the columns: a time column and one column per channel.
 The options (a campaign's ``record_format``) say how the file is written:
 ``separator`` (default ``,``), ``decimal`` (default ``.``), ``skip_rows``
-(0-based line numbers after the header to skip, a units row: ``[1]``),
-``time_column`` (default ``time``) and ``unit`` (default m/s²).
+(line numbers counted from the header to skip, a units row: ``[1]``),
+``time_column`` (default ``time``), ``unit`` (default m/s²), ``header_row``
+(the header's line, 0-based, after a preamble of metadata lines; without it
+the header is looked for, :mod:`~stcs_ident.io.records.preamble`) and
+``channels`` (the columns that are acceleration channels; the others are
+left out, :mod:`~stcs_ident.io.records.columns`).
 
 The time column holds seconds or date-times (ISO 8601, read by pandas; the
 first row is then the record's start time). Without ``sampling_rate`` the
 rate comes from the time column, which must be uniform: seconds within
 :data:`~stcs_ident.io.records.validation.TIME_TOLERANCE`, date-times within
 the resolution they are printed to. With ``sampling_rate`` the time column
-gives the start time only (date-times), so a time column printed to a few
-digits is no obstacle. The channel positions are given by the caller (the
-campaign's channel table). Then the checks of every record source apply
+need not be uniform (a time column printed to a few digits is no
+obstacle), but the rate of its span must agree with the given one within
+its printed resolution, else the file is refused unless
+``override_sampling_rate`` (:mod:`~stcs_ident.io.records.rates`). The
+channel positions are given by the caller (the campaign's channel table).
+Then the checks of every record source apply
 (:mod:`~stcs_ident.io.records.validation`). A refusal says which option
-would fix it, where one would.
+would fix it, where one would. The record's ``notes`` say where a header
+was found after a preamble and which columns were left out.
 """
 
 from __future__ import annotations
 
 import csv
+import itertools
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -32,6 +41,9 @@ import pandas as pd
 from ...core.errors import InputError
 from ...core.record import Record
 from .base import HEAD_BYTES, RecordReader, file_head
+from .columns import Selection, by_channels, text_positions
+from .preamble import find_header
+from .rates import FileRate, printed_resolution, resolved_rate
 from .validation import (
     TIME_TOLERANCE,
     Positions,
@@ -45,15 +57,25 @@ from .validation import (
 __all__ = ["READER", "CsvReader", "record_from_csv"]
 
 #: The options of this reader (the others a campaign gives are for other formats).
-CSV_OPTIONS = ("time_column", "unit", "sampling_rate", "separator", "decimal", "skip_rows")
+CSV_OPTIONS = ("time_column", "unit", "sampling_rate", "separator", "decimal", "skip_rows", "header_row", "channels",
+               "override_sampling_rate")
 _DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d*,\d+([eE][-+]?\d+)?\s*$")
 _FRACTION = re.compile(r"\d:\d\d:\d\d[.,](\d+)")
+#: First bytes of text layouts that have their own reader (a TOA5 or an LVM file named .csv or .txt).
+_OTHER_LAYOUTS = {b"TOA5": "toa5", b'"TOA5"': "toa5", b"LabVIEW Measurement": "lvm"}
+
+
+def other_layout(head: bytes) -> str | None:
+    """The name of the reader of a text layout that is not a plain table (TOA5, LVM), from its first bytes."""
+    head = head.removeprefix(b"\xef\xbb\xbf").lstrip(b" \t")
+    return next((name for mark, name in _OTHER_LAYOUTS.items() if head.startswith(mark)), None)
 
 
 class CsvReader(RecordReader):
     """CSV and text records (:func:`record_from_csv`): the channel positions come from the caller.
 
-    By content: text whose first line is a header separated by commas, semicolons or tabs (not JSON).
+    By content: text whose first line is a header separated by commas, semicolons or tabs (not JSON, not a
+    TOA5 or LVM file: a ``.csv`` or ``.txt`` of those is read by their readers).
     """
 
     name = "csv"
@@ -61,7 +83,7 @@ class CsvReader(RecordReader):
 
     def can_open(self, path: str | os.PathLike) -> bool:
         head = file_head(path)
-        if not head or b"\0" in head:
+        if not head or b"\0" in head or other_layout(head):
             return False
         first = head.split(b"\n", 1)[0].removeprefix(b"\xef\xbb\xbf").strip()  # a BOM is tolerated
         try:
@@ -72,14 +94,13 @@ class CsvReader(RecordReader):
         return any(mark in first for mark in (b",", b";", b"\t")) and first[:1] not in (b"[", b"{")
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_csv`; a channel without a position is refused, saying where positions are given."""
-        try:
-            return record_from_csv(path, positions or {}, **{k: v for k, v in options.items() if k in CSV_OPTIONS})
-        except InputError as err:
-            if err.field != "channel_position" or not err.message.startswith("no position"):
-                raise
-            hint = "a CSV record gives no positions: list its channels in the test's [test.channels] (m from end A)"
-            raise InputError(f"{err.message}; {hint}", field=err.field, file=err.file) from None
+        """:func:`record_from_csv`; a TOA5 or LVM file (by its first line) is read by its own reader."""
+        layout = other_layout(file_head(path))
+        if layout is not None:
+            from . import lvm, toa5  # (they build on this module)
+
+            return {"toa5": toa5.READER, "lvm": lvm.READER}[layout].read(path, positions=positions, **options)
+        return record_from_csv(path, positions or {}, **{k: v for k, v in options.items() if k in CSV_OPTIONS})
 
 
 READER = CsvReader()
@@ -88,6 +109,7 @@ READER = CsvReader()
 def record_from_csv(
     path: str | os.PathLike, positions: Positions, *, time_column: str = "time", unit: str = "m/s^2",
     sampling_rate: float | None = None, separator: str = ",", decimal: str = ".", skip_rows: Sequence[int] = (),
+    header_row: int | None = None, channels: Sequence[str] | None = None, override_sampling_rate: bool = False,
 ) -> Record:
     """Read a record from CSV: a header line, a time column, one column per channel.
 
@@ -103,11 +125,20 @@ def record_from_csv(
     unit : str
         The samples' unit, a spelling of :data:`.validation.UNITS` (m/s^2, m/s2, mm/s^2, g, G, mg, ...).
     sampling_rate : float, optional
-        Hz; given, the time column is not used for the rate (and may be missing).
+        Hz; given, the time column need not be uniform (and may be missing), but a rate it gives that differs
+        beyond its printed resolution is refused (:mod:`~stcs_ident.io.records.rates`).
     separator, decimal : str
         The column separator and the decimal mark, one character each.
     skip_rows : sequence of int
-        0-based line numbers (the header is line 0) not read: a units row under the header is ``[1]``.
+        Line numbers counted from the header (the header is line 0) not read: a units row under it is ``[1]``.
+    header_row : int, optional
+        The file's line (0-based) that names the columns, after a preamble; without it the header is looked
+        for (:func:`~stcs_ident.io.records.preamble.find_header`), and the record's ``notes`` say where it
+        was found when it is not line 0.
+    channels : sequence of str, optional
+        The columns that are acceleration channels; the others are left out (listed in ``notes``).
+    override_sampling_rate : bool
+        Whether ``sampling_rate`` replaces a time column's rate that differs from it.
 
     Raises
     ------
@@ -117,48 +148,70 @@ def record_from_csv(
     """
     file = str(path)
     skip = sorted(set(skip_rows))
-    header, table = _read_csv(file, separator, skip)
-    if len(set(header)) != len(header):
-        duplicate = next(name for name in header if header.count(name) > 1)
-        raise InputError(f"duplicate column {duplicate!r}", field="channel_name", file=file)
+    notes: list[str] = []
+    if header_row is None:
+        header_row, found = find_header(file, separator, decimal)
+        notes.extend(found)
+    header, table = read_table(file, separator, header_row, skip)
     has_time = time_column in header
     if not has_time and sampling_rate is None:
         raise InputError(f"no {time_column!r} column among {', '.join(map(repr, header))}; "
                          f"{_separator_hint(header, separator) or _TIME_HINT}", field="time", file=file)
-    names = [name for name in header if name != time_column]
+    selection = by_channels(header, channels, unit, file, excluded={time_column: "the time column"} if has_time else {})
     if not skip:
-        _check_units_row(table, header, file)
-    rate, start_time, replaced = None, None, []
-    if has_time:
+        _check_units_row(table, decimal, header_row, file)
+    return table_record(file, header, table, selection, positions, time_column=time_column if has_time else None,
+                        sampling_rate=sampling_rate, override=override_sampling_rate, decimal=decimal,
+                        header_row=header_row, skip=skip, notes=notes, channels_given=channels is not None)
+
+
+def table_record(file: str, header: list[str], table: pd.DataFrame, selection: Selection, positions: Positions,
+                 *, time_column: str | None, sampling_rate: float | None, override: bool, decimal: str,
+                 header_row: int, skip: list[int], notes: Sequence[str], channels_given: bool,
+                 replaced: Sequence[tuple[str, Any, Any]] = ()) -> Record:
+    """The record of a text table read by :func:`read_table`: its channels (``selection``) scaled to m/s², its
+    rate and start time from the time column and ``sampling_rate`` (:func:`~.rates.resolved_rate`)."""
+    replaced = list(replaced) + list(selection.replaced)
+    found, start_time = None, None
+    if time_column is not None:
         column = table.iloc[:, header.index(time_column)]
-        rate, start_time = _time_axis(column, time_column, decimal, skip, file, need_rate=sampling_rate is None)
-    if sampling_rate is not None:
-        if rate is not None and abs(rate - sampling_rate) > TIME_TOLERANCE * sampling_rate:
-            replaced.append(("sampling_rate", sampling_rate, rate))
-        rate = sampling_rate
-    acceleration = np.column_stack(
-        [_numeric_column(table, header, name, "acceleration", decimal, skip, file) for name in names]
-        or [np.empty((len(table), 0))]
-    )
-    channel_positions = position_list(names, positions_by_name(names, positions, file), file)
-    return validated_record(acceleration, rate, names, channel_positions, unit=unit, start_time=start_time,
-                            source=file, replaced=replaced)
+        found, start_time = _time_axis(column, time_column, decimal, header_row, skip, file, given=sampling_rate)
+    rate = resolved_rate(sampling_rate, found, override=override, file=file, replaced=replaced)
+    columns = [_numeric_column(table, header, name, "acceleration", decimal, header_row, skip, file)
+               for name in selection.names]
+    acceleration = np.column_stack(columns) if columns else np.empty((len(table), 0))
+    if any(scale != 1.0 for scale in selection.scales):
+        acceleration *= np.asarray(selection.scales)
+    if isinstance(positions, Mapping) or positions is None:
+        channel_positions = text_positions(selection, positions, file, channels_given)
+    else:
+        names = list(selection.names)
+        channel_positions = position_list(names, positions_by_name(names, positions, file), file)
+    return validated_record(acceleration, rate, list(selection.names), channel_positions, unit="m/s^2",
+                            start_time=start_time, source=file, replaced=replaced,
+                            notes=(*notes, *selection.notes()))
 
 
 _TIME_HINT = "name the time column with time_column, or give sampling_rate (the time column is then not needed)"
 
 
-def _read_csv(file: str, separator: str, skip: list[int]) -> tuple[list[str], pd.DataFrame]:
-    """The header and the data rows of ``file`` as text (columns by place, so duplicates survive)."""
+def read_table(file: str, separator: str, header_row: int, skip: list[int]) -> tuple[list[str], pd.DataFrame]:
+    """The header (line ``header_row``) and the data rows after it of ``file``, as text (columns by place);
+    ``skip`` counts lines from the header. A duplicate column name is refused."""
     hint = ""
     try:
         with open(file, newline="", encoding="utf-8-sig") as stream:  # -sig: tolerate a BOM
-            header = [name.strip() for name in next(csv.reader(stream, delimiter=separator), [])]
+            line = next(itertools.islice(stream, header_row, None), "")
+        header = [name.strip() for name in next(csv.reader([line], delimiter=separator), [])]
         if not header:
-            raise InputError("empty file: no header line", file=file)
+            raise InputError("empty file: no header line" if header_row == 0 else
+                             f"line {header_row} (0-based, header_row) is empty or past the end of the file",
+                             file=file)
         hint = _separator_hint(header, separator)
-        table = pd.read_csv(file, sep=separator, header=None, skiprows=[0, *skip], skipinitialspace=True,
-                            encoding="utf-8-sig", dtype=str, keep_default_na=False, na_values=[""])
+        table = pd.read_csv(file, sep=separator, header=None,
+                            skiprows=[*range(header_row + 1), *(header_row + k for k in skip)],
+                            skipinitialspace=True, encoding="utf-8-sig", dtype=str, keep_default_na=False,
+                            na_values=[""])
     except FileNotFoundError:
         raise InputError("file not found", file=file) from None
     except pd.errors.EmptyDataError:
@@ -166,13 +219,27 @@ def _read_csv(file: str, separator: str, skip: list[int]) -> tuple[list[str], pd
     except (OSError, UnicodeDecodeError, pd.errors.ParserError, csv.Error) as err:
         hint = (f"; {hint}" if hint else "; if the columns are separated otherwise, give separator in "
                 "record_format" if separator == "," else "")
+        if isinstance(err, pd.errors.ParserError) and header_row == 0:
+            hint += _PREAMBLE_HINT
         raise InputError(f"cannot read the file as CSV: {one_line(err)}{hint}", file=file) from err
     if table.shape[1] != len(header):
         hint = (f"; {_separator_hint(header, separator)}" if _separator_hint(header, separator) else
                 '; decimal commas in a comma-separated file? such a file cannot be read: write it with '
-                'separator ";"' if separator == "," else "")
-        raise InputError(f"the header has {len(header)} columns, the rows {table.shape[1]}{hint}", file=file)
+                'separator ";"' if separator == "," and table.shape[1] > len(header) else "")
+        if header_row == 0:
+            hint += _PREAMBLE_HINT
+        raise InputError(f"the header (line {header_row + 1}) has {len(header)} columns, the rows {table.shape[1]}"
+                         f"{hint}", file=file)
+    if len(set(header)) != len(header):
+        duplicate = next(name for name in header if header.count(name) > 1)
+        fix = _PREAMBLE_HINT if header_row == 0 else "; give header_row, the line that names the columns"
+        raise InputError(f"duplicate column {duplicate!r} in the header (line {header_row + 1}){fix}",
+                         field="channel_name", file=file)
     return header, table
+
+
+_PREAMBLE_HINT = ("; metadata lines before the header (a preamble)? give header_row = <the header's line, 0-based> "
+                  "in record_format")
 
 
 def _separator_hint(header: list[str], separator: str) -> str:
@@ -184,24 +251,25 @@ def _separator_hint(header: list[str], separator: str) -> str:
     return ""
 
 
-def _line(row: int, skip: list[int]) -> int:
-    """The 1-based line of the file of data row ``row`` (0-based), the header being line 1."""
-    line, seen = 1, -1  # 0-based file line numbers; line 0 is the header
+def _line(row: int, header_row: int, skip: list[int]) -> int:
+    """The 1-based line of the file of data row ``row`` (0-based), the header being line ``header_row + 1`` and
+    ``skip`` counted from the header."""
+    line, seen = 1, -1  # lines counted from the header (the header is 0)
     while True:
         if line not in skip:
             seen += 1
             if seen == row:
-                return line + 1
+                return header_row + line + 1
         line += 1
 
 
-def _check_units_row(table: pd.DataFrame, header: list[str], file: str) -> None:
+def _check_units_row(table: pd.DataFrame, decimal: str, header_row: int, file: str) -> None:
     """Refuse a first data row with no number in it (a units row under the header), saying how to skip it."""
     if len(table) and table.iloc[0].notna().all():
         first = table.iloc[0].astype(str)
-        if pd.to_numeric(first.str.strip(), errors="coerce").isna().all():
+        if np.isnan(_numbers(first, decimal)).all():
             cells = ", ".join(repr(v) for v in first.tolist()[:4])
-            raise InputError(f"line 2 ({cells}) holds no number: a units row under the header? give "
+            raise InputError(f"line {header_row + 2} ({cells}) holds no number: a units row under the header? give "
                              "skip_rows = [1] in record_format", field="acceleration", file=file)
 
 
@@ -212,12 +280,13 @@ def _numbers(column: pd.Series, decimal: str) -> np.ndarray:
     return pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
 
 
-def _numeric_column(table: pd.DataFrame, header: list[str], name: str, field: str, decimal: str, skip: list[int],
-                    file: str) -> np.ndarray:
+def _numeric_column(table: pd.DataFrame, header: list[str], name: str, field: str, decimal: str, header_row: int,
+                    skip: list[int], file: str) -> np.ndarray:
     """Column ``name`` as floats; empty cells become NaN, text is refused (with the option that reads it)."""
     column = table.iloc[:, header.index(name)]
     values = _numbers(column, decimal)
-    text = np.flatnonzero(np.isnan(values) & column.notna().to_numpy())
+    spelled_nan = column.str.strip().str.lower().isin(("nan", "-nan", "+nan")).to_numpy(dtype=bool)
+    text = np.flatnonzero(np.isnan(values) & column.notna().to_numpy() & ~spelled_nan)  # NAN: refused as non-finite
     if text.size:
         row = int(text[0])
         value = column.iloc[row]
@@ -226,20 +295,28 @@ def _numeric_column(table: pd.DataFrame, header: list[str], name: str, field: st
             hint = '; decimal commas? give decimal = "," in record_format'
         elif row == 0 and not skip:
             hint = "; a units row under the header? give skip_rows = [1] in record_format"
-        raise InputError(f"column {name!r}, line {_line(row, skip)}: {value!r} is not a number{hint}",
+        else:
+            hint = "; if it is not an acceleration channel, give channels in record_format naming those that are"
+        raise InputError(f"column {name!r}, line {_line(row, header_row, skip)}: {value!r} is not a number{hint}",
                          field=field, file=file)
     return values
 
 
-def _time_axis(column: pd.Series, name: str, decimal: str, skip: list[int], file: str,
-               need_rate: bool) -> tuple[float | None, str | None]:
-    """The sampling rate (None when not ``need_rate``) and the start time (date-times only) of the time column."""
+def _time_axis(column: pd.Series, name: str, decimal: str, header_row: int, skip: list[int], file: str,
+               given: float | None) -> tuple[FileRate | None, str | None]:
+    """The time column's rate (uniform unless ``given``: then from its span, to compare) and start time
+    (date-times only)."""
     if column.isna().any():
         row = int(np.argmax(column.isna().to_numpy()))
-        raise InputError(f"column {name!r}, line {_line(row, skip)}: no time", field="time", file=file)
+        raise InputError(f"column {name!r}, line {_line(row, header_row, skip)}: no time", field="time", file=file)
+    need_rate = given is None
     seconds = _numbers(column, decimal)
     if not np.isnan(seconds).any():
-        return (_rate_from_seconds(seconds, name, file) if need_rate else None), None
+        if need_rate:
+            rate = _rate_from_seconds(seconds, name, file)
+            return FileRate(rate, f"time column {name!r}", detail=f"steps of {1 / rate:.6g} s"), None
+        resolutions = [printed_resolution(column.iloc[k].replace(decimal, ".")) for k in (0, -1)]
+        return _span_rate(seconds[-1] - seconds[0], seconds.size, max((r or 0.0) for r in resolutions), name), None
     try:
         stamps = pd.to_datetime(column.str.strip(), format="ISO8601")
     except (ValueError, TypeError, OverflowError) as err:
@@ -248,17 +325,31 @@ def _time_axis(column: pd.Series, name: str, decimal: str, skip: list[int], file
         row = int(np.argmax(np.isnan(seconds)))
         hint = ('; decimal commas? give decimal = "," in record_format' if _DECIMAL_COMMA.match(column.iloc[row])
                 else f"; or give sampling_rate (and start_time) in record_format ({one_line(err)})")
-        raise InputError(f"column {name!r}, line {_line(row, skip)}: {column.iloc[row]!r} is neither a time in "
-                         f"seconds nor an ISO 8601 date-time{hint}", field="time", file=file) from None
+        raise InputError(f"column {name!r}, line {_line(row, header_row, skip)}: {column.iloc[row]!r} is neither a "
+                         f"time in seconds nor an ISO 8601 date-time{hint}", field="time", file=file) from None
     if stamps.isna().any():
         row = int(np.argmax(stamps.isna().to_numpy()))
-        raise InputError(f"column {name!r}, line {_line(row, skip)}: no date-time", field="time", file=file)
+        raise InputError(f"column {name!r}, line {_line(row, header_row, skip)}: no date-time", field="time",
+                         file=file)
     start = stamps.iloc[0].floor("us").to_pydatetime().isoformat()  # Python's: no fraction when it is zero
-    if not need_rate:
-        return None, start
     ns = (stamps - stamps.iloc[0]).to_numpy().astype("timedelta64[ns]").astype(np.int64)
     digits = column.str.extract(_FRACTION, expand=False).str.len().max()  # the finest the date-times are printed to
-    return _rate_from_stamps(ns, 0 if pd.isna(digits) else int(digits), name, file), start
+    digits = 0 if pd.isna(digits) else int(digits)
+    if not need_rate:
+        return _span_rate(int(ns[-1]) / 1e9, ns.size, 10.0 ** -min(digits, 9), name), start
+    rate = _rate_from_stamps(ns, digits, name, file)
+    return FileRate(rate, f"time column {name!r}", detail=f"steps of {1 / rate:.6g} s"), start
+
+
+def _span_rate(span: float, n: int, resolution: float, name: str) -> FileRate | None:
+    """The rate of ``n`` samples over ``span`` s of a time column printed to ``resolution`` s (None: no span),
+    agreeing with a given rate within the resolution over the span plus TIME_TOLERANCE (:mod:`.rates`)."""
+    if n < 2 or not np.isfinite(span) or span <= 0:
+        return None
+    rate = (n - 1) / span
+    return FileRate(rate, f"time column {name!r}", rtol=resolution / span + TIME_TOLERANCE,
+                    detail=f"{n} samples over {span:.9g} s, steps of {span / (n - 1):.6g} s, "
+                           f"printed to {resolution:g} s")
 
 
 def _rate_from_seconds(time: np.ndarray, name: str, file: str) -> float:
@@ -286,5 +377,6 @@ def _rate_from_stamps(ns: np.ndarray, digits: int, name: str, file: str) -> floa
         raise InputError(
             f"date-times not uniformly spaced: step {worst} is {steps[worst] / 1e9:.9g} s against "
             f"{mean / 1e9:.9g} s on average (resolution {resolution / 1e9:g} s); a gap or a clock jump? "
-            "give sampling_rate in record_format to use the samples as they are", field=name, file=file)
+            "give sampling_rate and override_sampling_rate = true in record_format to use the samples as they are",
+            field=name, file=file)
     return 1e9 * (ns.size - 1) / span  # from the whole span: the printed resolution spread over every step

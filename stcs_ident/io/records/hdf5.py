@@ -40,6 +40,7 @@ from ...core.planes import direction_text
 from ...core.record import Record
 from .base import RecordReader, file_head
 from .directions import file_directions
+from .rates import FileRate, resolved_rate
 from .validation import one_line, overridden, validated_record
 
 __all__ = ["FORMAT", "READER", "VERSION", "Hdf5Reader", "read_record", "write_record"]
@@ -64,21 +65,24 @@ class Hdf5Reader(RecordReader):
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
         """:func:`read_record`; ``positions`` is not used (the file gives every channel's); of the options,
-        ``unit`` and ``sampling_rate`` replace the file's, ``axes`` places axis labels of its directions (the
-        others do not apply)."""
+        ``unit`` replaces the file's, ``sampling_rate`` stands in for it or must agree with it (unless
+        ``override_sampling_rate``), ``axes`` places axis labels of its directions (the others do not apply)."""
         return read_record(path, unit=options.get("unit"), sampling_rate=options.get("sampling_rate"),
-                           axes=options.get("axes"))
+                           axes=options.get("axes"),
+                           override_sampling_rate=bool(options.get("override_sampling_rate", False)))
 
 
 READER = Hdf5Reader()
 
 
 def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_rate: float | None = None,
-                axes: Any = None) -> Record:
+                axes: Any = None, override_sampling_rate: bool = False) -> Record:
     """Read an acceleration record from its HDF5 file (the contract's layout).
 
-    ``unit`` and ``sampling_rate``, where given, replace the file's (the record's ``replaced`` says so);
-    ``axes`` places channel directions given as axes X, Y, Z on the cable (the reader option).
+    ``unit``, where given, replaces the file's (the record's ``replaced`` says so); ``sampling_rate`` stands
+    in for a missing attribute, and must agree with the file's within 1e-6 relative unless
+    ``override_sampling_rate`` (:mod:`~stcs_ident.io.records.rates`); ``axes`` places channel directions
+    given as axes X, Y, Z on the cable (the reader option).
 
     Returns
     -------
@@ -93,14 +97,14 @@ def read_record(path: str | os.PathLike, *, unit: str | None = None, sampling_ra
     """
     file = str(path)
     try:
-        return _read(file, {"unit": unit, "sampling_rate": sampling_rate}, axes)
+        return _read(file, {"unit": unit, "sampling_rate": sampling_rate}, axes, override_sampling_rate)
     except InputError:
         raise
     except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # h5py on a corrupt file
         raise InputError(f"cannot read the record (a corrupt HDF5 file?): {one_line(err)}", file=file) from None
 
 
-def _read(file: str, options: dict[str, Any], axes: Any = None) -> Record:
+def _read(file: str, options: dict[str, Any], axes: Any = None, override: bool = False) -> Record:
     with _open_hdf5(file) as h5:
         if (fmt := _attr(h5.attrs, "format", str, file)) != FORMAT:
             raise InputError(f"is {fmt!r}, expected {FORMAT!r}", field="format", file=file)
@@ -111,7 +115,10 @@ def _read(file: str, options: dict[str, Any], axes: Any = None) -> Record:
         found = {key: _attr(h5.attrs, key, kind, file)  # required unless the options give it
                  for key, kind in (("sampling_rate", float), ("unit", str))
                  if options[key] is None or key in h5.attrs}
-        sampling_rate = overridden("sampling_rate", found.get("sampling_rate"), options, replaced)
+        own = found.get("sampling_rate")
+        sampling_rate = resolved_rate(options["sampling_rate"],
+                                      None if own is None else FileRate(own, "attribute sampling_rate"),
+                                      override=override, file=file, replaced=replaced)
         unit = overridden("unit", found.get("unit"), options, replaced)
         start_time = _attr(h5.attrs, "start_time", str, file) if "start_time" in h5.attrs else None
         temperature = _attr(h5.attrs, "temperature", float, file) if "temperature" in h5.attrs else None
@@ -121,6 +128,9 @@ def _read(file: str, options: dict[str, Any], axes: Any = None) -> Record:
         directions = _directions(h5, file)
     if acceleration.dtype.kind != "f":
         raise InputError(f"must be float32 or float64, got {acceleration.dtype}", field="acceleration", file=file)
+    if positions.dtype.kind not in "fiu":
+        raise InputError(f"must be real numbers (m from end A, float64), got {positions.dtype}",
+                         field="channel_position", file=file)
     if directions is not None and acceleration.ndim == 2:  # (another shape is refused as every record's)
         if directions.size != acceleration.shape[1]:
             raise InputError(f"must have {acceleration.shape[1]} entries, one per channel, got {directions.size}",

@@ -2,10 +2,15 @@
 
 The record is one numeric matrix, (n_samples, n_channels) as MATLAB shows it
 (a vector is one channel): the variable named by the ``variable`` option, or
-the file's only matrix. Beside it the file may hold:
+the file's only matrix. It may be a field of a struct (``rec.acc``, nested
+structs as ``a.b.acc``; a 1x1 struct, v5 and v7.3 alike): then each of the
+variables below is looked for in the same struct first (``rec.fs``), then
+at the top level of the file. Beside it the file may hold:
 
-- ``fs`` (or ``Fs``, ``sampling_rate``): the sampling rate, Hz, one number
-  (MATLAB's 1×1 array); the ``sampling_rate`` option replaces it or stands in;
+- ``fs`` (or ``Fs``, ``FS``, ``sampling_rate``): the sampling rate, Hz, one
+  number (MATLAB's 1×1 array); the ``sampling_rate`` option stands in for
+  it, and must agree with it to 1e-6 relative unless
+  ``override_sampling_rate`` (:mod:`~stcs_ident.io.records.rates`);
 - ``channel_names``: a cell array of strings (or a char matrix), one per
   column; without it the campaign's channel table names the columns in order;
 - ``unit`` (a string; the ``unit`` option replaces it; default m/s²),
@@ -35,12 +40,15 @@ from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader, file_head
 from .directions import file_directions
+from .rates import FileRate, resolved_rate
 from .validation import names_from_positions, one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "MatlabReader", "record_from_mat"]
 
 #: Names the sampling rate goes by in the files of data loggers, in the order they are looked for.
 RATE_NAMES = ("fs", "Fs", "FS", "sampling_rate")
+#: Depth of nested structs read (``a.b.c`` is depth 2).
+MAX_DEPTH = 8
 #: Variables of the file that are not the record's matrix.
 _METADATA = (*RATE_NAMES, "channel_names", "channel_directions", "unit", "start_time", "temperature")
 
@@ -55,10 +63,12 @@ class MatlabReader(RecordReader):
         return file_head(path, 128).startswith(b"MATLAB")
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_mat` with the options ``variable``, ``sampling_rate``, ``unit`` and ``axes``."""
+        """:func:`record_from_mat` with the options ``variable``, ``sampling_rate``, ``unit``, ``axes`` and
+        ``override_sampling_rate``."""
         return record_from_mat(path, positions, variable=options.get("variable"),
                                sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
-                               axes=options.get("axes"))
+                               axes=options.get("axes"),
+                               override_sampling_rate=bool(options.get("override_sampling_rate", False)))
 
 
 READER = MatlabReader()
@@ -66,45 +76,52 @@ READER = MatlabReader()
 
 def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
                     variable: str | None = None, sampling_rate: float | None = None,
-                    unit: str | None = None, axes: Any = None) -> Record:
+                    unit: str | None = None, axes: Any = None, override_sampling_rate: bool = False) -> Record:
     """Read a record from a MATLAB file (see the module docstring).
 
     Raises
     ------
     InputError
         Naming the file: not a MATLAB file, no such variable (field ``variable``), several matrices and no
-        ``variable`` option, no sampling rate (field ``sampling_rate``), a transposed matrix, and the checks
-        of every record.
+        ``variable`` option, no sampling rate (field ``sampling_rate``), a given sampling rate that disagrees
+        with the file's (:mod:`~stcs_ident.io.records.rates`), a transposed matrix, and the checks of every
+        record.
     """
     file = os.fspath(path)
     variables = _load(file)
-    matrices = [k for k, v in variables.items() if k not in _METADATA and isinstance(v, np.ndarray) and v.size > 1]
+    matrices = [k for k, v in variables.items() if _leaf(k) not in _METADATA and isinstance(v, np.ndarray)
+                and v.dtype.names is None and v.size > 1]
     if variable is None:
         if len(matrices) != 1:
             found = ", ".join(matrices) or "none"
             raise InputError(f"cannot tell the record's matrix (numeric variables: {found}): give variable = "
-                             "\"<name>\" in record_format", field="variable", file=file)
+                             "\"<name>\" in record_format (a field of a struct as \"rec.acc\")", field="variable",
+                             file=file)
         variable = matrices[0]
     if variable not in variables:
         raise InputError(f"no variable {variable!r} in the file (variables: {', '.join(variables) or 'none'}); "
                          "give the right one as variable in record_format", field="variable", file=file)
     acceleration = _matrix(variables[variable], variable, file)
+    prefix = variable.rpartition(".")[0]
+    meta = {name: _beside(variables, prefix, name) for name in _METADATA}  # the struct's field, else the file's
     replaced: list = []
-    rate = overridden("sampling_rate", _rate(variables, file), {"sampling_rate": sampling_rate}, replaced)
+    rate = resolved_rate(sampling_rate, _rate(meta, file), override=override_sampling_rate, file=file,
+                         replaced=replaced)
     if rate is None:
-        raise InputError(f"no sampling rate: the file holds none of {', '.join(RATE_NAMES)}; give sampling_rate "
+        where = f"struct {prefix!r} nor the file hold" if prefix else "file holds"
+        raise InputError(f"no sampling rate: the {where} none of {', '.join(RATE_NAMES)}; give sampling_rate "
                          "in record_format", field="sampling_rate", file=file)
-    unit = overridden("unit", _text(variables, "unit", file), {"unit": unit}, replaced) or "m/s^2"
-    names = variables.get("channel_names")
+    unit = overridden("unit", _text(meta, "unit", file), {"unit": unit}, replaced) or "m/s^2"
+    names = _value(meta, "channel_names")
     if names is None:
         names = names_from_positions(acceleration.shape[1], positions, file)
     elif isinstance(names, str):
         names = [names]
     channel_positions = position_list(list(names), positions_by_name(list(names), positions or {}, file), file)
-    temperature = variables.get("temperature")
+    temperature = _value(meta, "temperature")
     if temperature is not None:
-        temperature = _one_number(temperature, "temperature", file)
-    directions = variables.get("channel_directions")
+        temperature = _one_number(temperature, meta["temperature"][0], file)
+    directions = _value(meta, "channel_directions")
     if directions is not None:
         directions = [directions] if isinstance(directions, str) else directions
         if not isinstance(directions, list) or len(directions) != acceleration.shape[1]:
@@ -113,12 +130,32 @@ def record_from_mat(path: str | os.PathLike, positions: Mapping[str, float] | No
                              field="channel_directions", file=file)
         directions = file_directions(directions, list(names), axes=axes, file=file, field="channel_directions")
     return validated_record(acceleration, rate, names, channel_positions, unit=unit,
-                            start_time=_text(variables, "start_time", file), source=file,
+                            start_time=_text(meta, "start_time", file), source=file,
                             temperature=temperature, replaced=replaced, directions=directions)
 
 
+def _leaf(key: str) -> str:
+    """The last part of a dotted name (``"rec.fs"``: ``"fs"``)."""
+    return key.rpartition(".")[2]
+
+
+def _beside(variables: dict[str, Any], prefix: str, name: str) -> tuple[str, Any] | None:
+    """(its full name, value) of variable ``name`` in the struct ``prefix`` (a field of it), else at the top
+    level of the file; None if neither holds it."""
+    for key in (f"{prefix}.{name}" if prefix else None, name):
+        if key is not None and key in variables:
+            return key, variables[key]
+    return None
+
+
+def _value(meta: dict[str, tuple[str, Any] | None], name: str) -> Any:
+    found = meta.get(name)
+    return None if found is None else found[1]
+
+
 def _load(file: str) -> dict[str, Any]:
-    """The file's variables: numeric arrays in MATLAB's shape, strings, lists of strings."""
+    """The file's variables: numeric arrays in MATLAB's shape, strings, lists of strings; the fields of a 1x1
+    struct as ``struct.field`` (nested structs as ``a.b.c``)."""
     if not os.path.exists(file):
         raise InputError("file not found", file=file)
     head = file_head(file, 1024)
@@ -132,9 +169,23 @@ def _load(file: str) -> dict[str, Any]:
         raise
     except NotImplementedError as err:
         raise InputError(f"a MATLAB format this toolkit does not read: {one_line(err)}", file=file) from None
-    except (OSError, ValueError, TypeError, KeyError, IndexError, RuntimeError) as err:
+    except (OSError, ValueError, TypeError, KeyError, IndexError, RuntimeError, AttributeError,
+            RecursionError) as err:
         raise InputError(f"not a MATLAB file this toolkit reads (v5 or v7.3): {one_line(err)}", file=file) from None
-    return {key: _v5_value(value) for key, value in raw.items() if not key.startswith("__")}
+    out: dict[str, Any] = {}
+    for key, value in raw.items():
+        if not key.startswith("__"):
+            _flatten_v5(key, value, out, 0)
+    return out
+
+
+def _flatten_v5(key: str, value: Any, out: dict[str, Any], depth: int) -> None:
+    if isinstance(value, np.ndarray) and value.dtype.names and value.size == 1 and depth < MAX_DEPTH:
+        item = value.reshape(-1)[0]
+        for field in value.dtype.names:
+            _flatten_v5(f"{key}.{field}", item[field], out, depth + 1)
+        return
+    out[key] = _v5_value(value)
 
 
 def _v5_value(value: Any) -> Any:
@@ -149,18 +200,30 @@ def _v5_value(value: Any) -> Any:
 def _load_v73(file: str) -> dict[str, Any]:
     out: dict[str, Any] = {}
     with h5py.File(file, "r") as h5:
-        for key, node in h5.items():
-            if key.startswith("#") or not isinstance(node, h5py.Dataset) or node.attrs.get("MATLAB_empty", 0):
-                continue
-            kind = node.attrs.get("MATLAB_class", b"double")
-            kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-            if kind == "char":
-                out[key] = _v73_chars(node[()])
-            elif kind == "cell":
-                out[key] = [_v73_chars(h5[ref][()]) for ref in node[()].T.ravel()]
-            else:
-                out[key] = np.asarray(node[()]).T  # column-major: back to MATLAB's (rows, columns)
+        _flatten_v73(h5, h5, "", out, 0)
     return out
+
+
+def _flatten_v73(h5: h5py.File, group: h5py.Group, prefix: str, out: dict[str, Any], depth: int) -> None:
+    """The datasets of ``group`` into ``out`` by dotted name, a struct (a group) field by field."""
+    for key, node in group.items():
+        if key.startswith("#"):
+            continue
+        name = f"{prefix}{key}"
+        if isinstance(node, h5py.Group):
+            if depth < MAX_DEPTH:
+                _flatten_v73(h5, node, f"{name}.", out, depth + 1)
+            continue
+        if not isinstance(node, h5py.Dataset) or node.attrs.get("MATLAB_empty", 0):
+            continue
+        kind = node.attrs.get("MATLAB_class", b"double")
+        kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+        if kind == "char":
+            out[name] = _v73_chars(node[()])
+        elif kind == "cell":
+            out[name] = [_v73_chars(h5[ref][()]) for ref in node[()].T.ravel()]
+        else:
+            out[name] = np.asarray(node[()]).T  # column-major: back to MATLAB's (rows, columns)
 
 
 def _v73_chars(codes: np.ndarray) -> str:
@@ -180,10 +243,12 @@ def _matrix(value: Any, name: str, file: str) -> np.ndarray:
     return value
 
 
-def _rate(variables: dict[str, Any], file: str) -> float | None:
+def _rate(meta: dict[str, tuple[str, Any] | None], file: str) -> FileRate | None:
+    """The file's rate: the first of :data:`RATE_NAMES` in the record's struct, else at the top level."""
     for name in RATE_NAMES:
-        if name in variables:
-            return _one_number(variables[name], name, file)
+        if meta.get(name) is not None:
+            key, value = meta[name]
+            return FileRate(_one_number(value, key, file), f"variable {key!r}")
     return None
 
 
@@ -194,8 +259,8 @@ def _one_number(value: Any, name: str, file: str) -> float:
     return float(value.reshape(()))
 
 
-def _text(variables: dict[str, Any], name: str, file: str) -> str | None:
-    value = variables.get(name)
-    if value is not None and not isinstance(value, str):
-        raise InputError(f"variable {name!r} must be a string", field=name, file=file)
-    return value
+def _text(meta: dict[str, tuple[str, Any] | None], name: str, file: str) -> str | None:
+    found = meta.get(name)
+    if found is not None and not isinstance(found[1], str):
+        raise InputError(f"variable {found[0]!r} must be a string", field=name, file=file)
+    return None if found is None else found[1]

@@ -5,7 +5,10 @@ One table, :data:`OPTIONS`, names every option and the kind of its value;
 turns it into an error naming the key, :func:`check_options` into one naming
 the record file), :func:`option_value` gives the value as the readers take
 it. Each reader uses the options that apply to its format and ignores the
-others: one campaign may give options for several formats.
+others: one campaign may give options for several formats. ``channels``,
+``header_row`` and ``skip_rows`` apply to text files (CSV, TOA5 and LVM as
+their readers say); ``override_sampling_rate`` to every format whose file has
+a rate of its own (:mod:`~stcs_ident.io.records.rates`).
 """
 
 from __future__ import annotations
@@ -30,6 +33,9 @@ OPTIONS = {
     "separator": "one character (the column separator)",
     "decimal": "one character (the decimal mark)",
     "skip_rows": "a list of line numbers >= 1 (0-based, the header is line 0)",
+    "header_row": "a line number >= 0 (0-based: the file's line that names the columns, after a preamble)",
+    "channels": "a list of column names, at least one, each once (the acceleration channels of a text file)",
+    "override_sampling_rate": "true or false (whether sampling_rate replaces a rate of the file's that differs)",
     "start_time": "an ISO 8601 date-time, YYYY-MM-DD[Thh:mm[:ss[.f]]][Z|±hh:mm], from 1677-09-22 to 2262-04-10",
     "temperature": "a number of degC",
     "variable": "a non-empty string (the MATLAB variable)",
@@ -59,6 +65,14 @@ def option_problem(key: str, value: Any) -> str | None:
                                                      for v in value)
     elif key == "start_time":
         ok = instant_problem(value.isoformat() if isinstance(value, datetime) else value) is None
+    elif key == "header_row":
+        ok = isinstance(value, int) and not isinstance(value, bool) and value >= 0
+    elif key == "channels":
+        ok = (isinstance(value, list | tuple) and len(value) > 0
+              and all(isinstance(v, str) and v.strip() == v and bool(v) for v in value)
+              and len(set(value)) == len(value))
+    elif key == "override_sampling_rate":
+        ok = isinstance(value, bool)
     elif key == "unit":
         ok = isinstance(value, str) and value.strip() in UNITS
     else:
@@ -71,6 +85,8 @@ def option_value(key: str, value: Any) -> Any:
     (axis, direction) pairs in the order X, Y, Z."""
     if key == "skip_rows":
         return tuple(int(v) for v in value)
+    if key == "channels":
+        return tuple(value)
     if key == "axes":
         return axes_value(value)
     if key == "start_time" and isinstance(value, datetime):

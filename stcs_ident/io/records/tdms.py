@@ -5,7 +5,9 @@ only group with channels), one TDMS channel per record channel, named as in
 the file; their positions come from the campaign's channel table. From each
 channel's properties: ``wf_increment`` (s) gives the sampling rate,
 ``wf_start_time`` the start time, ``unit_string`` the unit; the options
-``sampling_rate``, ``start_time`` and ``unit`` replace or stand in for them.
+``start_time`` and ``unit`` replace or stand in for them; ``sampling_rate``
+stands in for a missing ``wf_increment`` and must agree with one within 1e-6
+relative unless ``override_sampling_rate`` (:mod:`~.rates`).
 Every channel must agree on the rate and the unit and have as many samples.
 
 A channel's property ``direction`` gives its direction: ``in``, ``out``,
@@ -29,6 +31,7 @@ from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader, file_head
 from .directions import file_directions
+from .rates import FileRate, resolved_rate
 from .validation import one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "TdmsReader", "record_from_tdms"]
@@ -47,10 +50,12 @@ class TdmsReader(RecordReader):
         return file_head(path, 4) == b"TDSm"
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_tdms` with the options ``group``, ``sampling_rate``, ``unit`` and ``axes``."""
+        """:func:`record_from_tdms` with the options ``group``, ``sampling_rate``, ``unit``, ``axes`` and
+        ``override_sampling_rate``."""
         return record_from_tdms(path, positions, group=options.get("group"),
                                 sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
-                                axes=options.get("axes"))
+                                axes=options.get("axes"),
+                                override_sampling_rate=bool(options.get("override_sampling_rate", False)))
 
 
 READER = TdmsReader()
@@ -58,7 +63,7 @@ READER = TdmsReader()
 
 def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
                      group: str | None = None, sampling_rate: float | None = None,
-                     unit: str | None = None, axes: Any = None) -> Record:
+                     unit: str | None = None, axes: Any = None, override_sampling_rate: bool = False) -> Record:
     """Read a record from a TDMS file (see the module docstring).
 
     Raises
@@ -92,7 +97,8 @@ def record_from_tdms(path: str | os.PathLike, positions: Mapping[str, float] | N
         raise InputError(f"the channels of group {group!r} have different lengths ({sorted(lengths)})",
                          field="acceleration", file=file)
     replaced: list = []
-    rate = overridden("sampling_rate", _file_rate(channels, file), {"sampling_rate": sampling_rate}, replaced)
+    rate = resolved_rate(sampling_rate, _file_rate(channels, file), override=override_sampling_rate, file=file,
+                         replaced=replaced)
     if rate is None:
         raise InputError("no sampling rate: the channels have no wf_increment; give sampling_rate in record_format",
                          field="sampling_rate", file=file)
@@ -113,7 +119,7 @@ def _property(channel: Any, key: str) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def _file_rate(channels: list, file: str) -> float | None:
+def _file_rate(channels: list, file: str) -> FileRate | None:
     increments = [channel.properties.get("wf_increment") for channel in channels]
     if all(step is None for step in increments):
         return None
@@ -124,7 +130,7 @@ def _file_rate(channels: list, file: str) -> float | None:
     if np.ptp(steps) > RATE_AGREEMENT * steps[0]:
         raise InputError(f"the channels are sampled at different rates (wf_increment {sorted(set(steps))} s)",
                          field="sampling_rate", file=file)
-    return float(1.0 / steps[0])
+    return FileRate(float(1.0 / steps[0]), "wf_increment", detail=f"{steps[0]:.10g} s")
 
 
 def _agreed(channels: list, key: str, file: str) -> Any:

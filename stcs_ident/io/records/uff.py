@@ -4,10 +4,12 @@ Each dataset 58 of the file that is a time response (function type 1) is one
 channel, named by its response entity name (``rsp_ent_name``) or, where that
 is blank, its response node number; the positions come from the campaign's
 channel table. The abscissa increment (``abscissa_inc``, s) gives the
-sampling rate and the ordinate's units label the unit; the options
-``sampling_rate`` and ``unit`` replace or stand in for them. The format
-prints the increment to six significant digits: where that is not the exact
-step (1/2048 s, say), give ``sampling_rate``. The file holds no start time:
+sampling rate and the ordinate's units label the unit; the option ``unit``
+replaces or stands in for the unit, ``sampling_rate`` stands in for a missing
+increment. The format prints the increment to six significant digits: where
+that is not the exact step (1/2048 s, say), give ``sampling_rate``, which
+must agree with it within that rounding (:data:`PRINTED_RTOL`) unless
+``override_sampling_rate`` (:mod:`~.rates`). The file holds no start time:
 give ``start_time`` where one is needed.
 
 Each dataset's response direction (``rsp_dir``: 1, 2, 3 for +X, +Y, +Z,
@@ -31,12 +33,16 @@ from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader
 from .directions import AXES, file_directions
+from .rates import STORED_RTOL, FileRate, resolved_rate
 from .validation import one_line, overridden, position_list, positions_by_name, validated_record
 
 __all__ = ["READER", "UffReader", "record_from_uff"]
 
 #: Function type of a time response in dataset 58.
 TIME_RESPONSE = 1
+#: Relative agreement of a given rate with the abscissa increment's: the format prints it to six significant
+#: digits (half a unit of the sixth is at most 5e-6 of it), plus the stored-number agreement of :mod:`.rates`.
+PRINTED_RTOL = 5e-6 + STORED_RTOL
 #: Relative difference of two datasets' abscissa increments still taken as one rate.
 RATE_AGREEMENT = 1e-9
 _BLANK = ("", "NONE")
@@ -49,16 +55,19 @@ class UffReader(RecordReader):
     suffixes = (".uff", ".unv")
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`record_from_uff` with the options ``sampling_rate``, ``unit`` and ``axes``."""
+        """:func:`record_from_uff` with the options ``sampling_rate``, ``unit``, ``axes`` and
+        ``override_sampling_rate``."""
         return record_from_uff(path, positions, sampling_rate=options.get("sampling_rate"), unit=options.get("unit"),
-                               axes=options.get("axes"))
+                               axes=options.get("axes"),
+                               override_sampling_rate=bool(options.get("override_sampling_rate", False)))
 
 
 READER = UffReader()
 
 
 def record_from_uff(path: str | os.PathLike, positions: Mapping[str, float] | None = None, *,
-                    sampling_rate: float | None = None, unit: str | None = None, axes: Any = None) -> Record:
+                    sampling_rate: float | None = None, unit: str | None = None, axes: Any = None,
+                    override_sampling_rate: bool = False) -> Record:
     """Read a record from the datasets 58 of a universal file (see the module docstring).
 
     Raises
@@ -86,7 +95,8 @@ def record_from_uff(path: str | os.PathLike, positions: Mapping[str, float] | No
     if len(lengths) != 1:
         raise InputError(f"the datasets have different lengths ({sorted(lengths)})", field="acceleration", file=file)
     replaced: list = []
-    rate = overridden("sampling_rate", _file_rate(sets, file), {"sampling_rate": sampling_rate}, replaced)
+    rate = resolved_rate(sampling_rate, _file_rate(sets, file), override=override_sampling_rate, file=file,
+                         replaced=replaced)
     if rate is None:
         raise InputError("a dataset has no abscissa increment (an uneven abscissa?); give sampling_rate in "
                          "record_format", field="sampling_rate", file=file)
@@ -122,11 +132,11 @@ def _name(dataset: Mapping[str, Any]) -> str:
     return str(dataset.get("rsp_node")) if name in _BLANK else name
 
 
-def _file_rate(sets: list[Mapping[str, Any]], file: str) -> float | None:
+def _file_rate(sets: list[Mapping[str, Any]], file: str) -> FileRate | None:
     steps = np.asarray([float(s.get("abscissa_inc") or 0.0) for s in sets])
     if not np.all(steps > 0):
         return None
     if np.ptp(steps) > RATE_AGREEMENT * steps[0]:
         raise InputError(f"the datasets are sampled at different rates (abscissa_inc {sorted(set(steps))} s)",
                          field="sampling_rate", file=file)
-    return float(1.0 / steps[0])
+    return FileRate(float(1.0 / steps[0]), "abscissa increment", rtol=PRINTED_RTOL, detail=f"{steps[0]:.6g} s")

@@ -125,11 +125,11 @@ def check_bandwidth(record: Record, f1: float, usable: float = 0.45, margin: flo
 def validated_record(
     acceleration: Any, sampling_rate: Any, names: Any, positions: Any,
     *, unit: str, start_time: str | None, source: str | None, temperature: float | None = None,
-    replaced: Iterable[tuple[str, Any, Any]] = (), directions: Any = None,
+    replaced: Iterable[tuple[str, Any, Any]] = (), directions: Any = None, notes: Iterable[str] = (),
 ) -> Record:
     """Check the parts of a record, convert to m/s², drop dead and clipped channels (``replaced``: the file's
     values that the campaign's options replaced, :func:`overridden`; ``directions``: one per channel, or None
-    when the file gives none)."""
+    when the file gives none; ``notes``: what the reader did that a user should know, the record's ``notes``)."""
     file = source
     given = acceleration
     acceleration = check_shape(np.asarray(acceleration, dtype=float), file)
@@ -152,7 +152,7 @@ def validated_record(
         channel_names=tuple(names[k] for k in keep), channel_positions=positions[keep],
         start_time=start_time, source=source, dropped=tuple(dropped), temperature=temperature,
         replaced=tuple(replaced),
-        channel_directions=None if directions is None else tuple(directions[k] for k in keep),
+        channel_directions=None if directions is None else tuple(directions[k] for k in keep), notes=tuple(notes),
     )
 
 
