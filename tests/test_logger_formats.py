@@ -28,6 +28,7 @@ from stcs_ident.core.errors import CampaignError, InputError
 from stcs_ident.core.record import STANDARD_GRAVITY, Record
 from stcs_ident.io.campaign import campaign_to_toml, load_campaign
 from stcs_ident.io.records import read_record
+from stcs_ident.io.test_record import record_reading
 from stcs_ident.simulate.simulate import Impulse
 from stcs_ident.simulate.simulate_campaign import simulate_campaign
 from stcs_ident.spectra.pipeline import analyse_test
@@ -162,7 +163,7 @@ def test_every_logger_format_gives_the_frequencies_of_the_hdf5_record(simulated,
     _, _, record, reference = simulated
     campaign = _as_campaign(simulated, tmp_path, kind)
     test = campaign.test("T2")
-    positions, options = campaign.record_reading(test)
+    positions, options = _reading(campaign, test)
     read = read_record(Path(campaign.directory) / test.record, positions=positions, **options)
     assert read.channel_names == record.channel_names and read.sampling_rate == record.sampling_rate
     assert read.start_time == START  # from the file (date-times, .mat, TDMS) or the option (CSV, UFF)
@@ -175,7 +176,7 @@ def test_every_logger_format_gives_the_frequencies_of_the_hdf5_record(simulated,
 def test_an_option_that_replaces_the_file_s_value_is_recorded_on_the_record(simulated, tmp_path):
     campaign = _as_campaign(simulated, tmp_path, "tdms")
     path = Path(campaign.directory) / campaign.test("T2").record
-    positions, options = campaign.record_reading(campaign.test("T2"))
+    positions, options = _reading(campaign, campaign.test("T2"))
     record = read_record(path, positions=positions, **options, start_time="2026-03-05T00:00:00+00:00",
                          temperature=4.5)
     assert record.start_time == "2026-03-05T00:00:00+00:00" and record.temperature == 4.5
@@ -317,9 +318,9 @@ def test_channels_inline_and_every_option_round_trip(tmp_path):
     again = load_campaign(tmp_path / "again")
     assert replace(again, directory=None) == replace(campaign, directory=None)
     # The test's own table and options win over the campaign's top-level ones.
-    positions, merged = campaign.record_reading(test)
+    positions, merged = _reading(campaign, test)
     assert positions == {"acc1": 4.5, "acc3": 6.9} and merged["unit"] == "g"
-    positions, merged = campaign.record_reading(campaign.test("T1"))
+    positions, merged = _reading(campaign, campaign.test("T1"))
     assert positions == {"x": 1.0} and merged == {"unit": "mg"}
 
 
@@ -390,3 +391,9 @@ def test_the_command_line_refuses_a_rounded_csv_in_one_line_naming_the_file_and_
     (err,) = [line for line in capsys.readouterr().err.splitlines() if line.startswith("stcs-ident:")]  # progress aside
     assert "T2.csv" in err and "field 'time'" in err, err
     assert "give sampling_rate" in err and not (tmp_path / "out.json").exists()
+
+
+def _reading(campaign, test):
+    """(positions, reader options) of ``test``'s record, as io gives them."""
+    reading = record_reading(campaign, test)
+    return reading.positions, reading.options

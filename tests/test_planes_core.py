@@ -20,6 +20,7 @@ from stcs_ident.core.planes import (
 )
 from stcs_ident.core.record import Record
 from stcs_ident.io.campaign import campaign_to_toml, load_campaign
+from stcs_ident.io.test_record import record_reading
 
 STAY = Cable(length=300.0, mass_per_length=100.0, EI=1.0e5, EA=2.0e9, inclination=math.radians(30))
 
@@ -163,7 +164,7 @@ def test_a_campaign_gives_planes_directions_angles_and_round_trips(tmp_path):
     campaign = load_campaign(_write(tmp_path, CAMPAIGN.format(planes='planes = ["in", "out", "out"]')))
     assert campaign.tests[0].planes == ("in", "out", "out")
     assert dict(campaign.channel_directions) == {"acc1": "in", "acc2": "out", "acc3": "axial"}
-    assert campaign.record_directions(campaign.tests[0]) == {"acc1": "in", "acc2": "out", "acc3": "axial"}
+    assert record_reading(campaign, campaign.tests[0]).directions == {"acc1": "in", "acc2": "out", "acc3": "axial"}
     clamp, damper = sorted(campaign.setup("S").attachments, key=lambda a: a.name)
     assert clamp.stiffness_out == 2.0e4 and damper.angle == pytest.approx(math.radians(30))
     again = tmp_path / "again"
@@ -215,4 +216,4 @@ def test_a_campaign_round_trip_of_the_model_objects():
     campaign = Campaign("c", STAY, (Setup("S", (Attachment("a", 10.0, stiffness_out=1.0),)),),
                         (Test("T", "S", 4e6, (0.33,), planes=("out",), channel_directions={"x": 45.0}),))
     assert campaign.tests[0].channel_directions == (("x", 45.0),)
-    assert campaign.record_directions(campaign.tests[0]) == {"x": 45.0}
+    assert record_reading(campaign, campaign.tests[0]).directions == {"x": 45.0}

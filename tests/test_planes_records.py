@@ -28,6 +28,7 @@ from stcs_ident.io.records.hdf5 import write_record
 from stcs_ident.io.records.options import option_problem
 from stcs_ident.io.records.sep005 import write_sep005
 from stcs_ident.io.records.validation import check_positions
+from stcs_ident.io.test_record import record_reading
 
 NAMES = ("p1_in", "p1_out", "p1_ax", "p2_in", "p2_out", "p2_ax")
 POSITIONS = (4.0, 4.0, 4.0, 9.0, 9.0, 9.0)
@@ -337,7 +338,7 @@ def _campaign(directory: Path, record: str = "r.csv", top: str = 'a = { position
 def test_the_campaign_keeps_directions_and_axes_through_its_round_trip(tmp_path):
     first = load_campaign(_campaign(tmp_path / "a"))
     test = first.tests[0]
-    assert first.record_directions(test) == dict(zip(NAMES, DIRECTIONS))
+    assert record_reading(first, test).directions == dict(zip(NAMES, DIRECTIONS))
     assert dict(first.record_format)["axes"] == (("X", "axial"), ("Y", "in"), ("Z", 30.0))
     assert dict(test.record_format)["axes"] == (("X", "axial"), ("Y", "in"), ("Z", "out"))
     text = campaign_to_toml(first)
@@ -366,8 +367,8 @@ def test_a_triaxial_csv_record_is_read_as_the_spectra_read_it(triaxial, tmp_path
     _write_csv(triaxial, directory / "r.csv")
     campaign = load_campaign(directory)
     test = campaign.tests[0]
-    positions, options = campaign.record_reading(test)
-    read = read_record(directory / "r.csv", positions=positions, directions=campaign.record_directions(test),
+    positions, options = _reading(campaign, test)
+    read = read_record(directory / "r.csv", positions=positions, directions=record_reading(campaign, test).directions,
                        **options)
     _same(read, triaxial)
 
@@ -377,8 +378,8 @@ def test_a_triaxial_uff_record_is_placed_by_the_campaign_axes(triaxial, tmp_path
     directory = _campaign(tmp_path / "a", record="r.uff", top="a = 1.0", test=test)
     _write_uff(triaxial, directory / "r.uff", UFF_CODES)
     campaign = load_campaign(directory)
-    positions, options = campaign.record_reading(campaign.tests[0])
-    assert campaign.record_directions(campaign.tests[0]) is None
+    positions, options = _reading(campaign, campaign.tests[0])
+    assert record_reading(campaign, campaign.tests[0]).directions is None
     _same(read_record(directory / "r.uff", positions=positions, **options), triaxial)
 
 
@@ -409,3 +410,9 @@ def test_track_reads_a_record_with_the_campaigns_directions(triaxial, tmp_path, 
     assert row["reason"].endswith("stub: the analysis is not this test's")
     _same(seen["record"], triaxial)
     assert seen["test"].channel_directions == tuple(zip(NAMES, DIRECTIONS))
+
+
+def _reading(campaign, test):
+    """(positions, reader options) of ``test``'s record, as io gives them."""
+    reading = record_reading(campaign, test)
+    return reading.positions, reading.options

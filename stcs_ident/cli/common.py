@@ -172,7 +172,7 @@ class EscapedStream:
 
 def campaign_inputs(campaign, file: str) -> list[str]:
     """The files a command on ``campaign`` reads: its campaign file and every test's record."""
-    from ..spectra.pipeline import record_path
+    from ..io.test_record import record_path
 
     return [file] + [record_path(campaign, t) for t in campaign.tests if t.record is not None]
 

@@ -492,17 +492,6 @@ class Campaign:
                 return t
         raise KeyError(name)
 
-    def record_reading(self, test: Test) -> tuple[dict[str, float] | None, dict[str, Any]]:
-        """How to read ``test``'s record: the channel positions (the test's table, else the campaign's; None
-        if neither) and the reader options (the campaign's ``record_format`` updated with the test's)."""
-        positions = dict(test.channels or self.channels) or None
-        return positions, {**dict(self.record_format), **dict(test.record_format)}
-
-    def record_directions(self, test: Test) -> dict[str, str | float] | None:
-        """The channel directions the campaign gives for ``test``'s record (the test's table, else the
-        campaign's; None if neither: the file's directions, else in-plane)."""
-        return dict(test.channel_directions or self.channel_directions) or None
-
 
 def _directions(value: Any, field: str) -> tuple[tuple[str, str | float], ...]:
     """Channel directions as (name, direction) pairs (:func:`~stcs_ident.core.planes.check_direction`)."""

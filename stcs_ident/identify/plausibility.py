@@ -34,6 +34,7 @@ import numpy as np
 from ..core.errors import InputError
 from ..core.model import Campaign
 from ..forward import batch_frequencies
+from ..io.test_record import record_reading
 from ..spectra.scale_check import SCALE_BAND, round_factor
 from .problem import Measurement
 
@@ -249,7 +250,7 @@ def check_records(campaign: Campaign, picked, tension_model: str = "uniform") ->
     if factor is not None:
         given = next((g for option, g, _ in getattr(spectra, "record_replaced", ()) if option == "sampling_rate"),
                      None)
-        rate = dict(campaign.record_reading(campaign.test(first.test))[1]).get("sampling_rate")
+        rate = record_reading(campaign, campaign.test(first.test)).options.get("sampling_rate")
         word = f"{factor:g}× too high" if factor > 1 else f"{1 / factor:g}× too low"
         where = (f"test[{first.test}].record_format.sampling_rate ({rate:g} Hz)" if rate is not None else
                  "the record's sampling rate")

@@ -26,6 +26,7 @@ from ..core.model import Campaign
 from ..io.campaign import load_campaign
 from ..io.content import content_id
 from ..io.records import record_suffixes
+from ..io.test_record import record_reading
 
 __all__ = ["CableSpec", "cable_names", "content_id", "discover", "record_paths"]
 
@@ -70,10 +71,10 @@ def _cable(directory: Path) -> CableSpec:
         raise InputError("needs a test: its tension is the reference that numbers the modes of the records, and "
                          "its setup what is attached", field="test", file=file)
     test = campaign.tests[0]
-    positions, options = campaign.record_reading(test)
+    reading = record_reading(campaign, test)
     return CableSpec(directory.name, str(directory), campaign, test.setup, float(test.tension),
-                     tuple((positions or {}).items()), tuple(options.items()),
-                     tuple((campaign.record_directions(test) or {}).items()))
+                     tuple((reading.positions or {}).items()), tuple(reading.options.items()),
+                     tuple((reading.directions or {}).items()))
 
 
 def record_paths(spec: CableSpec) -> list[Path]:

@@ -46,7 +46,7 @@ from pathlib import Path
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.model import Damper, Test
 from ..identify import IdentifiabilityWarning, identify
-from ..io.records import read_record
+from ..io.test_record import open_test_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec
 
@@ -76,17 +76,16 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
            "damping": [], "damping_sigma": [], "coefficient": math.nan, "coefficient_sigma": math.nan,
            "coefficient_reason": ""}
     try:
-        record = read_record(path, positions=dict(spec.channels) or None, directions=dict(spec.directions) or None,
-                             **dict(spec.record_format))
-        row["start_time"] = record.start_time
-        row["temperature"] = math.nan if record.temperature is None else float(record.temperature)
-        if record.start_time is None:
-            raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
         # The record as a test of the cable's campaign: its setup, the reference tension, its path in the campaign.
         test = Test(name=relative, setup=spec.setup, tension=spec.reference_tension, record=relative,
                     channels=spec.channels, record_format=spec.record_format,
                     channel_directions=spec.directions)
-        campaign = replace(spec.campaign, tests=(test,))
+        campaign = replace(spec.campaign, tests=(test,), directory=spec.directory)
+        path, record = open_test_record(campaign, test)
+        row["start_time"] = record.start_time
+        row["temperature"] = math.nan if record.temperature is None else float(record.temperature)
+        if record.start_time is None:
+            raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
         spectra = analyse_record(campaign, test, record, path, max_modes=MAX_MODES)
         if not spectra.modes:
             raise ComputationError("no mode found in the record")
