@@ -167,21 +167,24 @@ def _ctrl_c() -> Iterator[list]:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-def _as_option(err: InputError, command: str, parser: argparse.ArgumentParser) -> InputError:
+def _as_option(err: InputError, command: str, parser: argparse.ArgumentParser,
+               args: argparse.Namespace | None = None) -> InputError:
     """``err`` naming the command's option when its field is an argument the option gave (the library
     names its own argument: ``params``, ``duration``, ``effects.extra_mass``), in one place for every command;
-    a command module may map other fields with ``field_options() -> {field: option}``."""
+    a command module may map other fields with ``field_options() -> {field: option}``. An option the user did
+    not give (its value the default in ``args``) is never named: the field stays the library's."""
     field = err.field or ""
     if not field or field.startswith("--"):
         return err
     module = command_module(command)
     aliases = module.field_options() if hasattr(module, "field_options") else {}
     option = aliases.get(field, "--" + field.replace("_", "-"))
-    options = {o for action in parser._subparsers._group_actions[0].choices[command]._actions
+    actions = {o: action for action in parser._subparsers._group_actions[0].choices[command]._actions
                for o in action.option_strings}
-    if option in options:
-        return InputError(err.message, field=option, file=err.file)
-    return err
+    action = actions.get(option)
+    if action is None or (args is not None and getattr(args, action.dest, action.default) == action.default):
+        return err
+    return InputError(err.message, field=option, file=err.file)
 
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
@@ -190,7 +193,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     except InputError as err:
         if args.debug:
             traceback.print_exc()
-        print(f"stcs-ident: {_as_option(err, args.command, parser)}", file=sys.stderr)
+        print(f"stcs-ident: {_as_option(err, args.command, parser, args)}", file=sys.stderr)
         return 2
     except (ComputationError, FloatingPointError) as err:
         if args.debug:

@@ -267,5 +267,10 @@ def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
         else:
             skipped.append((test.name, "no measured frequencies and no record"))
     if not out:
-        raise InputError("no selected test has measured frequencies or a record", field="test")
+        if not skipped:
+            raise InputError("the campaign has no test to identify from", field="test")
+        name, why = skipped[0]
+        where = "record" if campaign.test(name).record is not None else "frequencies"
+        reasons = "; ".join(f"{n}: {r}" for n, r in skipped)
+        raise InputError(f"no test is left to identify from ({reasons})", field=f"test[{name}].{where}")
     return out, skipped
