@@ -200,8 +200,10 @@ class Record:
         object.__setattr__(self, "sampling_rate", sampling_rate(self.sampling_rate, file=file))
         names = check_names(self.channel_names, self.acceleration.shape[1], file)
         object.__setattr__(self, "channel_names", tuple(names))
+        positions = np.asarray(self.channel_positions)
         object.__setattr__(self, "channel_positions", check_position_values(
-            np.asarray(self.channel_positions, dtype=float).reshape(-1), names, file))
+            positions.reshape(-1) if np.iscomplexobj(positions) else np.asarray(positions, dtype=float).reshape(-1),
+            names, file))
         if self.temperature is not None:
             object.__setattr__(self, "temperature", check_temperature(self.temperature, file))
         if self.channel_directions is not None:

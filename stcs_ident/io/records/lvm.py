@@ -43,6 +43,9 @@ __all__ = ["READER", "LvmReader", "record_from_lvm"]
 LVM_OPTIONS = ("unit", "sampling_rate", "channels", "override_sampling_rate")
 #: The first bytes of an LVM file.
 MAGIC = b"LabVIEW Measurement"
+#: A Delta_X printed so coarsely that its rate is known to worse than this (relative) gets a note: 1e-4 in the
+#: rate is 2e-4 in the tension, what an identification resolves at best (0.010000 s, 5e-5, says nothing).
+ROUNDED_NOTE = 1e-4
 #: Most bytes of an LVM file read (its text is parsed in memory, several times its size).
 MAX_BYTES = 1 << 30
 _DATE = re.compile(r"^\s*(\d{4})[/-](\d{1,2})[/-](\d{1,2})\s*$")
@@ -88,7 +91,8 @@ def record_from_lvm(path: str | os.PathLike, positions: Mapping[str, float] | No
     try:
         lvm = lvm_read.read_str(text)
     except Exception as err:  # noqa: BLE001 (the package raises what its parsing meets: ValueError, IndexError...)
-        raise InputError(f"cannot read the file as LVM: {one_line(err)}", file=file) from None
+        raise InputError(f"cannot read the file as LVM (a header cut short or malformed?): {type(err).__name__} "
+                         f"{one_line(err)}", file=file) from None
     if str(lvm.get("X_Columns", "One")).strip() == "Multi":
         raise InputError("X_Columns = Multi (an X column per channel) is not read: write the measurement with one "
                          "X column (or none)", field="X_Columns", file=file)
@@ -124,12 +128,16 @@ def record_from_lvm(path: str | os.PathLike, positions: Mapping[str, float] | No
     if rate is None:
         raise InputError("no sampling rate: the segment has no Delta_X and no X_Value column; give sampling_rate in "
                          "record_format", field="sampling_rate", file=file)
+    notes = list(selection.notes())
+    if found is not None and found.source == "Delta_X" and sampling_rate is None and found.rtol > ROUNDED_NOTE:
+        notes.append(f"sampling rate {rate:.9g} Hz from Delta_X {found.detail}, printed to a few digits only "
+                     f"({found.rtol:.1e} relative): give sampling_rate in record_format if the exact rate is known")
     keep = [names.index(name) for name in selection.names]
     acceleration = values[:, keep] * np.asarray(selection.scales)
     channel_positions = text_positions(selection, positions, file, channels is not None)
     return validated_record(acceleration, rate, list(selection.names), channel_positions, unit="m/s^2",
                             start_time=_start_time(segment, lvm, file), source=file, replaced=replaced,
-                            notes=selection.notes())
+                            notes=notes)
 
 
 def _text(file: str) -> str:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,7 @@ from ...core.planes import direction_text
 from ...core.record import Record
 from .base import RecordReader, file_head
 from .directions import file_directions
+from .rates import FileRate, resolved_rate
 from .validation import (
     UNITS,
     Positions,
@@ -143,9 +145,18 @@ class Sep005Reader(RecordReader):
         return file_head(path).lstrip(b"\xef\xbb\xbf \t\r\n")[:1] == b"["
 
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
-        """:func:`read_sep005`; its channel dicts carry their rate and unit (of the options, only ``axes``
-        applies)."""
-        return read_sep005(path, positions, axes=options.get("axes"))
+        """:func:`read_sep005`; its channel dicts carry their rate and unit (of the options, ``axes`` applies,
+        and ``sampling_rate`` must agree with the channels' rate unless ``override_sampling_rate``,
+        :mod:`~stcs_ident.io.records.rates`)."""
+        record = read_sep005(path, positions, axes=options.get("axes"))
+        given = options.get("sampling_rate")
+        if given is None:
+            return record
+        replaced = list(record.replaced)
+        rate = resolved_rate(given, FileRate(record.sampling_rate, "channels' rate (fs or time)"),
+                             override=bool(options.get("override_sampling_rate", False)), file=record.source,
+                             replaced=replaced)
+        return replace(record, sampling_rate=rate, replaced=tuple(replaced))  # within its rounding: the given
 
 
 READER = Sep005Reader()

@@ -12,6 +12,8 @@ Line 1 is the environment (station, logger, program, table), line 2 the column n
 line 4 the processing. ``TIMESTAMP`` gives the start time and the sampling interval, uniform within the
 resolution it is printed to (as a CSV time column of date-times, :mod:`~.csv_text`); ``RECORD`` and every
 other column whose unit is not one of acceleration are left out, and the record's ``notes`` list them
+(the ``RECORD`` counter must step by one: a lost sample, which timestamps printed to the sampling interval
+cannot show, is refused unless ``sampling_rate`` is given)
 (:mod:`~.columns`); each acceleration column keeps its own unit. The option ``channels`` names the channels
 instead (their unit then must be one of acceleration, or ``unit`` gives it); ``unit`` replaces the units of the
 channels read, ``sampling_rate`` stands in for or must agree with the timestamps' rate
@@ -29,6 +31,9 @@ import os
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+import pandas as pd
+
 from ...core.errors import InputError
 from ...core.record import Record
 from .base import RecordReader, file_head
@@ -41,6 +46,8 @@ __all__ = ["READER", "TIME_COLUMN", "Toa5Reader", "record_from_toa5"]
 
 #: The time column of a TOA5 table.
 TIME_COLUMN = "TIMESTAMP"
+#: The record counter of a TOA5 table: one more each row, unless samples were lost.
+RECORD_COLUMN = "RECORD"
 #: The options of this reader.
 TOA5_OPTIONS = ("unit", "sampling_rate", "channels", "override_sampling_rate")
 
@@ -116,10 +123,26 @@ def record_from_toa5(path: str | os.PathLike, positions: Mapping[str, float] | N
                          "record_format", field="time", file=file)
     selection = by_units(header, units, channels, unit, file,
                          excluded={TIME_COLUMN: "the time column"} if has_time else {})
+    if RECORD_COLUMN in header and sampling_rate is None:
+        _check_records(table.iloc[:, header.index(RECORD_COLUMN)], file)
     station = f"TOA5 table {lines[0][7]!r} of station {lines[0][1]!r}" if len(lines[0]) >= 8 else "TOA5 table"
     return table_record(file, header, table, selection, positions or {}, time_column=TIME_COLUMN if has_time else None,
                         sampling_rate=sampling_rate, override=override_sampling_rate, decimal=".", header_row=1,
                         skip=[1, 2], notes=(f"read as a {station}",), channels_given=channels is not None)
+
+
+def _check_records(column: Any, file: str) -> None:
+    """Refuse a RECORD counter that does not step by one (samples lost, or tables appended): the timestamps,
+    printed to the sampling interval, cannot show a lost sample."""
+    numbers = np.asarray(pd.to_numeric(column.str.strip(), errors="coerce"), dtype=float)
+    if numbers.size < 2 or not np.isfinite(numbers).all():
+        return  # a counter that is not numbers says nothing: the timestamps decide
+    jumps = np.flatnonzero(np.diff(numbers) != 1)
+    if jumps.size:
+        row = int(jumps[0])
+        raise InputError(f"RECORD goes from {numbers[row]:.0f} to {numbers[row + 1]:.0f} at lines {row + 5} to "
+                         f"{row + 6}: samples lost or tables joined ({jumps.size} jump(s)); give sampling_rate in "
+                         "record_format to use the samples as they are", field=RECORD_COLUMN, file=file)
 
 
 def _is_text(head: bytes) -> bool:
