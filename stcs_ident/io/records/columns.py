@@ -128,7 +128,7 @@ def text_positions(selection: Selection, positions: Mapping[str, Any] | None, fi
     """Each channel's position from the campaign's channel table, refusing in one line what is missing, saying
     where positions are given and, where a column without one may not be a channel, the option ``channels``."""
     names = list(selection.names)
-    table = dict(positions or {})
+    table = positions if positions is not None else {}  # (the object itself: positions_by_name may know its kind)
     why = {name: reason for name, reason, _ in selection.left_out}
     for key in table:
         if key not in names and key in why:

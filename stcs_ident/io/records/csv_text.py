@@ -315,8 +315,14 @@ def _time_axis(column: pd.Series, name: str, decimal: str, header_row: int, skip
         if need_rate:
             rate = _rate_from_seconds(seconds, name, file)
             return FileRate(rate, f"time column {name!r}", detail=f"steps of {1 / rate:.6g} s"), None
-        resolutions = [printed_resolution(column.iloc[k].replace(decimal, ".")) for k in (0, -1)]
-        return _span_rate(seconds[-1] - seconds[0], seconds.size, max((r or 0.0) for r in resolutions), name), None
+        try:  # uniform within TIME_TOLERANCE: printed finely enough for its rate to be known to that
+            rate = rate_from_time(seconds, name, file)
+            return FileRate(rate, f"time column {name!r}", rtol=TIME_TOLERANCE,
+                            detail=f"steps of {1 / rate:.6g} s"), None
+        except InputError:  # rounded (or a gap): the rate of its span, known to the printed digits of its ends
+            ends = [0.0 if seconds[k] == 0 else 0.5 * (printed_resolution(column.iloc[k].replace(decimal, ".")) or 0.0)
+                    for k in (0, -1)]
+            return _span_rate(seconds[-1] - seconds[0], seconds.size, sum(ends), name), None
     try:
         stamps = pd.to_datetime(column.str.strip(), format="ISO8601")
     except (ValueError, TypeError, OverflowError) as err:
@@ -335,21 +341,22 @@ def _time_axis(column: pd.Series, name: str, decimal: str, header_row: int, skip
     ns = (stamps - stamps.iloc[0]).to_numpy().astype("timedelta64[ns]").astype(np.int64)
     digits = column.str.extract(_FRACTION, expand=False).str.len().max()  # the finest the date-times are printed to
     digits = 0 if pd.isna(digits) else int(digits)
-    if not need_rate:
+    if not need_rate:  # each end off by up to half a unit of the last printed digit
         return _span_rate(int(ns[-1]) / 1e9, ns.size, 10.0 ** -min(digits, 9), name), start
     rate = _rate_from_stamps(ns, digits, name, file)
     return FileRate(rate, f"time column {name!r}", detail=f"steps of {1 / rate:.6g} s"), start
 
 
-def _span_rate(span: float, n: int, resolution: float, name: str) -> FileRate | None:
-    """The rate of ``n`` samples over ``span`` s of a time column printed to ``resolution`` s (None: no span),
-    agreeing with a given rate within the resolution over the span plus TIME_TOLERANCE (:mod:`.rates`)."""
+def _span_rate(span: float, n: int, uncertainty: float, name: str) -> FileRate | None:
+    """The rate of ``n`` samples over ``span`` s of a time column whose span is known to ``uncertainty`` s (the
+    rounding of its two ends; None: no span), agreeing with a given rate within the uncertainty over the span
+    plus TIME_TOLERANCE (:mod:`.rates`)."""
     if n < 2 or not np.isfinite(span) or span <= 0:
         return None
     rate = (n - 1) / span
-    return FileRate(rate, f"time column {name!r}", rtol=resolution / span + TIME_TOLERANCE,
-                    detail=f"{n} samples over {span:.9g} s, steps of {span / (n - 1):.6g} s, "
-                           f"printed to {resolution:g} s")
+    return FileRate(rate, f"time column {name!r}", rtol=uncertainty / span + TIME_TOLERANCE,
+                    detail=f"{n} samples over {span:.9g} s give steps of {span / (n - 1):.6g} s; the span is "
+                           f"known to {uncertainty:g} s, the rounding of its ends")
 
 
 def _rate_from_seconds(time: np.ndarray, name: str, file: str) -> float:

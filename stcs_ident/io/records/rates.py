@@ -19,6 +19,7 @@ How far a file's rate may be off its true value depends on how it is stored (:cl
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -70,6 +71,13 @@ def printed_resolution(text: Any) -> float | None:
     return 10.0 ** (exponent - decimals)
 
 
+def _ratio(value: float) -> str:
+    """``value`` with digits enough to show how far from 1 it is (1.000002, not 1)."""
+    off = abs(value - 1.0)
+    digits = 6 if off == 0 or off >= 1e-3 else min(17, 3 + int(-math.log10(off)))
+    return f"{value:.{digits}g}"
+
+
 def resolved_rate(given: float | None, found: FileRate | None, *, override: bool = False, file: str | None,
                   replaced: list) -> float | None:
     """The record's sampling rate, Hz, from the option ``given`` and the file's ``found`` (either may be None).
@@ -96,5 +104,5 @@ def resolved_rate(given: float | None, found: FileRate | None, *, override: bool
     detail = f" ({found.detail})" if found.detail else ""
     raise InputError(
         f"record_format gives sampling_rate {given:.10g} Hz, the file's {found.source} says {found.value:.10g} Hz"
-        f"{detail}: every frequency would be scaled by {given / found.value:.6g}; remove sampling_rate, or give "
+        f"{detail}: every frequency would be scaled by {_ratio(given / found.value)}; remove sampling_rate, or give "
         f"override_sampling_rate = true to use {given:.10g} Hz", field="sampling_rate", file=file)
