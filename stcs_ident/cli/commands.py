@@ -60,8 +60,11 @@ COMMANDS: dict[str, Command] = {
                         "correct tension, EI, attachment positions... from measured frequencies",
                         (("stcs-ident identify campaigns/han2020 --test case1-L4 --params tension,EI "
                           "--method contour --plot figures/"),)),
-    "tension": Command("stcs_ident.cli.tension", "the quick answer: tension from a length, a mass and frequencies",
-                       ("stcs-ident tension --length 19.715 --mass 16.6 --frequencies 7.24,14.42,21.77 --EA 4.1382e8",)),
+    "tension": Command("stcs_ident.cli.tension", "the quick answer: tension from a length, a mass and frequencies "
+                       "or one record",
+                       ("stcs-ident tension --length 19.715 --mass 16.6 --frequencies 7.24,14.42,21.77 --EA 4.1382e8",
+                        "stcs-ident tension --record campaigns/hanger-hidden-mass/records/T1.h5 --length 8 --mass 30 "
+                        "--EI 2e5")),
     "diagnose": Command("stcs_ident.cli.diagnose",
                         "what the model gets wrong, its cause among physical effects, and the gain",
                         ("stcs-ident diagnose campaigns/han2020 --out report/",)),

@@ -44,6 +44,8 @@ def run(args: argparse.Namespace) -> int:
     from ..report.forward import to_json
     from ..report.spectra_tables import spectra_text
 
+    if _is_record(args.campaign):
+        return _run_record(args)
     campaign, file, tests = prepare(args)
     if args.structural:
         from ..spectra.pipeline import analyse_campaign
@@ -67,4 +69,46 @@ def run(args: argparse.Namespace) -> int:
         write_modes_csv(results, args.plot)
     if args.json != "-":
         sys.stdout.write(spectra_text(campaign.name, results, skipped))
+    return 0
+
+
+def _is_record(path: str) -> bool:
+    """Whether the positional argument is a record file (not a campaign directory or its TOML file)."""
+    return os.path.isfile(path) and not path.lower().endswith(".toml")
+
+
+def _run_record(args: argparse.Namespace) -> int:
+    """``spectra FILE``: the record's peaks, unnumbered (no campaign: no model to number them against)."""
+    from ..core.errors import InputError
+    from ..identify.quick_record import pick_unnumbered
+    from ..io.records.validation import UnknownPositions
+    from ..io.test_record import RecordReading, open_record
+    from ..report.forward import to_json
+
+    for option, value in (("--test", args.test), ("--plot", args.plot), ("--structural", args.structural)):
+        if value is not None:
+            raise InputError("needs a campaign: a record alone is listed unnumbered", field=option)
+    record = open_record(args.campaign, RecordReading(positions=UnknownPositions()))
+    peaks = pick_unnumbered(record)
+    rows = [{"frequency": p.frequency, "uncertainty": p.uncertainty,
+             "damping": None if p.damping is None else float(p.damping), "channels": list(p.channels)}
+            for p in peaks.peaks]
+    hint = (f"stcs-ident tension --record {args.campaign} --length L --mass M numbers them from their own spacing "
+            "and gives the tension")
+    if args.json:
+        write_output(args.json, to_json({"record": args.campaign, "kind": peaks.kind,
+                                         "sampling_rate": record.sampling_rate, "duration": record.duration,
+                                         "channels": list(record.channel_names), "peaks": rows,
+                                         "notes": [str(n) for n in getattr(record, "notes", ())], "numbered": False,
+                                         "hint": hint}))
+    if args.json != "-":
+        lines = [f"Record {args.campaign}: {peaks.kind}, {record.duration:.4g} s at {record.sampling_rate:.6g} Hz, "
+                 f"channels {', '.join(record.channel_names)}; {len(rows)} peaks, unnumbered (no campaign)", "",
+                 f"{'frequency':>11} {'1σ (Hz)':>9} {'damping %':>9}  channels"]
+        for r in rows:
+            zeta = "-" if r["damping"] is None else f"{100 * r['damping']:.3f}"
+            lines.append(f"{r['frequency']:>11.5f} {r['uncertainty']:>9.2g} {zeta:>9}  {' '.join(r['channels'])}")
+        lines += [f"  note: {n}" for n in getattr(record, "notes", ())]
+        lines += ["", f"numbered and a tension: {hint}"]
+        sys.stdout.write("\n".join(lines) + "\n")
     return 0

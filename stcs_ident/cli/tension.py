@@ -1,4 +1,5 @@
-"""``stcs-ident tension``: the quick answer, a tension from a length, a mass and frequencies (no campaign file)."""
+"""``stcs-ident tension``: the quick answer, a tension from a length, a mass and frequencies or one record (no
+campaign file)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,10 @@ def add_parser(sub) -> None:
     parser = command_parser(sub, "tension")
     parser.add_argument("--length", required=True, metavar="L", help="chord length between the anchorages, m")
     parser.add_argument("--mass", required=True, metavar="M", help="mass per unit length, kg/m")
-    parser.add_argument("--frequencies", required=True, metavar="F1[,F2,...]", help="measured frequencies, Hz")
+    given = parser.add_mutually_exclusive_group(required=True)
+    given.add_argument("--frequencies", metavar="F1[,F2,...]", help="measured frequencies, Hz")
+    given.add_argument("--record", metavar="FILE", help="an acceleration record (any format spectra reads): its peaks "
+                                                         "picked and numbered from their own spacing")
     parser.add_argument("--modes", metavar="1,2,...", help="their mode numbers (default 1, 2, ...)")
     parser.add_argument("--EI", metavar="N_M2", help="bending stiffness, N m^2 (default: fitted with two modes "
                                                      "or more, else 0)")
@@ -30,7 +34,74 @@ def add_parser(sub) -> None:
                                                               "exact model's σ (default 0.3; 0: exact)")
     parser.add_argument("--length-tolerance", metavar="REL", help="relative 1σ of --length (default 0.002)")
     parser.add_argument("--mass-tolerance", metavar="REL", help="relative 1σ of --mass (default 0.01)")
+    reader = parser.add_argument_group("reading a --record (as a campaign's record_format)")
+    for option, metavar, text in READER_OPTIONS:
+        reader.add_argument(option, metavar=metavar, help=text)
+    reader.add_argument("--override-sampling-rate", action="store_true",
+                        help="use --sampling-rate even where the file's own rate disagrees")
     add_json_option(parser)
+
+
+#: The reader options of ``--record``: (option, metavar, help); each is the record_format key of its name.
+READER_OPTIONS = (
+    ("--sampling-rate", "HZ", "Hz, where the file has none (or with --override-sampling-rate)"),
+    ("--unit", "UNIT", "m/s^2, g, mg, mm/s^2 (default: the file's, else m/s^2)"),
+    ("--channels", "NAME[=POS],...", "the acceleration channels to use (a text file's other columns ignored); "
+                                     "positions (m from end A) optional"),
+    ("--directions", "NAME=DIR,...", "channel directions: in, out, axial or degrees (default: the file's, else in)"),
+    ("--time-column", "NAME", "a text file's time column (default time)"),
+    ("--separator", "CHAR", "a text file's column separator (default ,)"),
+    ("--decimal", "CHAR", "a text file's decimal mark (default .)"),
+    ("--header-row", "N", "a text file's header line, 0-based (default: found after any preamble)"),
+    ("--skip-rows", "N,...", "a text file's lines after the header to skip (a units row: 1)"),
+    ("--variable", "NAME", "a MATLAB file's matrix (rec.acc for a struct's field)"),
+    ("--group", "NAME", "a TDMS file's group"),
+)
+
+
+def _reading(args: argparse.Namespace):
+    """The ``--record`` reading from the reader options given; a reader option without ``--record`` refused."""
+    from ..io.test_record import RecordReading
+
+    given = [o for o, _, _ in READER_OPTIONS if getattr(args, o[2:].replace("-", "_")) is not None]
+    if args.override_sampling_rate:
+        given.append("--override-sampling-rate")
+    if args.record is None:
+        if given:
+            raise InputError("is a reader option: it goes with --record", field=given[0])
+        return None
+    options, positions, directions = {}, {}, {}
+    for option in given:
+        key = option[2:].replace("-", "_")
+        value = getattr(args, key)
+        if key in ("sampling_rate",):
+            options[key] = _number(value, option)
+        elif key == "override_sampling_rate":
+            options[key] = True
+        elif key == "header_row":
+            options[key] = _numbers(value, option, int)[0]
+        elif key == "skip_rows":
+            options[key] = _numbers(value, option, int)
+        elif key == "channels":
+            names = []
+            for item in value.split(","):
+                name, _, where = item.partition("=")
+                names.append(name.strip())
+                if where:
+                    positions[name.strip()] = _number(where, option)
+            options[key] = names
+        elif key == "directions":
+            for item in value.split(","):
+                name, _, where = item.partition("=")
+                if not where:
+                    raise InputError(f"must be NAME=DIR pairs, got {item!r}", field=option)
+                try:
+                    directions[name.strip()] = float(where)
+                except ValueError:
+                    directions[name.strip()] = where.strip()
+        else:
+            options[key] = value
+    return RecordReading(positions=positions or None, options=options, directions=directions or None)
 
 
 def _number(text: str | None, option: str) -> float | None:
@@ -92,6 +163,9 @@ def run(args: argparse.Namespace) -> int:
     from ..identify.quick import quick_tension, rounding_uncertainty
     from ..report.forward import to_json
 
+    reading = _reading(args)
+    if args.record is not None:
+        return _run_record(args, reading)
     frequencies = _numbers(args.frequencies, "--frequencies")
     uncertainty = _numbers(args.uncertainty, "--uncertainty")
     source = "stated (--uncertainty)" if uncertainty is not None else None
@@ -110,3 +184,43 @@ def run(args: argparse.Namespace) -> int:
     if args.json != "-":
         sys.stdout.write(tension_text(result))
     return 1 if result.methods["exact"].failed else 0
+
+
+def _run_record(args: argparse.Namespace, reading) -> int:
+    """``tension --record``: the record's peaks, numbered from their spacing, then every method."""
+    from ..identify.quick_record import tension_from_record
+    from ..report.forward import to_json
+
+    for option in ("--modes", "--uncertainty"):
+        if getattr(args, option[2:]) is not None:
+            raise InputError("goes with --frequencies: with --record the peaks' numbers and 1σ come from the record",
+                             field=option)
+    result = tension_from_record(args.record, _number(args.length, "--length"), _number(args.mass, "--mass"),
+                                 reading=reading, EI=_number(args.EI, "--EI"), EA=_number(args.EA, "--EA"),
+                                 inclination=_number(args.inclination, "--inclination"), boundary=args.boundary,
+                                 plane=args.plane, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
+                                 length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
+                                 mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"))
+    if args.json:
+        write_output(args.json, to_json(result.summary()))
+    if args.json != "-":
+        sys.stdout.write(record_text(result) + tension_text(result.tension))
+    return 1 if result.methods["exact"].failed else 0
+
+
+def record_text(result) -> str:
+    """The record read and its peaks, numbered from their own harmonic series."""
+    rec = result.record
+    lines = [f"record {rec['path']}: {rec['kind']}, {rec['duration']:.4g} s at {rec['sampling_rate']:.6g} Hz, "
+             f"channels {', '.join(rec['channels'])}"]
+    lines += [f"  {o['option']}: {o['given']} given, the file's {o['file']}" for o in rec["replaced"]]
+    lines += [f"  dropped {d['channel']}: {d['reason']}" for d in rec["dropped"]]
+    lines += [f"  note: {n}" for n in rec["notes"]]
+    series = result.series
+    lines.append(f"peaks numbered from their own spacing: f_n = n x {series.fundamental:.5g} Hz x sqrt(1 + "
+                 f"{series.inharmonicity:.3g} n^2), {series.n_assigned} of {len(result.peaks)} peaks")
+    lines.append(f"{'mode':>5} {'frequency':>11} {'1σ (Hz)':>10}")
+    for p in sorted((p for p in result.peaks if p["mode"] is not None), key=lambda p: p["mode"]):
+        lines.append(f"{p['mode']:>5} {p['frequency']:>11.5f} {p['uncertainty']:>10.2g}")
+    lines += [f"  {n}" for n in result.notes]
+    return "\n".join(lines) + "\n\n"

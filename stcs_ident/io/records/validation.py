@@ -42,7 +42,7 @@ from ...core.times import check_instant
 from .screening import screen_channels
 
 __all__ = [
-    "TIME_TOLERANCE", "UNITS", "Positions", "check_bandwidth", "check_duration", "check_positions",
+    "TIME_TOLERANCE", "UNITS", "UnknownPositions", "Positions", "check_bandwidth", "check_duration", "check_positions",
     "check_sampling_rate", "names_from_positions", "one_line", "overridden", "position_list", "positions_by_name",
     "rate_from_time", "unit_scale", "validated_record",
 ]
@@ -195,8 +195,20 @@ def _scale(array: np.ndarray, factor: float) -> np.ndarray:
     return array
 
 
+class UnknownPositions(dict):
+    """Positions for a reader when none are known nor needed (the quick ``tension --record``, which numbers the
+    peaks from their spacing, not from shapes): every channel, named or not, at 0 m. Empty as a mapping, yet
+    true (a reader's ``positions or {}`` keeps it)."""
+
+    def __bool__(self) -> bool:
+        return True
+
+
 def positions_by_name(names: list[str], positions: Positions, file: str | None) -> dict[str, Any]:
-    """Positions given as ``{name: position}`` or in channel order, by name."""
+    """Positions given as ``{name: position}`` or in channel order, by name (every channel at 0 m for
+    :class:`UnknownPositions`)."""
+    if isinstance(positions, UnknownPositions):
+        return dict.fromkeys(names, 0.0)
     if isinstance(positions, Mapping):
         unknown = [key for key in positions if key not in names]
         if unknown:

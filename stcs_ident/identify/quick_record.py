@@ -1,0 +1,250 @@
+"""One record to one tension: the quick answer from a file, a length and a mass (no campaign, no nominal tension).
+
+The commonest field question is "here is my record, the length and the mass:
+what is the tension?". :func:`tension_from_record` answers it as ``spectra``
+and ``tension`` would together, without a campaign:
+
+1. the record is read through the record readers (any format, the reader
+   options as a campaign's ``record_format``);
+2. the peaks are picked as ``spectra`` picks them (:func:`~stcs_ident.spectra.peaks.find_peaks`), over the whole
+   band below the anti-aliasing roll-off;
+3. they are numbered from their own spacing (:func:`~stcs_ident.spectra.harmonic.harmonic_series`: no nominal
+   tension is needed), and on an ambient record picked again with that series' modes proposed where no peak was
+   detected (as ``spectra`` proposes the nominal family's);
+4. every method of :func:`~stcs_ident.identify.quick.quick_tension` runs on the numbered peaks, with each
+   frequency's 1σ from the record.
+
+A series that several spacings explain (one peak, or peaks a sub-harmonic
+numbers as well) is refused: its numbers would be a guess, and a wrong number
+is a tension tens of per cent off with a small σ.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InputError
+from ..core.planes import PLANES
+from ..core.record import Record
+from ..core.result import Result
+from ..io.records.validation import UnknownPositions
+from ..io.test_record import RecordReading, open_record
+from ..spectra.harmonic import HarmonicSeries, harmonic_series
+from ..spectra.peaks import PeakResult, find_peaks
+from .quick import QuickTensionResult, quick_tension
+
+__all__ = ["RecordTensionResult", "pick_unnumbered", "tension_from_record"]
+
+#: The analysis band ends at this share of the sampling rate, below the anti-aliasing filter's roll-off (as
+#: ``spectra``'s).
+USABLE = 0.45
+#: Most modes passed to the tension methods: the lowest of the series (enough for tension and EI; a long stay
+#: shows hundreds below the Nyquist frequency).
+MAX_MODES = 30
+
+
+@dataclass(frozen=True)
+class RecordTensionResult(Result):
+    """The tension from one record (:func:`tension_from_record`).
+
+    Attributes
+    ----------
+    tension : QuickTensionResult
+        Every method side by side, on the numbered peaks (their 1σ from the record).
+    record : dict
+        ``path``, ``channels`` read, ``sampling_rate`` (Hz), ``duration`` (s), ``kind`` (impulse or ambient),
+        ``replaced`` (the file's values the reader options replaced), ``dropped`` channels, ``notes``.
+    peaks : tuple of dict
+        Every peak picked: ``frequency``, ``uncertainty`` (Hz), ``mode`` (its number in the series, None when
+        left out), ``doubtful``, ``damping``.
+    series : HarmonicSeries
+        The peaks' own series (fundamental, inharmonicity).
+    notes : tuple of str
+    """
+
+    tension: QuickTensionResult
+    record: dict
+    peaks: tuple[dict, ...]
+    series: HarmonicSeries
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    main_table = "methods"
+
+    @property
+    def settings(self):
+        return None
+
+    @property
+    def inputs(self) -> dict:
+        return self.tension.inputs
+
+    @property
+    def methods(self) -> dict:
+        return self.tension.methods
+
+    def summary(self) -> dict:
+        """The JSON of ``tension --record``: ``tension``'s, plus ``record``, ``peaks`` and ``series``."""
+        out = self.tension.summary()
+        out["notes"] = list(out.get("notes", [])) + list(self.notes)
+        out["record"] = dict(self.record)
+        out["peaks"] = [dict(p) for p in self.peaks]
+        out["series"] = {"fundamental": self.series.fundamental, "inharmonicity": self.series.inharmonicity,
+                         "numbered": self.series.n_assigned}
+        return out
+
+    to_dict = summary
+
+    def tables(self):
+        import pandas as pd
+
+        tables = self.tension.tables()
+        tables["peaks"] = pd.DataFrame(list(self.peaks), columns=["frequency", "uncertainty", "mode", "doubtful",
+                                                                  "damping"])
+        return tables
+
+
+def pick_unnumbered(record: Record, *, f_min: float | None = None, f_max: float | None = None,
+                    expected=None) -> PeakResult:
+    """The peaks of ``record`` as ``spectra`` picks them, over the band from a few periods of the record's
+    length (``f_min`` default: 8 / duration) to :data:`USABLE` of its sampling rate, unnumbered."""
+    low = 8.0 / record.duration if f_min is None else f_min
+    high = USABLE * record.sampling_rate if f_max is None else f_max
+    if not high > low:
+        raise InputError(f"the record ({record.duration:.4g} s at {record.sampling_rate:.4g} Hz) has no band to "
+                         f"search: {low:.4g} Hz (8 periods of its length) to {high:.4g} Hz", field="acceleration",
+                         file=record.source)
+    return find_peaks(record, f_min=low, f_max=high, expected=expected)
+
+
+def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
+                        reading: RecordReading | Mapping[str, Any] | None = None, EI: float | None = None,
+                        EA: float | None = None, inclination: float = 0.0, boundary: str = "clamped",
+                        plane: str = "in", EI_tolerance: float | None = None, length_tolerance: float | None = None,
+                        mass_tolerance: float | None = None) -> RecordTensionResult:
+    """A cable's tension from one record, its length and its mass per length (module docstring).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The record, in any format the record readers take.
+    length, mass : float
+        Chord length (m) and mass per length (kg/m).
+    reading : RecordReading or mapping, optional
+        Channel positions and directions, and reader options (``sampling_rate``, ``unit``, ``channels``,
+        ``separator``, ``decimal``, ``header_row`` …), as a campaign's; positions are not needed (the peaks are
+        numbered from their spacing, not from shapes).
+    EI, EA, inclination, boundary, EI_tolerance, length_tolerance, mass_tolerance
+        As :func:`~stcs_ident.identify.quick.quick_tension`.
+    plane : {"in", "out"}
+        The plane of the modes: with channel directions, only that plane's channels are used.
+
+    Returns
+    -------
+    RecordTensionResult
+
+    Raises
+    ------
+    InputError
+        A record that cannot be read (one line naming the file and the field), no peak found, or peaks whose
+        mode numbers several harmonic series explain.
+    """
+    if plane not in PLANES:
+        raise InputError(f'must be "in" or "out", got {plane!r}', field="plane")
+    if isinstance(reading, Mapping):
+        reading = RecordReading(**dict(reading))
+    reading = reading or RecordReading()
+    if reading.positions is None:  # not needed: the peaks are numbered from their spacing, not their shapes
+        reading = replace(reading, positions=UnknownPositions())
+    record = open_record(path, reading)
+    file = os.fspath(path)
+    record = _named_channels(record, reading.options.get("channels"))
+    record, used = _plane_channels(record, plane)
+    first = pick_unnumbered(record)
+    if not first.peaks:
+        raise InputError(f"no peak found between {8 / record.duration:.3g} and {USABLE * record.sampling_rate:.4g} Hz "
+                         "on any channel", field="acceleration", file=file)
+    series = _series(first, file)
+    peaks = first
+    if first.kind == "ambient":  # undetected modes proposed where the series puts them, as spectra does
+        top = series.frequency(np.arange(1, MAX_MODES + 1))
+        again = pick_unnumbered(record, expected=top[top < USABLE * record.sampling_rate])
+        if again.peaks:
+            retry = harmonic_series([p.frequency for p in again.peaks], [p.uncertainty for p in again.peaks])
+            if retry is not None and not retry.ambiguous and abs(retry.fundamental / series.fundamental - 1) < 0.02:
+                peaks, series = again, retry
+    freqs = np.array([p.frequency for p in peaks.peaks])
+    sigma = np.array([p.uncertainty for p in peaks.peaks])
+    numbered = np.flatnonzero(series.modes > 0)
+    numbered = numbered[np.argsort(series.modes[numbered])][:MAX_MODES]
+    quick = quick_tension(length, mass, freqs[numbered], series.modes[numbered], EI=EI, EA=EA,
+                          inclination=inclination, boundary=boundary, uncertainty=sigma[numbered],
+                          uncertainty_source="from the record's spectra (each peak's fit)",
+                          EI_tolerance=EI_tolerance, length_tolerance=length_tolerance,
+                          mass_tolerance=mass_tolerance, plane=plane)
+    shown = set(numbered.tolist())
+    table = tuple({"frequency": float(p.frequency), "uncertainty": float(p.uncertainty),
+                   "mode": int(series.modes[k]) if k in shown else None, "doubtful": False,
+                   "damping": None if p.damping is None or not math.isfinite(p.damping) else float(p.damping)}
+                  for k, p in enumerate(peaks.peaks))
+    notes = []
+    left = [p for p in table if p["mode"] is None]
+    if left:
+        notes.append(f"{len(left)} peak(s) not in the series (not the cable's, or beyond mode {MAX_MODES}): "
+                     + ", ".join(f"{p['frequency']:.4g} Hz" for p in left[:8]) + (" …" if len(left) > 8 else ""))
+    info = {"path": file, "channels": list(used), "sampling_rate": record.sampling_rate,
+            "duration": record.duration, "kind": peaks.kind,
+            "replaced": [{"option": o, "given": g, "file": f} for o, g, f in record.replaced],
+            "dropped": [{"channel": c, "reason": r} for c, r in record.dropped],
+            "notes": [str(n) for n in getattr(record, "notes", ())]}
+    return RecordTensionResult(quick, info, table, series, tuple(notes))
+
+
+def _series(peaks: PeakResult, file: str) -> HarmonicSeries:
+    """The peaks' harmonic series; refused where it is not sure (module docstring)."""
+    freqs = [p.frequency for p in peaks.peaks]
+    series = harmonic_series(freqs, [p.uncertainty for p in peaks.peaks])
+    if series.ambiguous:
+        listed = ", ".join(f"{f:.4g}" for f in sorted(freqs)[:8])
+        other = f" or {series.alternative:.4g} Hz" if series.alternative else ""
+        raise InputError(f"the peaks ({listed} Hz) do not number themselves: harmonic series with a fundamental "
+                         f"of {series.fundamental:.4g}{other} explain them about as well; give the frequencies "
+                         "with their mode numbers (--frequencies, --modes) instead", field="acceleration", file=file)
+    return series
+
+
+def _plane_channels(record: Record, plane: str) -> tuple[Record, tuple[str, ...]]:
+    """The record with only the channels of ``plane`` (every channel when the record has no directions)."""
+    if record.channel_directions is None:
+        return record, record.channel_names
+    keep = [k for k, d in enumerate(record.channel_directions) if d == plane]
+    if not keep:
+        given = ", ".join(f"{n} {d}" for n, d in zip(record.channel_names, record.channel_directions))
+        raise InputError(f"no {plane!r} channel among {given}: give --plane or the channels' directions",
+                         field="channel_direction", file=record.source)
+    sub = replace(record, acceleration=record.acceleration[:, keep],
+                  channel_names=tuple(record.channel_names[k] for k in keep),
+                  channel_positions=record.channel_positions[keep],
+                  channel_directions=tuple(record.channel_directions[k] for k in keep))
+    return sub, sub.channel_names
+
+
+def _named_channels(record: Record, names) -> Record:
+    """The record with only the channels ``names`` (all when None; a text file's reader has left the others out
+    already, another format's are dropped here)."""
+    if not names or tuple(names) == record.channel_names:
+        return record
+    missing = [n for n in names if n not in record.channel_names]
+    if missing:
+        raise InputError(f"no channel named {missing[0]!r}; the record has {', '.join(record.channel_names)}",
+                         field="channels", file=record.source)
+    keep = [record.channel_names.index(n) for n in names]
+    return replace(record, acceleration=record.acceleration[:, keep], channel_names=tuple(names),
+                   channel_positions=record.channel_positions[keep],
+                   channel_directions=None if record.channel_directions is None else
+                   tuple(record.channel_directions[k] for k in keep))
