@@ -85,7 +85,7 @@ TOML_KINDS = ("delete_line", "duplicate_line", "swap_lines", "truncate", "random
               "huge_integer", "long_literal", "float_overflow", "nonfinite", "negative", "zero", "tiny",
               "string_for_number", "number_for_string", "nested_arrays", "control_name", "newline_name",
               "long_name", "unknown_key", "many_attachments", "empty_file", "many_tests", "bad_boundary",
-              "huge_mode", "reference_huge", "extreme_frequencies")
+              "huge_mode", "reference_huge", "extreme_frequencies", "huge_boundary", "nul_record")
 RECORD_KINDS = ("bit_flips", "truncated_record", "dangling_link", "self_link", "external_link", "wrong_dtype",
                 "wrong_shape", "nan_samples", "nyquist", "missing_dataset", "empty_record", "not_hdf5",
                 "string_rate", "huge_rate", "one_sample", "constant")
@@ -216,6 +216,13 @@ def _mutate_toml(text: str, kind: str, rng: random.Random) -> str | bytes:
         value = rng.choice(("1e-300", "1e300", "1e-12", "1e12"))
         return re.sub(r"frequencies = \[[^\]]*\]", lambda m: f"frequencies = [{value}, 2.0, 3.0, {value}, 5.0]",
                       text, count=1)
+    elif kind == "huge_boundary":  # an end stiffness as an integer beyond a float (alone, or one end of two)
+        huge = str(10 ** rng.choice((309, 400, 4000)))
+        return text.replace('boundary = "clamped"', "boundary = " + rng.choice(
+            (huge, f'["clamped", {huge}]', f'[{huge}, "pinned"]', f"[{huge}, {huge}]")))
+    elif kind == "nul_record":  # a NUL character in a record's path (the system refuses such a path)
+        return text.replace('record = "records/T2.h5"', 'record = ' + rng.choice(
+            ('"records/a\\u0000b.h5"', '"records/T2.h5\\u0000"', '"\\u0000"')))
     elif kind == "bad_boundary":
         return text.replace('boundary = "clamped"', "boundary = " + rng.choice(
             ('"glued"', "[1, 2, 3]", "-5.0", "nan", '["clamped"]', "1e400", "[]")))

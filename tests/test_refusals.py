@@ -161,3 +161,60 @@ def test_a_record_with_flipped_bits_is_read_or_refused_naming_it(campaign, capsy
     err = [ln for ln in capsys.readouterr().err.splitlines()
            if not ln.startswith("spectra: ") and "warning" not in ln]
     assert code == 0 or (code == 2 and len(err) == 1 and str(record) in err[0]), (code, err)
+
+
+HUGE = "1" + "0" * 400  # an integer TOML reads whole, beyond a float's range
+
+
+@pytest.mark.parametrize("old, new, field, said", [
+    ('boundary = "clamped"', f"boundary = {HUGE}", "field 'cable.boundary'", "too large"),
+    ('boundary = "clamped"', f'boundary = ["clamped", {HUGE}]', "field 'cable.boundary'", "end B: is too large"),
+    ('boundary = "clamped"', f'boundary = [{HUGE}, "pinned"]', "field 'cable.boundary'", "end A: is too large"),
+    ("[tolerance]", f'[channels]\nA1 = {{ position = 2.0, direction = {HUGE} }}\n\n[tolerance]',
+     "field 'channels.A1.direction'", "an integer beyond the range of a float"),
+])
+def test_an_integer_beyond_a_float_names_the_file_and_the_field(campaign, capsys, old, new, field, said):
+    """Issue 34 (fuzz): an end stiffness (and a channel's direction) written as a huge TOML integer ended in
+    an OverflowError; every other number of the campaign went through the shared check (tests/test_fuzz.py's
+    huge_integer and huge_boundary kinds, and each number of a campaign with every field: none left)."""
+    toml = edit(campaign, old, new)
+    line = refusal(["forward", campaign], capsys)
+    assert toml in line and field in line and said in line, line
+
+
+NUL_RECORD = 'record = "records/a\\u0000b.h5"'  # TOML's escape: the path holds a NUL character
+
+
+@pytest.mark.parametrize("command", [["forward"], ["spectra"], ["identify"], ["diagnose"],
+                                     ["simulate", "--out", "{tmp}/sim"]])
+def test_a_record_path_with_a_nul_names_the_file_and_the_field(campaign, capsys, tmp_path, command):
+    """Issue 34 (fuzz): ValueError 'embedded null byte' from the output checks (os.path.realpath)."""
+    toml = edit(campaign, 'record = "records/T2.h5"', NUL_RECORD)
+    line = refusal([command[0], campaign, *(a.format(tmp=tmp_path) for a in command[1:])], capsys)
+    assert toml in line and "field 'test[T2].record'" in line and "NUL" in line, line
+
+
+def test_an_archive_whose_campaign_has_a_nul_record_path_is_refused(campaign, capsys, tmp_path):
+    archive = tmp_path / "archive"
+    (archive / "C1" / "records").mkdir(parents=True)
+    text = (campaign / "campaign.toml").read_text().replace('record = "records/T2.h5"', NUL_RECORD)
+    (archive / "C1" / "campaign.toml").write_text(text)
+    line = refusal(["track", archive, "--out", tmp_path / "out"], capsys)
+    assert str(archive / "C1" / "campaign.toml") in line and "field 'test[T2].record'" in line, line
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["forward", "{c}", "--json", "{t}/a\0b.json"], "option '--json'"),
+    (["spectra", "{c}", "--plot", "{t}/p\0q"], "option '--plot'"),
+    (["identify", "{c}", "--test", "T1", "--json", "{t}/a\0b.json"], "option '--json'"),
+    (["simulate", "{c}", "--out", "{t}/s\0m"], "option '--out'"),
+    (["forward", "{c}\0x"], "\\x00x"),
+    (["track", "{t}/arch\0x"], "\\x00x"),
+    (["tension", "--length", "8", "--mass", "30", "--frequencies", "12.3", "--json", "{t}/a\0b.json"],
+     "option '--json'"),
+])
+def test_a_path_with_a_nul_on_the_command_line_is_refused(campaign, capsys, tmp_path, argv, named):
+    """A shell cannot pass a NUL in an argument, main(argv) in-process can: one line, never 'embedded null
+    byte' from the system's interface."""
+    line = refusal([a.format(c=campaign, t=tmp_path) for a in argv], capsys)
+    assert "holds a NUL character" in line and named in line, line

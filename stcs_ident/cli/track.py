@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``track``; returns the exit status."""
     import os
 
-    from ..core.files import check_outputs
+    from ..core.files import check_outputs, check_path
     from ..core.formatting import counted
     from ..report.forward import to_json
     from ..report.track import write_report
@@ -49,6 +49,7 @@ def run(args: argparse.Namespace) -> int:
         from ..track.execution import probe_scheduler
 
         probe_scheduler(args.scheduler)
+    check_path(args.archive)  # (default_out resolves it)
     out = args.out if args.out is not None else str(default_out(args.archive))
     specs = discover(args.archive, args.cable)  # refuses a bad archive before any work
     inputs = [os.path.join(s.directory, "campaign.toml") for s in specs]

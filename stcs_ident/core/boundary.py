@@ -28,6 +28,9 @@ class Boundary:
             k = float(k)
         except (TypeError, ValueError):
             raise ModelError(f"must be a number, got {k!r}", field="boundary") from None
+        except OverflowError:  # an integer too large for a float (TOML integers are unbounded)
+            raise ModelError("rotational stiffness is too large: an integer beyond the range of a float (about "
+                             "1.8e308; a clamped end is \"clamped\")", field="boundary") from None
         if math.isnan(k) or k < 0:
             raise ModelError(f"rotational stiffness must be >= 0, got {k!r}", field="boundary")
         object.__setattr__(self, "rotational_stiffness", k)

@@ -73,6 +73,7 @@ def output_target(path: str | os.PathLike) -> tuple[Path, bool]:
     kept); ``stream`` True for a FIFO or a character device (opened and written, never renamed over).
     Raises :class:`OutputError` for a directory, a block device or a socket.
     """
+    check_path(path, output=True)
     target = Path(os.path.realpath(path))
     try:
         mode = os.stat(target).st_mode
@@ -346,6 +347,17 @@ def writable_problem(path: str | os.PathLike, is_directory: bool) -> str | None:
     return None
 
 
+def check_path(path, option: str | None = None, *, output: bool = False) -> None:
+    """Refuse a path holding a NUL character, which the system refuses (``stat``, ``open`` and ``realpath``
+    raise ValueError, not OSError): :class:`InputError` (:class:`OutputError` with ``output``) naming the path
+    and ``option`` (None: the path alone). Paths from a shell never hold one; a campaign's ``record``, a path
+    given through the API or a command line run in-process may."""
+    text = os.fsdecode(path) if isinstance(path, (str, bytes, os.PathLike)) else str(path)
+    if "\0" in text:
+        raise (OutputError if output else InputError)("holds a NUL character, which no path can", field=option,
+                                                      file=text)
+
+
 def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
                   inputs: Iterable[str | os.PathLike]) -> None:
     """Refuse, before any work, an output that would replace or be written inside an input.
@@ -356,10 +368,14 @@ def check_outputs(outputs: Iterable[tuple[str, str | os.PathLike | None, bool]],
     be writable (:func:`writable_problem`). Raises :class:`~stcs_ident.core.errors.InputError` naming the
     option.
     """
-    read = [os.path.realpath(p) for p in inputs]
+    read = []
+    for p in inputs:
+        check_path(p)
+        read.append(os.path.realpath(p))
     for option, path, is_directory in outputs:
         if path is None or str(path) == "-":
             continue
+        check_path(path, option, output=True)
         real = os.path.realpath(path)
         for file in read:
             if real == file:

@@ -317,6 +317,8 @@ class Test:
         if not isinstance(self.name, str) or not self.name:
             raise ModelError("must be a non-empty string", field="test.name")
         where = f"test[{self.name}]"
+        if self.record is not None:
+            object.__setattr__(self, "record", _path(self.record, f"{where}.record"))
         object.__setattr__(self, "record_format", _record_format(self.record_format, f"{where}.record_format"))
         object.__setattr__(self, "channel_directions", _directions(self.channel_directions,
                                                                    f"{where}.channels"))
@@ -491,6 +493,20 @@ class Campaign:
             if t.name == name:
                 return t
         raise KeyError(name)
+
+
+def _path(value: Any, field: str) -> str:
+    """A path as given (a non-empty string; a path-like is taken as its string) that the system can open: no
+    NUL character (which ends a path at the system's interface: ``open`` and ``stat`` refuse it)."""
+    import os
+
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if not isinstance(value, str) or not value:
+        raise ModelError(f"must be a non-empty string (a path), got {value!r}", field=field)
+    if "\0" in value:
+        raise ModelError(f"holds a NUL character, which no path can: {value!r}", field=field)
+    return value
 
 
 def _directions(value: Any, field: str) -> tuple[tuple[str, str | float], ...]:

@@ -57,11 +57,27 @@ def check_direction(value: Any, field: str = "direction") -> str | float:
         except ValueError:
             raise ModelError(f'must be "in", "out", "axial" or an angle in degrees, got {value!r}',
                              field=field) from None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(float(value)):
-        raise ModelError(f'must be "in", "out", "axial" or an angle in degrees, got {value!r}', field=field)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not _finite(value):
+        raise ModelError(f'must be "in", "out", "axial" or an angle in degrees, got {_short(value)}', field=field)
     angle = float(value) % 360.0
     angle = angle - 360.0 if angle > 180.0 else angle
     return {0.0: "in", 90.0: "out"}.get(angle, angle)
+
+
+def _finite(value: int | float) -> bool:
+    """Whether ``value`` is a finite float (an integer beyond a float's range is not: TOML integers are
+    unbounded)."""
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
+
+
+def _short(value: Any) -> str:
+    """``repr(value)`` for a message, an integer of hundreds of digits shortened to its size."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
+        return "an integer beyond the range of a float"  # (str() of one of 4300 digits or more raises)
+    return repr(value)
 
 
 def direction_angle(direction: str | float) -> float | None:

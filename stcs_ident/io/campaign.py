@@ -94,6 +94,8 @@ def campaign_file(path: str | os.PathLike) -> Path:
 
 def _campaign_file(path: Path) -> Path:
     """The TOML file named by ``path`` (a campaign directory or the file)."""
+    if "\0" in str(path):
+        raise CampaignError("holds a NUL character, which no path can", file=str(path))
     if path.is_dir():
         file = path / CAMPAIGN_FILE
         if not file.is_file():
@@ -225,6 +227,10 @@ def _boundary_end(value: Any, which: str) -> Boundary:
     if value == "pinned" and isinstance(value, str):
         return Boundary.pinned()
     if _is_number(value) and value >= 0:
+        try:
+            _in_float_range(value, "cable.boundary")
+        except CampaignError as err:
+            raise CampaignError(which + err.message, field=err.field) from None
         return Boundary(value)
     raise CampaignError(f"{which}must be {_BOUNDARY_HELP}, got {_show(value)}", field="cable.boundary")
 
