@@ -499,3 +499,16 @@ def test_truncated_and_mutated_files_give_one_line_never_a_traceback(tmp_path, s
         except InputError as err:
             assert err.file == str(path) and "\n" not in str(err), str(err)
     assert read > 0  # some variants are still records (a cut after the last row, a flipped digit)
+
+
+def test_samples_too_large_for_their_spread_are_refused_not_a_warning(tmp_path):
+    """A corrupt binary file's flipped exponent (1e200 m/s²): the spread of the channel overflows; refused in one
+    line (it used to be a RuntimeWarning from the screening, an error under this suite's warning filter)."""
+    acc = _signals()
+    acc[10, 1] = 1e200
+    path = tmp_path / "r.h5"
+    write_record(Record(np.ones((2, 2)), FS, ("acc1", "acc2"), np.array([4.5, 9.9])), path)
+    with h5py.File(path, "r+") as h5:
+        del h5["acceleration"]
+        h5["acceleration"] = acc
+    _refused(path, "channel 'acc2' has samples up to 1e\\+200 m/s², too large", "acceleration")

@@ -181,15 +181,18 @@ def read_record(path: str | os.PathLike, *, positions: Mapping[str, float] | Non
         in-plane; :func:`~stcs_ident.core.planes.directions_note` says so).
     **options
         Reader options (:data:`~stcs_ident.io.records.options.OPTIONS`: ``unit``, ``sampling_rate``,
-        ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``start_time``, ``temperature``,
-        ``variable``, ``group``, ``axes``), a campaign's ``record_format``; None values are ignored. Each reader takes
-        those of its format; ``start_time`` and ``temperature`` replace the file's in every format, and the
-        record's ``replaced`` lists where a given value differs from the file's.
+        ``override_sampling_rate``, ``time_column``, ``separator``, ``decimal``, ``skip_rows``, ``header_row``,
+        ``channels``, ``start_time``, ``temperature``, ``variable``, ``group``, ``axes``), a campaign's
+        ``record_format``; None values are ignored. Each reader takes those of its format; ``start_time`` and
+        ``temperature`` replace the file's in every format, and the record's ``replaced`` lists where a given
+        value differs from the file's; a ``sampling_rate`` that disagrees with the file's is refused unless
+        ``override_sampling_rate`` (:mod:`~stcs_ident.io.records.rates`).
 
     Returns
     -------
     Record
-        In m/s², ``source = str(path)``, dead and clipped channels dropped.
+        In m/s², ``source = str(path)``, dead and clipped channels dropped; its ``notes`` say what the reader
+        did that a user should know (a header found after a preamble, columns left out).
 
     Raises
     ------

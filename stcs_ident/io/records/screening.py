@@ -16,7 +16,8 @@ and ``Record.dropped`` keeps ``(name, reason)``.
   ``"clipped at ±X m/s²"`` (one signed value when only one rail is held).
 
 If every channel would be dropped, that is an ``InputError`` ("no usable
-channel"), raised without warnings.
+channel"), raised without warnings; so is a channel of samples so large
+(beyond about 1e154 m/s²) that their spread overflows: a corrupt file.
 """
 
 from __future__ import annotations
@@ -40,8 +41,15 @@ BLOCK_ROWS = 65536
 
 
 def screen_channels(acceleration: np.ndarray, names: list[str], file: str | None) -> tuple[list[int], list]:
-    """Indices of the usable channels and ``(name, reason)`` of the others."""
-    low, high, spread, at_rails = _column_statistics(acceleration)
+    """Indices of the usable channels and ``(name, reason)`` of the others; a channel whose samples are so
+    large that their spread overflows (a corrupt file's 1e200) is refused, not dropped."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        low, high, spread, at_rails = _column_statistics(acceleration)
+    if not np.all(np.isfinite(spread)):
+        j = int(np.argmin(np.isfinite(spread)))
+        raise InputError(f"channel {names[j]!r} has samples up to {max(abs(low[j]), abs(high[j])):.3g} m/s², too "
+                         "large for their spread to be computed: not an acceleration (a corrupt file?)",
+                         field="acceleration", file=file)
     reasons = []
     for j in range(len(names)):
         if high[j] == low[j] or spread[j] <= DEAD_RELATIVE_STD * spread.max():
