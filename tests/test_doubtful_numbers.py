@@ -40,8 +40,8 @@ def _spectra(modes, frequencies, doubtful, damping=None):
 def _row(tmp_path, monkeypatch, modes, frequencies, doubtful):
     spectra = _spectra(modes, frequencies, doubtful)
     monkeypatch.setattr(process, "analyse_record", lambda *a, **k: spectra)
-    monkeypatch.setattr(process, "read_record", lambda *a, **k: type("R", (), {
-        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})())
+    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
+        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
     return process_record(CableSpec("stay", str(tmp_path), BARE, "S", 4.0e6), str(tmp_path / "records" / "r.h5"), "x")
 
 

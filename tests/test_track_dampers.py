@@ -139,8 +139,8 @@ def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_
 
     monkeypatch.setattr(process, "identify", fake_identify)  # looked up in process
     monkeypatch.setattr(process, "analyse_record", lambda *a, **k: Spectra())
-    monkeypatch.setattr(process, "read_record", lambda *a, **k: type("R", (), {
-        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})())
+    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
+        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
     spec = CableSpec("stay", str(tmp_path), DAMPED, "S", 4.0e6)
     row = process_record(spec, str(tmp_path / "records" / "r.h5"), "x")
     assert row["status"] == "ok" and row["tension"] == 4.1e6  # the tension kept

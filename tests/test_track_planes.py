@@ -14,6 +14,7 @@ import pytest
 from stcs_ident.core.model import Cable, Campaign, Setup, Test
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.io.tables import write_parquet
+from stcs_ident.io.test_record import record_reading
 from stcs_ident.track import process
 from stcs_ident.track.archive import CableSpec
 from stcs_ident.track.store import ROW_COLUMNS, append_part, read_parts
@@ -54,12 +55,12 @@ def test_a_row_lists_the_planes_and_the_tension_comes_from_both(tmp_path, monkey
     spectra = FakeSpectra((1, 2, 3, 4) * 2, tuple(f_in) + tuple(f_out), (SIGMA,) * 8, ("in",) * 4 + ("out",) * 4)
     seen = {}
 
-    def fake_read(path, positions=None, directions=None, **options):
-        seen["directions"] = directions
-        return FakeRecord()
+    def fake_open(campaign, test):
+        seen["directions"] = record_reading(campaign, test).directions
+        return str(tmp_path / "r.h5"), FakeRecord()
 
     # patched where track.process looks them up
-    monkeypatch.setattr(process, "read_record", fake_read)
+    monkeypatch.setattr(process, "open_test_record", fake_open)
     monkeypatch.setattr(process, "analyse_record", lambda *args, **kwargs: spectra)
     (tmp_path / "r.h5").write_bytes(b"")
     row = process.process_record(spec(tmp_path, {"acc2": "out"}), str(tmp_path / "r.h5"), "id")

@@ -63,8 +63,8 @@ COMMANDS: dict[str, Command] = {
     "tension": Command("stcs_ident.cli.tension", "the quick answer: tension from a length, a mass and frequencies "
                        "or one record",
                        ("stcs-ident tension --length 19.715 --mass 16.6 --frequencies 7.24,14.42,21.77 --EA 4.1382e8",
-                        "stcs-ident tension --record campaigns/hanger-hidden-mass/records/T1.h5 --length 8 --mass 30 "
-                        "--EI 2e5")),
+                        ("stcs-ident tension --record campaigns/hanger-hidden-mass/records/T1.h5 --length 8 --mass 30 "
+                         "--EI 2e5"))),
     "diagnose": Command("stcs_ident.cli.diagnose",
                         "what the model gets wrong, its cause among physical effects, and the gain",
                         ("stcs-ident diagnose campaigns/han2020 --out report/",)),

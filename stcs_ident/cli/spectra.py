@@ -102,8 +102,8 @@ def _run_record(args: argparse.Namespace) -> int:
                                          "notes": [str(n) for n in getattr(record, "notes", ())], "numbered": False,
                                          "hint": hint}))
     if args.json != "-":
-        lines = [f"Record {args.campaign}: {peaks.kind}, {record.duration:.4g} s at {record.sampling_rate:.6g} Hz, "
-                 f"channels {', '.join(record.channel_names)}; {len(rows)} peaks, unnumbered (no campaign)", "",
+        lines = [(f"Record {args.campaign}: {peaks.kind}, {record.duration:.4g} s at {record.sampling_rate:.6g} Hz, "
+                  f"channels {', '.join(record.channel_names)}; {len(rows)} peaks, unnumbered (no campaign)"), "",
                  f"{'frequency':>11} {'1σ (Hz)':>9} {'damping %':>9}  channels"]
         for r in rows:
             zeta = "-" if r["damping"] is None else f"{100 * r['damping']:.3f}"

@@ -46,8 +46,8 @@ def add_parser(sub) -> None:
 READER_OPTIONS = (
     ("--sampling-rate", "HZ", "Hz, where the file has none (or with --override-sampling-rate)"),
     ("--unit", "UNIT", "m/s^2, g, mg, mm/s^2 (default: the file's, else m/s^2)"),
-    ("--channels", "NAME[=POS],...", "the acceleration channels to use (a text file's other columns ignored); "
-                                     "positions (m from end A) optional"),
+    ("--channels", "NAME[=POS],...", ("the acceleration channels to use (a text file's other columns ignored); "
+                                      "positions (m from end A) optional")),
     ("--directions", "NAME=DIR,...", "channel directions: in, out, axial or degrees (default: the file's, else in)"),
     ("--time-column", "NAME", "a text file's time column (default time)"),
     ("--separator", "CHAR", "a text file's column separator (default ,)"),
@@ -211,8 +211,8 @@ def _run_record(args: argparse.Namespace, reading) -> int:
 def record_text(result) -> str:
     """The record read and its peaks, numbered from their own harmonic series."""
     rec = result.record
-    lines = [f"record {rec['path']}: {rec['kind']}, {rec['duration']:.4g} s at {rec['sampling_rate']:.6g} Hz, "
-             f"channels {', '.join(rec['channels'])}"]
+    lines = [(f"record {rec['path']}: {rec['kind']}, {rec['duration']:.4g} s at {rec['sampling_rate']:.6g} Hz, "
+              f"channels {', '.join(rec['channels'])}")]
     lines += [f"  {o['option']}: {o['given']} given, the file's {o['file']}" for o in rec["replaced"]]
     lines += [f"  dropped {d['channel']}: {d['reason']}" for d in rec["dropped"]]
     lines += [f"  note: {n}" for n in rec["notes"]]

@@ -7,7 +7,7 @@ import sys
 
 from ..core.errors import InputError
 from .commands import ARCHIVE_EXAMPLE, COMMANDS
-from .common import command_parser, worker_count, write_output
+from .common import add_plausibility_option, command_parser, worker_count, write_output
 
 TRACK_EXAMPLE = COMMANDS["track"].examples[0]
 
@@ -32,6 +32,7 @@ def add_parser(sub) -> None:
     trk.add_argument("--workers", type=worker_count, default=1, metavar="N", help="local processes (default 1)")
     trk.add_argument("--scheduler", metavar="ADDRESS",
                      help="a Dask distributed scheduler (tcp://host:8786) to run the records on instead")
+    add_plausibility_option(trk)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     inputs += [str(p) for s in specs for p in record_paths(s)]
     check_outputs([("--out", out, True), ("--json", args.json, False)], inputs)
     result = track(args.archive, out, cables=args.cable, workers=args.workers, scheduler=args.scheduler,
-                   progress=True if sys.stderr.isatty() else _lines())
+                   progress=True if sys.stderr.isatty() else _lines(), check_plausibility=args.plausibility_check)
     print(result.run_line(), file=sys.stderr)
     write_report(result)
     summary = result.summary()

@@ -269,7 +269,7 @@ def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
     if not out:
         if not skipped:
             raise InputError("the campaign has no test to identify from", field="test")
-        name, why = skipped[0]
+        name = skipped[0][0]
         where = "record" if campaign.test(name).record is not None else "frequencies"
         reasons = "; ".join(f"{n}: {r}" for n, r in skipped)
         raise InputError(f"no test is left to identify from ({reasons})", field=f"test[{name}].{where}")

@@ -200,6 +200,10 @@ def check_plausibility(campaign: Campaign, measurements: Sequence[Measurement], 
         raise InputError(f"{message} (if you mean it: --no-plausibility-check)", field=field)
 
 
+#: How a record path's refusal begins (``track`` recognises a cable whose first records all say it).
+IMPLAUSIBLE = "the nominal model is implausibly far from the record"
+
+
 def record_findings(campaign: Campaign, picked) -> list[tuple[Finding, Measurement, object]]:
     """Per picked test whose peaks' own series is implausibly far from the nominal family (the spectra's
     ``implausible_scale``): the finding, the peaks as the series numbers them, and the check."""
@@ -263,7 +267,7 @@ def check_records(campaign: Campaign, picked, tension_model: str = "uniform") ->
         guesses.append("check the units and values of the tension, cable.mass_per_length, cable.length and "
                        "cable.EI, and the record's sampling rate")
     scope = f"{len(findings)} of {n_records} records are off; " if n_records > 1 else ""
-    message = (f"the nominal model is implausibly far from the record ({scope}test {first.test}: "
+    message = (f"{IMPLAUSIBLE} ({scope}test {first.test}: "
                f"{check.sentence()}, outside ×/÷ {BAND:g}) — {' or '.join(guesses)} "
                "(if you mean it: --no-plausibility-check)")
     raise InputError(message, field=field, file=file)

@@ -30,7 +30,7 @@ from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes
 from .plane_options import PlaneOptions
-from .scale_check import ScaleCheck, check_scale, round_factor
+from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -267,8 +267,20 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
         plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),),
     )
-    check = check_scale("in", freqs, unc, _nominal_family(cable, atts, test.tension, tension_model, "in"))
+    family = _nominal_family(cable, atts, test.tension, tension_model, "in")
+    check = check_scale("in", freqs, unc, family)
+    if freqs.size < MIN_PEAKS and f_max < usable * record.sampling_rate:
+        # Too few peaks in the nominal band to judge its scale: a mass per length typed 1000x too large puts the
+        # band's top below the cable's mode 2. The scale is judged on a band WIDER_BAND times wider (the
+        # numbers stay the nominal band's).
+        wide = find_peaks(record, f_min=0.5 * nominal[0], f_max=min(usable * record.sampling_rate, WIDER_BAND * f_max),
+                          options=options)
+        check = check_scale("in", [p.frequency for p in wide.peaks], [p.uncertainty for p in wide.peaks], family)
     return _with_scale(spectra, () if check is None else (check,))
+
+
+#: How much wider the band searched for the scale check is when the nominal band holds too few peaks.
+WIDER_BAND = 10.0
 
 
 #: A numbered mode whose MAC is below this while its plane's family's median MAC is at least

@@ -33,6 +33,9 @@ __all__ = ["SCALE_BAND", "ScaleCheck", "check_scale", "round_factor"]
 SCALE_BAND = 1.3
 #: Fewest peaks the series must number for its scale to be trusted (two peaks fit many spacings).
 MIN_PEAKS = 3
+#: The lowest numbered modes whose ratios to the nominal family give the scale (more than one, so that one mode
+#: moved by a hidden mass or by sag does not decide).
+LOWEST = 3
 #: Sampling-rate slips recognised in a ratio (a rate typed 2×, 10× off, or the rate of another logger).
 RATE_FACTORS = (2.0, 0.5, 4.0, 0.25, 5.0, 0.2, 10.0, 0.1, 100.0, 0.01, 1000.0, 0.001)
 
@@ -50,8 +53,9 @@ class ScaleCheck:
     frequencies : ndarray
         The plane's peaks, Hz (numbered or not by the nominal numbering; structural peaks left out).
     ratio : float
-        Median over the series' numbered peaks of measured / nominal frequency of the same mode (NaN when
-        no numbered mode has a nominal frequency).
+        Measured / nominal frequency of the same mode, the geometric mean over the series' :data:`LOWEST`
+        lowest numbered modes (where a slip shows whole: a stiff member's higher modes are set by EI, which no
+        tension or mass slip moves; NaN when nothing is numbered).
     mode : int
         The lowest mode the series numbers.
     measured, nominal : float
@@ -120,6 +124,7 @@ def check_scale(plane: str, frequencies: Sequence[float], uncertainties: Sequenc
     family = np.asarray(nominal(int(n.max())), float)
     model = family[n - 1]
     ratios = f[numbered] / model
-    lowest = int(np.argmin(n))
-    return ScaleCheck(plane, series, f, float(np.median(ratios)), int(n[lowest]), float(f[numbered][lowest]),
-                      float(model[lowest]))
+    low = np.argsort(n)[:LOWEST]
+    lowest = int(low[0])
+    return ScaleCheck(plane, series, f, float(np.exp(np.mean(np.log(ratios[low])))), int(n[lowest]),
+                      float(f[numbered][lowest]), float(model[lowest]))

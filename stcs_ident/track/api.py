@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterable
@@ -38,6 +39,7 @@ from ..core.errors import InputError, TrackWarning
 from ..core.files import remove_stale
 from ..core.model import Damper, has_dampers
 from ..core.version import __version__
+from ..identify.plausibility import IMPLAUSIBLE
 from .archive import CableSpec, cable_names, content_id, discover
 from .damper_history import analyse_coefficient
 from .events import analyse_history
@@ -85,7 +87,7 @@ def cable_version(spec: CableSpec) -> str:
 
 def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, cables: list[str] | None = None,
           workers: int = 1, scheduler: str | None = None, batch: int = BATCH,
-          progress: bool | Callable = False) -> TrackResult:
+          progress: bool | Callable = False, check_plausibility: bool = True) -> TrackResult:
     """Bring the table of an archive up to date and analyse every cable's history (see the module docstring).
 
     Parameters
@@ -106,6 +108,10 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
         Records per task.
     progress : bool or callable(done, total)
         True: a progress bar with ETA on standard error (tqdm).
+    check_plausibility : bool
+        Refuse (InputError) a cable whose first records all say its nominal model is implausibly far from them
+        (a unit or sampling-rate slip in its campaign); False keeps their failed rows and goes on
+        (``--no-plausibility-check``).
 
     Returns
     -------
@@ -142,10 +148,35 @@ def track(archive: str | os.PathLike, out: str | os.PathLike | None = None, *, c
         if path.name.split("-")[0] in {cable_key(name) for name in gone}:
             path.unlink(missing_ok=True)
     table = sort_rows(pd.concat([*tables, others], ignore_index=True).drop(columns="part"))
+    if check_plausibility:
+        _refuse_slips(specs, table)
     table, histories = _histories(specs, table)
     table, dampers = _damper_histories(specs, table)
     write_table(out, table)
     return TrackResult(str(archive), out, tuple(specs), table, histories, counts=counts, dampers=dampers)
+
+
+#: A cable whose first this many records (by start time) all failed the record path's plausibility is refused.
+FIRST_RECORDS = 3
+
+
+def _refuse_slips(specs: list[CableSpec], table: pd.DataFrame) -> None:
+    """Refuse (InputError, exit 2 from the command line) a cable whose first :data:`FIRST_RECORDS` records all
+    say its nominal model is implausibly far from them: a unit or sampling-rate slip in its campaign, which no
+    history can be made of (a cable that changed later has plausible first records)."""
+    for spec in specs:
+        rows = table[table["cable"] == spec.name].sort_values("start_time", na_position="last")
+        first = rows.head(FIRST_RECORDS)
+        if len(first) and (first["status"] == "failed").all() and \
+                first["reason"].str.contains(IMPLAUSIBLE, regex=False).all():
+            reason = str(first["reason"].iloc[0])
+            named = re.search(r"field '([^']+)'", reason)
+            field = named.group(1) if named else None
+            if field is not None and field.startswith("test["):  # the record's test is the campaign's reference
+                field = f"test[{spec.campaign.tests[0].name}]" + field[field.index("]") + 1:]
+            raise InputError(f"cable {spec.name}: its first {len(first)} record(s) refused: "
+                             f"{reason[reason.index(IMPLAUSIBLE):]}", field=field,
+                             file=str(Path(spec.directory) / "campaign.toml"))
 
 
 def _other_cables(archive, specs: list[CableSpec], known: pd.DataFrame):

@@ -46,6 +46,7 @@ from pathlib import Path
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.model import Damper, Test
 from ..identify import IdentifiabilityWarning, identify
+from ..identify.plausibility import IMPLAUSIBLE, check_records
 from ..io.test_record import open_test_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec
@@ -87,6 +88,8 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
         if record.start_time is None:
             raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
         spectra = analyse_record(campaign, test, record, path, max_modes=MAX_MODES)
+        if getattr(spectra, "implausible_scale", ()):  # a unit or sampling-rate slip, not a change of the cable
+            check_records(campaign, {test.name: spectra})
         if not spectra.modes:
             raise ComputationError("no mode found in the record")
         row.update(n_modes=len(spectra.modes), modes=[int(m) for m in spectra.modes],
