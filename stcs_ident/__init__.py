@@ -43,9 +43,11 @@ _EXPORTS = {
     "compare_forward": "forward.compare", "find_peaks": "spectra.peaks", "analyse_test": "spectra.pipeline",
     "analyse_campaign": "spectra.pipeline", "simulate_campaign": "simulate.simulate_campaign",
     "identify": "identify.api", "diagnose": "diagnose.api", "track": "track.api", "quick_tension": "identify.quick",
+    "tension_from_record": "identify.quick_record", "harmonic_series": "spectra.harmonic",
+    "open_test_record": "io.test_record",
     # their results
     "ForwardResult": "forward.compare", "PeakResult": "spectra.peak_result", "TestSpectra": "spectra.pipeline",
-    "IdentificationResult": "identify.result", "Diagnosis": "diagnose.result", "TrackResult": "track.result",
+    "IdentificationResult": "identify.result", "RecordTensionResult": "identify.quick_record", "Diagnosis": "diagnose.result", "TrackResult": "track.result",
     # errors and warnings
     "InputError": "core.errors", "CampaignError": "core.errors", "ModelError": "core.errors",
     "ComputationError": "core.errors", "BoundError": "core.errors", "StcsWarning": "core.errors", "RecordWarning": "core.errors",
