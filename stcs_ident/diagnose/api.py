@@ -26,7 +26,7 @@ from ..core.notes import Note
 from ..core.settings import Settings
 from ..effects import registry
 from ..forward.compare import ForwardResult, compare_forward
-from ..identify.measurement import without_doubtful
+from ..identify.measurement import with_record_spectra, without_doubtful
 from ..identify.plausibility import check_plausibility as plausible
 from ..identify.plausibility import check_records
 from ..identify.problem import Measurement, gather_measurements, picked_planes, reset_warm_starts
@@ -118,6 +118,7 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
     settings = Settings(tension_model=tension_model, max_effects=max_effects, all_hypotheses=all_hypotheses)
     given = dict(picked or {})
     if check_plausibility:  # the records' own scale first: a slip bends the numbering to the wrong nominal
+        given = with_record_spectra(campaign, tests, given)
         check_records(campaign, given, settings.tension_model)
     picked, excluded = without_doubtful(campaign, given)
     measurements, skipped = gather_measurements(campaign, tests, picked, excluded)

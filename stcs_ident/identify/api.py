@@ -107,8 +107,10 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if method not in METHODS:
         raise InputError(f"must be one of {', '.join(METHODS)}, got {method!r}", field="method")
     if check_plausibility:  # the records' own scale first: a slip bends the numbering to the wrong nominal
+        from .measurement import with_record_spectra
         from .plausibility import check_records
 
+        picked = with_record_spectra(campaign, tests, picked)
         check_records(campaign, picked, tension_model)
     picked, doubt = without_doubtful(campaign, picked)
     measurements, skipped = gather_measurements(campaign, tests, picked, doubt)

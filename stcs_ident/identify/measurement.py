@@ -217,6 +217,24 @@ def without_doubtful(campaign: Campaign, picked: Mapping[str, object] | None) ->
     return out, notes
 
 
+def with_record_spectra(campaign: Campaign, tests: Sequence[str] | None,
+                        picked: Mapping[str, object] | None) -> dict:
+    """``picked`` with the spectra of every selected test measured by its record alone computed (as
+    :func:`gather_measurements` would compute them), so that the records can be judged before their numbers are
+    used (:func:`~stcs_ident.identify.plausibility.check_records`). Unknown names are left to
+    :func:`gather_measurements` to refuse."""
+    out = dict(picked or {})
+    known = {t.name for t in campaign.tests}
+    names = [n for n in tests if n in known] if tests else sorted(known, key=[t.name for t in campaign.tests].index)
+    for name in names:
+        test = campaign.test(name)
+        if name not in out and test.frequencies is None and test.record is not None:
+            from ..spectra.pipeline import analyse_test  # lazily: reads the record
+
+            out[name] = analyse_test(campaign, test)
+    return out
+
+
 def gather_measurements(campaign: Campaign, tests: Sequence[str] | None = None,
                         picked: Mapping[str, object] | None = None,
                         notes: list[Note] | None = None) -> tuple[list[Measurement], list[tuple[str, str]]]:

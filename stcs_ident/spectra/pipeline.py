@@ -233,9 +233,17 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     atts = campaign.setup(test.setup).attachments
     check_positions(record, cable.length, file=path)
     nominal = natural_frequencies(cable, atts, test.tension, max_modes, tension_model=tension_model)
-    check_duration(record, nominal[0] / 1.5, file=path)  # a few periods of mode 1, with margin for a 15 % error
     usable = 0.45  # of the sampling rate: the analysis band ends below the anti-aliasing filter's roll-off
-    check_bandwidth(record, nominal[0], usable=usable, file=path)
+    try:
+        check_duration(record, nominal[0] / 1.5, file=path)  # a few periods of mode 1, with margin for a 15 % error
+        check_bandwidth(record, nominal[0], usable=usable, file=path)
+    except InputError:
+        # Too short or too slowly sampled for the nominal mode 1: or a slip that moved the nominal family (a mass
+        # per length typed 1000x too large or small). The record's own peaks over its whole band tell which.
+        slip = _slip_only(test, record, path, cable, atts, tension_model, usable, options, plane_options)
+        if slip is None:
+            raise
+        return slip
     if record.channel_directions is not None:
         outcome = analyse_planes(record, cable, atts, test.tension, max_modes=max_modes, tension_model=tension_model,
                                  options=options, plane_options=plane_options, nominal_in=nominal)
@@ -277,6 +285,34 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                           options=options)
         check = check_scale("in", [p.frequency for p in wide.peaks], [p.uncertainty for p in wide.peaks], family)
     return _with_scale(spectra, () if check is None else (check,))
+
+
+def _slip_only(test: Test, record: Record, path: str, cable, atts, tension_model: str, usable: float,
+               options: PickingOptions, plane_options: PlaneOptions) -> TestSpectra | None:
+    """The spectra of a record the nominal model cannot even be looked for in (too short or too slowly sampled
+    for its mode 1) when the record's own peaks, over its whole band, form a series implausibly far from the
+    nominal family: no mode numbered, the peaks unassigned, the scale check implausible (a warning, and the
+    refusal with its hint in identify, diagnose and track). None when the peaks do not say so: the record is
+    then too short or too slow indeed."""
+    high = usable * record.sampling_rate
+    low = 8.0 / record.duration
+    if not high > low:
+        return None
+    result = find_peaks(record, f_min=low, f_max=high, options=options)
+    freqs = np.array([p.frequency for p in result.peaks])
+    unc = np.array([p.uncertainty for p in result.peaks])
+    check = check_scale("in", freqs, unc, _nominal_family(cable, atts, test.tension, tension_model, "in"))
+    if check is None or not check.implausible:
+        return None
+    spectra = TestSpectra(
+        name=test.name, record=path, modes=(), frequencies=np.zeros(0), uncertainty=np.zeros(0),
+        damping=np.zeros(0), channels=(), doubtful=(),
+        unassigned=tuple((float(f), float(u)) for f, u in zip(freqs, unc)), dropped=tuple(record.dropped),
+        peaks=result, numbering=number_modes([], [], cable, atts, test.tension), damping_uncertainty=np.zeros(0),
+        nominal_frequencies=None, options=options, record_replaced=tuple(record.replaced), mac=np.zeros(0),
+        shapes=(), plane_options=plane_options,
+        plane_notes=(Note.plain("directions", directions_note(record)),))
+    return _with_scale(spectra, (check,))
 
 
 #: How much wider the band searched for the scale check is when the nominal band holds too few peaks.
