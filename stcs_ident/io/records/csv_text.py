@@ -40,7 +40,7 @@ import pandas as pd
 
 from ...core.errors import InputError
 from ...core.record import Record
-from .base import HEAD_BYTES, RecordReader, file_head
+from .base import HEAD_BYTES, RecordReader, file_head, readers
 from .columns import Selection, by_channels, text_positions
 from .preamble import find_header
 from .rates import FileRate, printed_resolution, resolved_rate
@@ -96,10 +96,12 @@ class CsvReader(RecordReader):
     def read(self, path: str | os.PathLike, *, positions: Mapping[str, float] | None = None, **options: Any) -> Record:
         """:func:`record_from_csv`; a TOA5 or LVM file (by its first line) is read by its own reader."""
         layout = other_layout(file_head(path))
-        if layout is not None:
-            from . import lvm, toa5  # (they build on this module)
-
-            return {"toa5": toa5.READER, "lvm": lvm.READER}[layout].read(path, positions=positions, **options)
+        if layout is not None:  # their readers build on this module: found in the registry, not imported
+            reader = next((r for r in readers() if r.name == layout), None)
+            if reader is None:
+                raise InputError(f"a {layout.upper()} file, and no {layout!r} reader is registered",
+                                 file=os.fspath(path))
+            return reader.read(path, positions=positions, **options)
         return record_from_csv(path, positions or {}, **{k: v for k, v in options.items() if k in CSV_OPTIONS})
 
 
