@@ -147,8 +147,9 @@ def _score_starts(fs, sigma, starts: np.ndarray) -> list:
 
 def _starts(fs: np.ndarray) -> np.ndarray:
     """Rows (f₀, B): taut-string series with each of the three lowest peaks as mode 1, 2, …, :data:`MAX_MODE`
-    (deduplicated) and the spacing of neighbouring peaks as f₀ (a series whose low modes were not picked); and
-    stretched series through two of the three lowest peaks taken as low modes (a stiff member's)."""
+    (deduplicated) and the spacing of neighbouring peaks as f₀ (a series whose low modes were not picked);
+    stretched series through two neighbouring low peaks taken as modes n and n + 1 (a stiff member's high modes),
+    and through two of the three lowest peaks taken as low modes (a stiff member's)."""
     candidates = []
     for peak in fs[:3]:
         candidates.extend(peak / np.arange(1, MAX_MODE + 1))
@@ -161,6 +162,13 @@ def _starts(fs: np.ndarray) -> np.ndarray:
         if v > kept[-1] * 1.002:
             kept.append(v)
     rows = [(v, 0.0) for v in kept]
+    for i in range(min(2, fs.size - 1)):  # neighbouring peaks as neighbouring modes n, n + 1 of a stretched series
+        n = np.arange(1, MAX_MODE + 1, dtype=float)
+        yi, yj = (fs[i] / n) ** 2, (fs[i + 1] / (n + 1)) ** 2
+        c = (yj - yi) / (2 * n + 1)
+        a = yi - c * n**2
+        ok = (a > 0) & (c > 0) & (c <= MAX_INHARMONICITY * np.where(a > 0, a, 1))
+        rows.extend(zip(np.sqrt(a[ok]), c[ok] / a[ok]))
     low = fs[:3]
     for i in range(low.size):
         for j in range(i + 1, low.size):
