@@ -40,7 +40,10 @@ def test_missing_modes_odd_modes_only_and_a_high_start_are_numbered():
     f = pinned_beam(n, EI=2e3)
     for keep in ([2, 4, 5, 8], list(range(0, 30, 2)), list(range(14, 30))):  # modes 3, 5, 6, 9; odd; from 15
         series = harmonic_series(f[keep], 1e-3 * f[keep])
-        assert np.array_equal(series.modes, n[keep]) and not series.ambiguous
+        assert np.array_equal(series.modes, n[keep])
+        # four sparse peaks, or modes 15-30 alone: another stretched series (modes 16-31 ...) comes within the
+        # ambiguity; said so, never sure and wrong. Every other mode from mode 1 is sure.
+        assert series.ambiguous == (keep[0] > 0)
 
 
 def test_a_stiff_series_seen_from_a_high_mode_is_right_or_ambiguous():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from dataclasses import replace
 
 from .common import (
     add_campaign_argument,
@@ -15,6 +16,7 @@ from .common import (
     progress_line,
     write_output,
 )
+from .reader_options import add_reader_options, as_options, reading_from_args
 
 
 def add_parser(sub) -> None:
@@ -26,6 +28,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--structural", metavar="HZ[,HZ...]", type=_frequencies,
                         help="known frequencies of the deck or pylon (Hz): peaks at them or their harmonics are "
                              "reported as structural, never numbered (records with channel directions)")
+    add_reader_options(parser, "a RECORD file given instead of a campaign")
 
 
 def _frequencies(text: str) -> tuple[float, ...]:
@@ -44,8 +47,9 @@ def run(args: argparse.Namespace) -> int:
     from ..report.forward import to_json
     from ..report.spectra_tables import spectra_text
 
-    if _is_record(args.campaign):
-        return _run_record(args)
+    reading = reading_from_args(args, _is_record(args.campaign), "a record file given instead of a campaign")
+    if reading is not None or _is_record(args.campaign):
+        return _run_record(args, reading)
     campaign, file, tests = prepare(args)
     if args.structural:
         from ..spectra.pipeline import analyse_campaign
@@ -77,7 +81,7 @@ def _is_record(path: str) -> bool:
     return os.path.isfile(path) and not path.lower().endswith(".toml")
 
 
-def _run_record(args: argparse.Namespace) -> int:
+def _run_record(args: argparse.Namespace, reading) -> int:
     """``spectra FILE``: the record's peaks, unnumbered (no campaign: no model to number them against)."""
     from ..core.errors import InputError
     from ..identify.quick_record import pick_unnumbered
@@ -88,7 +92,11 @@ def _run_record(args: argparse.Namespace) -> int:
     for option, value in (("--test", args.test), ("--plot", args.plot), ("--structural", args.structural)):
         if value is not None:
             raise InputError("needs a campaign: a record alone is listed unnumbered", field=option)
-    record = open_record(args.campaign, RecordReading(positions=UnknownPositions()))
+    reading = reading or RecordReading()
+    try:
+        record = open_record(args.campaign, replace(reading, positions=reading.positions or UnknownPositions()))
+    except InputError as err:  # a reader's fix said as the option to type
+        raise as_options(err) from None
     peaks = pick_unnumbered(record)
     rows = [{"frequency": p.frequency, "uncertainty": p.uncertainty,
              "damping": None if p.damping is None else float(p.damping), "channels": list(p.channels)}

@@ -8,6 +8,7 @@ import sys
 
 from ..core.errors import InputError
 from .common import add_json_option, command_parser, write_output
+from .reader_options import add_reader_options, as_options, reading_from_args
 
 
 def add_parser(sub) -> None:
@@ -34,74 +35,8 @@ def add_parser(sub) -> None:
                                                               "exact model's σ (default 0.3; 0: exact)")
     parser.add_argument("--length-tolerance", metavar="REL", help="relative 1σ of --length (default 0.002)")
     parser.add_argument("--mass-tolerance", metavar="REL", help="relative 1σ of --mass (default 0.01)")
-    reader = parser.add_argument_group("reading a --record (as a campaign's record_format)")
-    for option, metavar, text in READER_OPTIONS:
-        reader.add_argument(option, metavar=metavar, help=text)
-    reader.add_argument("--override-sampling-rate", action="store_true",
-                        help="use --sampling-rate even where the file's own rate disagrees")
+    add_reader_options(parser, "--record")
     add_json_option(parser)
-
-
-#: The reader options of ``--record``: (option, metavar, help); each is the record_format key of its name.
-READER_OPTIONS = (
-    ("--sampling-rate", "HZ", "Hz, where the file has none (or with --override-sampling-rate)"),
-    ("--unit", "UNIT", "m/s^2, g, mg, mm/s^2 (default: the file's, else m/s^2)"),
-    ("--channels", "NAME[=POS],...", ("the acceleration channels to use (a text file's other columns ignored); "
-                                      "positions (m from end A) optional")),
-    ("--directions", "NAME=DIR,...", "channel directions: in, out, axial or degrees (default: the file's, else in)"),
-    ("--time-column", "NAME", "a text file's time column (default time)"),
-    ("--separator", "CHAR", "a text file's column separator (default ,)"),
-    ("--decimal", "CHAR", "a text file's decimal mark (default .)"),
-    ("--header-row", "N", "a text file's header line, 0-based (default: found after any preamble)"),
-    ("--skip-rows", "N,...", "a text file's lines after the header to skip (a units row: 1)"),
-    ("--variable", "NAME", "a MATLAB file's matrix (rec.acc for a struct's field)"),
-    ("--group", "NAME", "a TDMS file's group"),
-)
-
-
-def _reading(args: argparse.Namespace):
-    """The ``--record`` reading from the reader options given; a reader option without ``--record`` refused."""
-    from ..io.test_record import RecordReading
-
-    given = [o for o, _, _ in READER_OPTIONS if getattr(args, o[2:].replace("-", "_")) is not None]
-    if args.override_sampling_rate:
-        given.append("--override-sampling-rate")
-    if args.record is None:
-        if given:
-            raise InputError("is a reader option: it goes with --record", field=given[0])
-        return None
-    options, positions, directions = {}, {}, {}
-    for option in given:
-        key = option[2:].replace("-", "_")
-        value = getattr(args, key)
-        if key in ("sampling_rate",):
-            options[key] = _number(value, option)
-        elif key == "override_sampling_rate":
-            options[key] = True
-        elif key == "header_row":
-            options[key] = _numbers(value, option, int)[0]
-        elif key == "skip_rows":
-            options[key] = _numbers(value, option, int)
-        elif key == "channels":
-            names = []
-            for item in value.split(","):
-                name, _, where = item.partition("=")
-                names.append(name.strip())
-                if where:
-                    positions[name.strip()] = _number(where, option)
-            options[key] = names
-        elif key == "directions":
-            for item in value.split(","):
-                name, _, where = item.partition("=")
-                if not where:
-                    raise InputError(f"must be NAME=DIR pairs, got {item!r}", field=option)
-                try:
-                    directions[name.strip()] = float(where)
-                except ValueError:
-                    directions[name.strip()] = where.strip()
-        else:
-            options[key] = value
-    return RecordReading(positions=positions or None, options=options, directions=directions or None)
 
 
 def _number(text: str | None, option: str) -> float | None:
@@ -163,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     from ..identify.quick import quick_tension, rounding_uncertainty
     from ..report.forward import to_json
 
-    reading = _reading(args)
+    reading = reading_from_args(args, args.record is not None, "--record")
     if args.record is not None:
         return _run_record(args, reading)
     frequencies = _numbers(args.frequencies, "--frequencies")
@@ -195,12 +130,15 @@ def _run_record(args: argparse.Namespace, reading) -> int:
         if getattr(args, option[2:]) is not None:
             raise InputError("goes with --frequencies: with --record the peaks' numbers and 1σ come from the record",
                              field=option)
-    result = tension_from_record(args.record, _number(args.length, "--length"), _number(args.mass, "--mass"),
-                                 reading=reading, EI=_number(args.EI, "--EI"), EA=_number(args.EA, "--EA"),
-                                 inclination=_number(args.inclination, "--inclination"), boundary=args.boundary,
-                                 plane=args.plane, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
-                                 length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
-                                 mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"))
+    try:
+        result = tension_from_record(args.record, _number(args.length, "--length"), _number(args.mass, "--mass"),
+                                     reading=reading, EI=_number(args.EI, "--EI"), EA=_number(args.EA, "--EA"),
+                                     inclination=_number(args.inclination, "--inclination"), boundary=args.boundary,
+                                     plane=args.plane, EI_tolerance=_number(args.EI_tolerance, "--EI-tolerance"),
+                                     length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
+                                     mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"))
+    except InputError as err:  # a reader's fix said as the option to type
+        raise as_options(err) from None
     if args.json:
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":
