@@ -33,10 +33,11 @@ __all__ = ["HarmonicSeries", "harmonic_series"]
 #: Relative misfit allowed per mode (clamped ends and sag move the lowest modes of a stay by up to a few per cent
 #: from the pinned beam-string form; attachments move single modes by as much).
 TOLERANCE = 0.02
-#: ... and at most this share of the series' spacing f₀ (a tolerance of 2 % at mode 30 would be 60 % of the spacing,
-#: and a sub-harmonic series would absorb any stray peak; a tenth of it left a sagging 198 m stay's modes, a few
-#: per cent off the beam-string form, to a series twice as wide).
-SPACING_SHARE = 0.2
+#: ... and at most this share of the peaks' median spacing (a tolerance of 2 % at mode 30 would be 60 % of the
+#: spacing, and a sub-harmonic series would absorb any stray peak). The same for every candidate: a tolerance
+#: scaled by each candidate's own spacing gave a series twice as wide a tolerance twice as loose, and a sagging
+#: 198 m stay's peaks went to it.
+SPACING_SHARE = 0.1
 #: The refinement's first tolerance, as a share of the spacing (:func:`_refine`).
 LOOSE_SHARE = 0.3
 #: Cost of a peak left out of the series (a squared standardised residual: beyond 3σ).
@@ -205,13 +206,17 @@ def _starts(fs: np.ndarray) -> np.ndarray:
 
 
 def _sigma(fs, sigma, f0, share: float = None) -> np.ndarray:
-    """Each peak's σ for the series of fundamental ``f0`` (an array: one row per series): its own 1σ and the
-    model tolerance, at most :data:`SPACING_SHARE` of the spacing. ``sigma``: (the peaks' 1σ, the tolerance)."""
+    """Each peak's σ: its own 1σ and the model tolerance, at most ``share`` (default :data:`SPACING_SHARE`) of the
+    peaks' own median spacing. The same for every candidate series (``f0`` only shapes the result: one row per
+    series), so that a series twice as wide is not judged by a tolerance twice as loose. ``sigma``: (the peaks'
+    1σ, the tolerance)."""
     u, tolerance = sigma
     f0 = np.asarray(f0, float)
     share = SPACING_SHARE if share is None else share
-    model = np.minimum(tolerance * fs, share * (f0[..., None] if f0.ndim else f0))
-    return np.sqrt(u**2 + model**2)
+    spacing = float(np.median(np.diff(fs))) if fs.size > 1 else float(fs[0])
+    model = np.minimum(tolerance * fs, share * spacing)
+    out = np.sqrt(u**2 + model**2)
+    return np.broadcast_to(out, (*f0.shape, fs.size)) if f0.ndim else out
 
 
 def _family(f0: float, b: float, top: float) -> np.ndarray:
