@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import print_header  # noqa: E402  (the benchmarks' own helpers, beside this script)
+from common import print_header
+
 from stcs_ident.core.errors import ComputationError, InputError
 from stcs_ident.core.model import Cable
 from stcs_ident.identify.quick_record import tension_from_record

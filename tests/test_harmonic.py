@@ -84,7 +84,7 @@ def test_peaks_that_number_themselves_no_way_are_ambiguous():
 
 def test_the_scale_check_reads_a_slip_and_only_a_slip():
     f = pinned_beam(np.arange(1, 13), EI=2e4)
-    nominal = lambda n: pinned_beam(np.arange(1, n + 1), EI=2e4)  # noqa: E731
+    nominal = lambda n: pinned_beam(np.arange(1, n + 1), EI=2e4)
     same = check_scale("in", f, 1e-3 * f, nominal)
     assert same.conclusive and not same.implausible and same.ratio == pytest.approx(1.0, rel=1e-6)
     for factor in (2.0, 0.5, 10.0):  # a sampling rate typed wrong scales every peak

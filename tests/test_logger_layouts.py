@@ -178,8 +178,8 @@ def test_the_header_after_a_preamble_is_found_and_said(tmp_path):
     _refused(path, r"line 6 \('\[s\]', '\[g\]', '\[g\]'\) holds no number.*skip_rows = \[1\]", "acceleration",
              **options)
     record = read_record(path, skip_rows=[1], **options)
-    assert record.notes == ("header line found at line 4 (0-based) after a preamble of 4 line(s), 3 columns: "
-                            "give header_row = 4 in record_format to set it",)
+    assert record.notes == (("header line found at line 4 (0-based) after a preamble of 4 line(s), 3 columns: "
+                             "give header_row = 4 in record_format to set it"),)
     np.testing.assert_allclose(record.acceleration, acc * STANDARD_GRAVITY, rtol=RTOL)
     assert record.sampling_rate == FS
     given = read_record(path, skip_rows=[1], header_row=4, **options)  # given: nothing to say

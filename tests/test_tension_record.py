@@ -132,6 +132,6 @@ def test_the_stated_sigma_covers_the_truth_on_stays_and_hangers(tmp_path):
 
     z = []
     for k, kind in enumerate(["stay", "hanger"] * 6):
-        status, value = tension_record.run_case(kind, 600.0, 31000 + k, tmp_path)
+        _, value = tension_record.run_case(kind, 600.0, 31000 + k, tmp_path)
         z.append(np.inf if value is None else value)
     assert sum(v <= 3 for v in z) >= 11, z

@@ -64,7 +64,7 @@ def check_direction(value: Any, field: str = "direction") -> str | float:
     return {0.0: "in", 90.0: "out"}.get(angle, angle)
 
 
-def _finite(value: int | float) -> bool:
+def _finite(value: float) -> bool:
     """Whether ``value`` is a finite float (an integer beyond a float's range is not: TOML integers are
     unbounded)."""
     try:

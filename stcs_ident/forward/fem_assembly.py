@@ -10,7 +10,6 @@ in :mod:`~stcs_ident.forward.fem`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 

@@ -205,7 +205,7 @@ def _starts(fs: np.ndarray) -> np.ndarray:
     return np.asarray(rows)
 
 
-def _sigma(fs, sigma, f0, share: float = None) -> np.ndarray:
+def _sigma(fs, sigma, f0, share: float | None = None) -> np.ndarray:
     """Each peak's σ: its own 1σ and the model tolerance, at most ``share`` (default :data:`SPACING_SHARE`) of the
     peaks' own median spacing. The same for every candidate series (``f0`` only shapes the result: one row per
     series), so that a series twice as wide is not judged by a tolerance twice as loose. ``sigma``: (the peaks'
@@ -224,7 +224,7 @@ def _family(f0: float, b: float, top: float) -> np.ndarray:
     return n * f0 * np.sqrt(1.0 + b * n**2)
 
 
-def _score(fs, sigma, f0, b, share: float = None) -> tuple[float, float, float, np.ndarray]:
+def _score(fs, sigma, f0, b, share: float | None = None) -> tuple[float, float, float, np.ndarray]:
     """(cost with the skips, f₀, B, modes) of the series (f₀, B), its tolerance at most ``share`` of the spacing
     (default :data:`SPACING_SHARE`)."""
     family = _family(f0, b, fs[-1] * (1 + 4 * TOLERANCE))

@@ -46,7 +46,7 @@ from pathlib import Path
 from ..core.errors import ComputationError, InputError, one_line
 from ..core.model import Damper, Test
 from ..identify import IdentifiabilityWarning, identify
-from ..identify.plausibility import IMPLAUSIBLE, check_records
+from ..identify.plausibility import check_records
 from ..io.test_record import open_test_record
 from ..spectra.pipeline import analyse_record
 from .archive import CableSpec

@@ -106,5 +106,5 @@ def find_header(file: str, separator: str, decimal: str) -> tuple[int, tuple[str
     if run == 0:  # every line above the data is as wide: no preamble
         return 0, ()
     header = next((i for i in range(start - 1, run - 1, -1) if not looks_like_units(rows[i])), run)
-    return header, (f"header line found at line {header} (0-based) after a preamble of {header} line(s), "
-                    f"{width} columns: give header_row = {header} in record_format to set it",)
+    return header, ((f"header line found at line {header} (0-based) after a preamble of {header} line(s), "
+                     f"{width} columns: give header_row = {header} in record_format to set it"),)

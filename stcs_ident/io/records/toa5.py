@@ -36,9 +36,9 @@ import pandas as pd
 
 from ...core.errors import InputError
 from ...core.record import Record
+from . import csv_text
 from .base import RecordReader, file_head
 from .columns import by_units
-from . import csv_text
 from .csv_text import read_table, table_record
 from .validation import one_line
 
@@ -55,7 +55,7 @@ TOA5_OPTIONS = ("unit", "sampling_rate", "channels", "override_sampling_rate")
 def is_toa5(head: bytes) -> bool:
     """Whether a file's first bytes are a TOA5 header (``TOA5`` or ``"TOA5"`` opening the first line)."""
     head = head.removeprefix(b"\xef\xbb\xbf")
-    return head.startswith(b'"TOA5"') or head.startswith(b"TOA5,") or head.startswith(b"TOA5\r") or head == b"TOA5"
+    return head.startswith((b'"TOA5"', b"TOA5,", b"TOA5\r")) or head == b"TOA5"
 
 
 class Toa5Reader(RecordReader):

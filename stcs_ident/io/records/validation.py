@@ -42,9 +42,22 @@ from ...core.times import check_instant
 from .screening import screen_channels
 
 __all__ = [
-    "TIME_TOLERANCE", "UNITS", "UnknownPositions", "Positions", "check_bandwidth", "check_duration", "check_positions",
-    "check_sampling_rate", "names_from_positions", "one_line", "overridden", "position_list", "positions_by_name",
-    "rate_from_time", "unit_scale", "validated_record",
+    "TIME_TOLERANCE",
+    "UNITS",
+    "Positions",
+    "UnknownPositions",
+    "check_bandwidth",
+    "check_duration",
+    "check_positions",
+    "check_sampling_rate",
+    "names_from_positions",
+    "one_line",
+    "overridden",
+    "position_list",
+    "positions_by_name",
+    "rate_from_time",
+    "unit_scale",
+    "validated_record",
 ]
 
 #: Units a record may be in, as data loggers spell them, with their factor to m/s²: the one table of every
