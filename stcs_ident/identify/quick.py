@@ -34,7 +34,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..core import kinds
-from ..core.errors import ComputationError, InputError
+from ..core.errors import BoundError, ComputationError, InputError
 from ..core.model import finite_number, frequency, in_band, mode_number
 from ..core.notes import Note
 from ..core.planes import PLANES
@@ -386,6 +386,11 @@ def _tension_start(length, mass, freqs, modes, EI, fallback) -> float:
     return float(guess) if guess > 0 and math.isfinite(guess) else float(fallback)
 
 
+def _at_lower_EI(err: BoundError) -> bool:
+    """Whether a fit's BoundError is EI at its lower bound (its message names the parameter and the side)."""
+    return "EI_ratio = " in str(err) and "is its lower bound" in str(err)
+
+
 def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance,
            plane: str = "in") -> MethodEstimate:
     from ..core.model import Boundary, Cable, Campaign, Setup, Test
@@ -401,22 +406,37 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
     params = "tension,EI" if fit_EI else "tension"
     bounds = {"tension": (0.05, 2.0), **({"EI": (1e-3, 1e3)} if fit_EI else {})}
     source = SOURCES["exact"]
+    unseen = None
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             # the inputs are the nominal: nothing to judge them against (check_plausibility off)
-            result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
+            try:
+                result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
+            except BoundError as err:
+                if not (fit_EI and _at_lower_EI(err)):
+                    raise
+                # The modes show no stretch (a long stay's: ξ in the thousands): EI is not seen, and a string it is.
+                unseen = err
+                fit_EI, params, bounds = False, "tension", {"tension": (0.05, 2.0)}
+                campaign = replace(campaign, cable=replace(cable, EI=0.0))
+                result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
         t, u = result.value("tension")
     except (ComputationError, InputError, FloatingPointError, ArithmeticError) as err:
         return MethodEstimate("exact", None, None, f"the exact model's fit failed: {err}", source,
                               failed=isinstance(err, (ComputationError, FloatingPointError, ArithmeticError)))
     said = [str(n) for n in result.notes] + [str(w.message) for w in caught]
+    if unseen is not None:
+        said.insert(0, "EI is not seen by these modes (its fit went to its lower bound): the tension of a string "
+                       "(EI 0), high by EI's share, which these modes say is below their 1σ")
     extra: dict = {"EI": None, "EI_uncertainty": None}
     if fit_EI:
         extra["EI"], extra["EI_uncertainty"] = result.value("EI")
         extra["EI_source"] = "fitted with the tension (two modes or more, no --EI)"
     elif EI is not None:
         extra["EI"], extra["EI_source"] = EI, "given"
+    elif unseen is not None:
+        extra["EI_source"] = "taken as 0 (the modes show no stretch: EI's fit went to its lower bound)"
     else:
         extra["EI_source"] = "taken as 0 (one frequency and no --EI: a string)"
     if result.uncertainty_sources:  # the tension's σ from the frequencies and from the tolerances held, N
