@@ -10,9 +10,11 @@ and ``tension`` would together, without a campaign:
    band below the anti-aliasing roll-off;
 3. they are numbered from their own spacing (:func:`~stcs_ident.spectra.harmonic.harmonic_series`: no nominal
    tension is needed), and on an ambient record picked again with that series' modes proposed where no peak was
-   detected (as ``spectra`` proposes the nominal family's);
-4. every method of :func:`~stcs_ident.identify.quick.quick_tension` runs on the numbered peaks, with each
-   frequency's 1σ from the record.
+   detected (as ``spectra`` proposes the nominal family's); where the first peaks number no series (a short
+   record of a long cable), the spacings whose harmonics stand highest in the overview are proposed instead;
+4. every method of :func:`~stcs_ident.identify.quick.quick_tension` runs on the lowest numbered peaks (up to
+   :data:`MAX_MODES`, and to the first jump of more than :data:`MAX_JUMP` mode numbers), with each frequency's 1σ
+   from the record.
 
 A series that several spacings explain (one peak, or peaks a sub-harmonic
 numbers as well) is refused: its numbers would be a guess, and a wrong number
