@@ -30,7 +30,7 @@ from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes
 from .plane_options import PlaneOptions
-from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor
+from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor, shapes_confirm
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -275,6 +275,8 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
         plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),),
     )
+    if shapes_confirm(macs, ("in",) * len(order), "in"):  # the shapes confirm the numbers: no slip to look for
+        return _with_scale(spectra, ())
     family = _nominal_family(cable, atts, test.tension, tension_model, "in")
     check = check_scale("in", freqs, unc, family)
     if freqs.size < MIN_PEAKS and f_max < usable * record.sampling_rate:
@@ -364,7 +366,8 @@ def _with_scale(spectra: TestSpectra, checks: tuple[ScaleCheck, ...]) -> TestSpe
         return spectra
     text = "; ".join(c.sentence() for c in bad)
     factor = next((round_factor(c.ratio) for c in bad if round_factor(c.ratio) is not None), None)
-    cause = (f"the sampling rate {factor:g}× off, or units?" if factor is not None else
+    word = "" if factor is None else (f"{factor:g}× too high" if factor > 1 else f"{1 / factor:g}× too low")
+    cause = (f"a sampling rate {word}, or units?" if factor is not None else
              "the units of the tension or the mass per length?")
     message = f"{spectra.name}: {text}: {cause} every mode number is doubtful"
     warnings.warn(message, NumberingWarning, stacklevel=3)
@@ -422,13 +425,17 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
         plane_peaks=tuple(peaks.items()), plane_options=plane_options, plane_notes=notes,
         plane_nominal=tuple((plane, np.asarray(outcome.nominal[plane], float)) for plane in peaks),
     )
-    return _with_scale(spectra, _plane_scale(outcome, cable, atts, tension, tension_model))
+    return _with_scale(spectra, _plane_scale(outcome, cable, atts, tension, tension_model, spectra))
 
 
-def _plane_scale(outcome: PlanesOutcome, cable, atts, tension: float, tension_model: str) -> tuple[ScaleCheck, ...]:
-    """Each plane's scale check on its peaks, the structural ones and the leaks left out."""
+def _plane_scale(outcome: PlanesOutcome, cable, atts, tension: float, tension_model: str,
+                 spectra: TestSpectra) -> tuple[ScaleCheck, ...]:
+    """Each plane's scale check on its peaks, the structural ones and the leaks left out; none for a plane whose
+    numbered modes' shapes confirm their numbers (:func:`.scale_check.shapes_confirm`)."""
     out = []
     for plane, result in outcome.peaks.items():
+        if shapes_confirm(spectra.mac, spectra.mode_planes, plane):
+            continue
         aside = {k for p, k, _ in (*outcome.structural, *outcome.leaks) if p == plane}
         kept = [p for k, p in enumerate(result.peaks) if k not in aside]
         check = check_scale(plane, [p.frequency for p in kept], [p.uncertainty for p in kept],

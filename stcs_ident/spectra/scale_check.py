@@ -26,7 +26,7 @@ import numpy as np
 
 from .harmonic import HarmonicSeries, harmonic_series
 
-__all__ = ["SCALE_BAND", "ScaleCheck", "check_scale", "round_factor"]
+__all__ = ["SCALE_BAND", "ScaleCheck", "check_scale", "round_factor", "shapes_confirm"]
 
 #: Largest plausible ratio (either way) of measured to nominal frequencies: the plausibility check's band
 #: (a stated tension 0.6–1.7 × the truth gives a ratio within 1.3; a unit slip is √1000 ≈ 31.6 or more).
@@ -36,6 +36,12 @@ MIN_PEAKS = 3
 #: The lowest numbered modes whose ratios to the nominal family give the scale (more than one, so that one mode
 #: moved by a hidden mass or by sag does not decide).
 LOWEST = 3
+#: A plane whose numbered modes' median MAC is this or more, over at least :data:`MIN_PEAKS` modes with a meaningful
+#: MAC, has its numbers confirmed by the shapes, and is not checked (:func:`shapes_confirm`): the slips the check is
+#: for give 0.0-0.6 (a tension in kN: 0.48, 0.04, 0.00; a rate 2x off: 0.00-0.59), a correct campaign's modes
+#: 0.95-1.00; and the series of a plane whose deck-mode peaks stand beside the cable's may be the sub-harmonic
+#: one, which numbers both (a biaxial stay's out-of-plane peaks gave a ratio of 0.51, its MACs 0.9 and more).
+CONFIRMING_MAC = 0.8
 #: Sampling-rate slips recognised in a ratio (a rate typed 2×, 10× off, or the rate of another logger).
 RATE_FACTORS = (2.0, 0.5, 4.0, 0.25, 5.0, 0.2, 10.0, 0.1, 100.0, 0.01, 1000.0, 0.001)
 
@@ -93,7 +99,8 @@ class ScaleCheck:
         return {"plane": self.plane, "ratio": float(self.ratio), "mode": int(self.mode),
                 "measured": float(self.measured), "nominal": float(self.nominal),
                 "fundamental": float(self.series.fundamental), "inharmonicity": float(self.series.inharmonicity),
-                "numbered": self.series.n_assigned, "conclusive": self.conclusive, "implausible": self.implausible}
+                "numbered": self.series.n_assigned, "conclusive": self.conclusive,
+                "implausible": self.implausible}
 
 
 def _times(ratio: float) -> str:
@@ -107,6 +114,16 @@ def round_factor(ratio: float, tolerance: float = 0.03) -> float | None:
         if abs(ratio / k - 1) <= tolerance:
             return k
     return None
+
+
+def shapes_confirm(macs, planes, plane: str) -> bool:
+    """Whether the numbered modes of ``plane`` (``macs`` and ``planes`` per mode) confirm their numbers by their
+    shapes (:data:`CONFIRMING_MAC`)."""
+    if macs is None:
+        return False
+    values = np.asarray(macs, float)[np.asarray(planes) == plane]
+    values = values[np.isfinite(values)]
+    return bool(values.size >= MIN_PEAKS and np.median(values) >= CONFIRMING_MAC)
 
 
 def check_scale(plane: str, frequencies: Sequence[float], uncertainties: Sequence[float],
