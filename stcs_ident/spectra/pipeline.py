@@ -279,10 +279,12 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         return _with_scale(spectra, ())
     family = _nominal_family(cable, atts, test.tension, tension_model, "in")
     check = check_scale("in", freqs, unc, family)
-    if freqs.size < MIN_PEAKS and f_max < usable * record.sampling_rate:
-        # Too few peaks in the nominal band to judge its scale: a mass per length typed 1000x too large puts the
-        # band's top below the cable's mode 2. The scale is judged on a band WIDER_BAND times wider (the
-        # numbers stay the nominal band's).
+    if freqs.size < MIN_PEAKS and f_max < usable * record.sampling_rate and (not order or any(spectra.doubtful)):
+        # Too few peaks in the nominal band to judge its scale, and no sure number among them: a mass per length
+        # typed 1000x too large puts the band's top below the cable's mode 2. The scale is judged on a band
+        # WIDER_BAND times wider (the numbers stay the nominal band's). A record whose few peaks the nominal
+        # numbers surely is left alone (a short or quiet record of a correct campaign: the wider search would
+        # cost a second picking).
         wide = find_peaks(record, f_min=0.5 * nominal[0], f_max=min(usable * record.sampling_rate, WIDER_BAND * f_max),
                           options=options)
         check = check_scale("in", [p.frequency for p in wide.peaks], [p.uncertainty for p in wide.peaks], family)
