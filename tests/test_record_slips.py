@@ -85,6 +85,7 @@ def test_a_tension_typed_in_kN_on_a_record_is_refused_naming_the_tension(stay, t
     assert "--test" not in line and "--no-plausibility-check" in line
 
 
+@pytest.mark.slow
 def test_spectra_warns_and_marks_every_number_doubtful(stay, tmp_path):
     campaign = load_campaign(_variant(stay, tmp_path, lambda t: _scale(t, 1e-3)))
     with warnings.catch_warnings(record=True) as caught:
@@ -154,6 +155,7 @@ def test_the_override_fits_anyway(stay, tmp_path, capsys):
     assert "option '--test'" not in err
 
 
+@pytest.mark.slow
 def test_a_library_call_refuses_in_one_line(stay, tmp_path):
     from stcs_ident import identify
 

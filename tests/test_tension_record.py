@@ -59,6 +59,7 @@ def test_a_stays_record_gives_its_tension_within_its_sigma(stay_record):
     assert "from the record" in summary["inputs"]["uncertainty_source"]
 
 
+@pytest.mark.slow
 def test_the_command_line_answers_and_writes_the_json(stay_record, tmp_path, capsys):
     out = tmp_path / "t.json"
     assert _run("tension", "--record", stay_record, "--length", "120", "--mass", "80", "--EA", "1.5e9",
@@ -70,6 +71,7 @@ def test_the_command_line_answers_and_writes_the_json(stay_record, tmp_path, cap
     assert abs(data["methods"]["exact"]["tension"] / TENSION - 1) < 0.03
 
 
+@pytest.mark.slow
 def test_a_text_record_with_a_preamble_and_decimal_commas_reads_with_its_options(stay_record, tmp_path, capsys):
     import h5py
 
