@@ -189,7 +189,8 @@ def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
                 peaks, series = again, retry
     freqs = np.array([p.frequency for p in peaks.peaks])
     sigma = np.array([p.uncertainty for p in peaks.peaks])
-    numbered = _low_block(series.modes)
+    usable = np.isfinite(sigma) & (sigma > 0) & (sigma < MAX_SHARE * freqs)
+    numbered = _low_block(np.where(usable, series.modes, 0))
     quick = quick_tension(length, mass, freqs[numbered], series.modes[numbered], EI=EI, EA=EA,
                           inclination=inclination, boundary=boundary, uncertainty=sigma[numbered],
                           uncertainty_source="from the record's spectra (each peak's fit)",
@@ -214,6 +215,9 @@ def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
     return RecordTensionResult(quick, info, table, series, tuple(notes))
 
 
+#: A numbered peak whose 1σ is this share of its frequency or more is not passed on (a fit that says nothing of the
+#: frequency: one such peak of a 60-s record had a 1σ above its frequency, which the methods refuse).
+MAX_SHARE = 0.05
 #: The modes passed on stop before a jump of more than this many mode numbers: sparse high peaks are numbered from a
 #: stretch extrapolated beyond the modes that fixed it (a 198 m stay's peaks at 17.6 and 19.9 Hz, after its run of
 #: modes up to 37 at 13.7 Hz, came out as modes 42 and 46 for 47 and 53).
