@@ -108,6 +108,11 @@ def test_refusals_name_the_option(stay_record, capsys):
     assert exit_.value.code == 2 and "not allowed with argument --record" in capsys.readouterr().err
     assert _run("spectra", ROOT / "campaigns" / "hanger-hidden-mass", "--unit", "g") == 2
     assert "option '--unit': is a reader option" in capsys.readouterr().err
+    # a reader's fix is said as the option to type (a text file without a time column)
+    assert _run("tension", "--record", ROOT / "campaigns" / "han2020" / "data" / "tensions.csv", "--length", "20",
+                "--mass", "16") == 2
+    err = capsys.readouterr().err
+    assert "--time-column" in err and "--sampling-rate" in err and "time_column" not in err, err
 
 
 def test_peaks_that_several_spacings_explain_are_refused(tmp_path):

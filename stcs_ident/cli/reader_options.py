@@ -88,7 +88,7 @@ def reading_from_args(args: argparse.Namespace, has_record: bool, record: str):
     return RecordReading(positions=positions or None, options=options, directions=directions or None)
 
 
-_KEY = re.compile(r"\b(?P<verb>give |remove )?(?P<key>"
+_KEY = re.compile(r"\b(?P<verb>give |remove |with )?(?P<key>"
                   + "|".join(o[2:].replace("-", "_") for o, _, _ in READER_OPTIONS) + r"|override_sampling_rate)"
                   + r"( = (?P<value>\[[^\]]*\]|\"[^\"]*\"|'[^']*'|<[^>]*>|[^\s,;)]+))?(?P<where> in record_format)?")
 
