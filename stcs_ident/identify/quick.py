@@ -40,6 +40,7 @@ from ..core.notes import Note
 from ..core.planes import PLANES
 from ..core.result import Result
 from .problem import printed_step
+from .quick_starts import EI_start, at_lower_EI, tension_start
 
 BOUNDARIES = ("clamped", "pinned")
 
@@ -360,44 +361,13 @@ def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, to
     return replace(estimate, uncertainty=math.hypot(estimate.uncertainty, *shares.values()), extra=extra)
 
 
-def _EI_start(length, mass, freqs, modes, tension) -> float:
-    """A start for EI: the slope of (f_n/n)² against n² is π² EI/(4 m l⁴) on a pinned beam; where that slope is
-    not positive, EI for ξ = 100."""
-    slope = np.polyfit(modes.astype(float) ** 2, (freqs / modes) ** 2, 1)[0]
-    guess = 4 * mass * length**4 * slope / math.pi**2
-    fallback = tension * length**2 / 100.0**2
-    return float(guess) if guess > 0 and math.isfinite(guess) else fallback
-
-
-def _tension_start(length, mass, freqs, modes, EI, fallback) -> float:
-    """A start for the exact fit's tension from the pinned tensioned beam, (f_n/n)² = T/(4 m l²) + π² EI n²/(4 m l⁴)
-    (docs/model.md): with EI unknown and two modes or more, the intercept of the straight line through the
-    modes; with EI given (or one mode), the lowest mode with EI's share removed. The mean of the taut-string
-    tensions of every mode, the start before, was 1.6x the truth on a stiff hanger (ξ 16, eleven modes), far
-    enough that the fit refused its own start as implausible. ``fallback`` where the line gives no positive
-    tension."""
-    n = modes.astype(float)
-    if EI is None and freqs.size >= 2 and np.unique(n).size >= 2:
-        intercept = np.polyfit(n**2, (freqs / n) ** 2, 1)[1]
-        guess = 4 * mass * length**2 * intercept
-    else:
-        k = int(np.argmin(n))
-        guess = 4 * mass * length**2 * (freqs[k] / n[k]) ** 2 - (n[k] * math.pi) ** 2 * (EI or 0.0) / length**2
-    return float(guess) if guess > 0 and math.isfinite(guess) else float(fallback)
-
-
-def _at_lower_EI(err: BoundError) -> bool:
-    """Whether a fit's BoundError is EI at its lower bound (its message names the parameter and the side)."""
-    return "EI_ratio = " in str(err) and "is its lower bound" in str(err)
-
-
 def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance,
            plane: str = "in") -> MethodEstimate:
     from ..core.model import Boundary, Cable, Campaign, Setup, Test
     from .api import identify
 
     fit_EI = EI is None and freqs.size >= 2
-    EI_nominal = EI if EI is not None else (_EI_start(length, mass, freqs, modes, start) if fit_EI else 0.0)
+    EI_nominal = EI if EI is not None else (EI_start(length, mass, freqs, modes, start) if fit_EI else 0.0)
     end = Boundary.clamped() if boundary == "clamped" else Boundary.pinned()
     cable = Cable(length, mass, EI_nominal, EA, math.radians(inclination), boundary_a=end, boundary_b=end)
     test = Test("quick", "quick", start, tuple(map(float, freqs)), tuple(map(int, modes)),
@@ -414,7 +384,7 @@ def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, sta
             try:
                 result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
             except BoundError as err:
-                if not (fit_EI and _at_lower_EI(err)):
+                if not (fit_EI and at_lower_EI(err)):
                     raise
                 # The modes show no stretch (a long stay's: ξ in the thousands): EI is not seen, and a string it is.
                 unseen = err
@@ -531,7 +501,7 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
         "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
         **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
         "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
-                        _tension_start(length, mass, freqs, modes, EI, float(np.mean(taut.per_mode))), tolerance,
+                        tension_start(length, mass, freqs, modes, EI, float(np.mean(taut.per_mode))), tolerance,
                         plane),
     }
     return QuickTensionResult(inputs, methods)

@@ -37,6 +37,7 @@ from ..core.record import Record
 from ..core.result import Result
 from ..io.records.validation import UnknownPositions
 from ..io.test_record import RecordReading, open_record
+from ..spectra.channels import plane_channels, plane_record
 from ..spectra.harmonic import HarmonicSeries, harmonic_series
 from ..spectra.peaks import PeakResult, find_peaks
 from .quick import QuickTensionResult, quick_tension
@@ -164,15 +165,14 @@ def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
     reading = reading or RecordReading()
     if reading.positions is None:  # not needed: the peaks are numbered from their spacing, not their shapes
         reading = replace(reading, positions=UnknownPositions())
-    record = open_record(path, reading)
+    read = open_record(path, reading)
     file = os.fspath(path)
-    record = _named_channels(record, reading.options.get("channels"))
-    record, used = _plane_channels(record, plane)
+    record, used = _plane_channels(_named_channels(read, reading.options.get("channels")), plane)
     first = pick_unnumbered(record)
     if not first.peaks:
         raise InputError(f"no peak found between {8 / record.duration:.3g} and {USABLE * record.sampling_rate:.4g} Hz "
                          "on any channel", field="acceleration", file=file)
-    series = harmonic_series([p.frequency for p in first.peaks], [p.uncertainty for p in first.peaks])
+    series = _series_of(first)
     peaks = first
     if first.kind == "ambient" and (series.ambiguous or series.n_assigned < MIN_SERIES):
         # A short ambient record of a long cable: most modes below the detection threshold, too few peaks to
@@ -184,7 +184,7 @@ def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
         top = series.frequency(np.arange(1, MAX_MODES + 1))
         again = pick_unnumbered(record, expected=top[top < USABLE * record.sampling_rate])
         if again.peaks:
-            retry = harmonic_series([p.frequency for p in again.peaks], [p.uncertainty for p in again.peaks])
+            retry = _series_of(again)
             if retry is not None and not retry.ambiguous and abs(retry.fundamental / series.fundamental - 1) < 0.02:
                 peaks, series = again, retry
     freqs = np.array([p.frequency for p in peaks.peaks])
@@ -209,9 +209,9 @@ def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
                      + ", ".join(f"{p['frequency']:.4g} Hz" for p in left[:8]) + (" …" if len(left) > 8 else ""))
     info = {"path": file, "channels": list(used), "sampling_rate": record.sampling_rate,
             "duration": record.duration, "kind": peaks.kind,
-            "replaced": [{"option": o, "given": g, "file": f} for o, g, f in record.replaced],
-            "dropped": [{"channel": c, "reason": r} for c, r in record.dropped],
-            "notes": [str(n) for n in getattr(record, "notes", ())]}
+            "replaced": [{"option": o, "given": g, "file": f} for o, g, f in read.replaced],
+            "dropped": [{"channel": c, "reason": r} for c, r in read.dropped],
+            "notes": list(read.notes)}
     return RecordTensionResult(quick, info, table, series, tuple(notes))
 
 
@@ -235,6 +235,11 @@ def _low_block(modes: np.ndarray) -> np.ndarray:
     return numbered[:MAX_MODES]
 
 
+def _series_of(peaks: PeakResult) -> HarmonicSeries | None:
+    """The harmonic series of picked peaks (their frequencies and 1σ)."""
+    return harmonic_series([p.frequency for p in peaks.peaks], [p.uncertainty for p in peaks.peaks])
+
+
 def _series(peaks: PeakResult, series: HarmonicSeries, file: str) -> HarmonicSeries:
     """``series``, the harmonic series of ``peaks``; refused where it is not sure (module docstring)."""
     freqs = [p.frequency for p in peaks.peaks]
@@ -248,18 +253,16 @@ def _series(peaks: PeakResult, series: HarmonicSeries, file: str) -> HarmonicSer
 
 
 def _plane_channels(record: Record, plane: str) -> tuple[Record, tuple[str, ...]]:
-    """The record with only the channels of ``plane`` (every channel when the record has no directions)."""
+    """The record of ``plane``'s channels as spectra reads a plane (:func:`~stcs_ident.spectra.channels.plane_channels`:
+    a turned sensor pair rotated, a sensor at an angle scaled); every channel when the record has no directions."""
     if record.channel_directions is None:
         return record, record.channel_names
-    keep = [k for k, d in enumerate(record.channel_directions) if d == plane]
-    if not keep:
+    channels, _ = plane_channels(record)
+    if plane not in channels:
         given = ", ".join(f"{n} {d}" for n, d in zip(record.channel_names, record.channel_directions))
         raise InputError(f"no {plane!r} channel among {given}: give --plane or the channels' directions",
                          field="channel_direction", file=record.source)
-    sub = replace(record, acceleration=record.acceleration[:, keep],
-                  channel_names=tuple(record.channel_names[k] for k in keep),
-                  channel_positions=record.channel_positions[keep],
-                  channel_directions=tuple(record.channel_directions[k] for k in keep))
+    sub = plane_record(record, channels[plane])
     return sub, sub.channel_names
 
 
@@ -314,7 +317,7 @@ def _from_harmonic_sum(record: Record, first: PeakResult, series: HarmonicSeries
         again = pick_unnumbered(record, expected=expected)
         if not again.peaks:
             continue
-        trial = harmonic_series([p.frequency for p in again.peaks], [p.uncertainty for p in again.peaks])
+        trial = _series_of(again)
         if trial is not None and not trial.ambiguous and (best[1].ambiguous or trial.n_assigned > best[1].n_assigned):
             best = (again, trial)
     return best

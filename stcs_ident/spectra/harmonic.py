@@ -149,12 +149,7 @@ def _score_starts(fs, sigma, starts: np.ndarray) -> list:
     residual = ((fs[None, :] - n * f0 * np.sqrt(1 + b * n**2)) / sigma) ** 2
     on = residual < UNASSIGNED_COST
     on[:, 1:] &= n[:, 1:] != n[:, :-1]  # sorted peaks: a repeated mode is taken by its first peak only
-    cost = np.where(on, residual, UNASSIGNED_COST).sum(axis=1)
-    lowest = np.where(on, n, np.inf).min(axis=1)
-    highest = np.where(on, n, -np.inf).max(axis=1)
-    count = on.sum(axis=1)
-    skipped = np.where(count > 0, highest - lowest + 1 - count, 0)
-    total = cost + SKIP_COST * skipped
+    total = np.where(on, residual, UNASSIGNED_COST).sum(axis=1) + SKIP_COST * _skipped(np.where(on, n, 0))
     order = np.argsort(total, kind="stable")
     return [(float(total[k]), float(starts[k, 0]), float(starts[k, 1]), None) for k in order]
 
@@ -233,11 +228,16 @@ def _scores(fs, sigma, f0: np.ndarray, b: np.ndarray, share: float | None = None
     families = np.where(n[None, :] <= count[:, None], n[None, :] * f0[:, None] * np.sqrt(1 + b[:, None] * n**2),
                         np.inf)
     modes, cost = assign(fs, _sigma(fs, sigma, np.float64(1.0), share), families, UNASSIGNED_COST)
+    return cost + SKIP_COST * _skipped(modes), modes
+
+
+def _skipped(modes: np.ndarray) -> np.ndarray:
+    """Per row of mode numbers (0: a peak left out), the modes of the series skipped between its lowest and its
+    highest assigned one."""
     on = modes > 0
-    lowest = np.where(on, modes, np.iinfo(int).max).min(axis=1)
-    highest = np.where(on, modes, 0).max(axis=1)
-    skipped = np.where(on.any(axis=1), highest - lowest + 1 - on.sum(axis=1), 0)
-    return cost + SKIP_COST * skipped, modes
+    lowest = np.where(on, modes, np.inf).min(axis=1)
+    highest = np.where(on, modes, -np.inf).max(axis=1)
+    return np.where(on.any(axis=1), highest - lowest + 1 - on.sum(axis=1), 0)
 
 
 def _refine_all(fs, sigma, f0: np.ndarray, b: np.ndarray, iterations: int = 6) -> list:
