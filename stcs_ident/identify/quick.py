@@ -27,20 +27,19 @@ as ``identify`` does).
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..core import kinds
-from ..core.errors import BoundError, ComputationError, InputError
+from ..core.errors import ComputationError, InputError
 from ..core.model import finite_number, frequency, in_band, mode_number
 from ..core.notes import Note
 from ..core.planes import PLANES
 from ..core.result import Result
 from .problem import printed_step
-from .quick_starts import EI_start, at_lower_EI, tension_start
+from .quick_exact import Member, exact_tension
 
 BOUNDARIES = ("clamped", "pinned")
 
@@ -361,64 +360,21 @@ def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, to
     return replace(estimate, uncertainty=math.hypot(estimate.uncertainty, *shares.values()), extra=extra)
 
 
-def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, start, tolerance,
+def _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, tolerance,
            plane: str = "in") -> MethodEstimate:
-    from ..core.model import Boundary, Cable, Campaign, Setup, Test
-    from .api import identify
-
-    fit_EI = EI is None and freqs.size >= 2
-    EI_nominal = EI if EI is not None else (EI_start(length, mass, freqs, modes, start) if fit_EI else 0.0)
-    end = Boundary.clamped() if boundary == "clamped" else Boundary.pinned()
-    cable = Cable(length, mass, EI_nominal, EA, math.radians(inclination), boundary_a=end, boundary_b=end)
-    test = Test("quick", "quick", start, tuple(map(float, freqs)), tuple(map(int, modes)),
-                uncertainty=tuple(map(float, sigma)), planes=(plane,) * freqs.size)
-    campaign = Campaign("quick-tension", cable, (Setup("quick"),), (test,), tolerance=tuple(tolerance.items()))
-    params = "tension,EI" if fit_EI else "tension"
-    bounds = {"tension": (0.05, 2.0), **({"EI": (1e-3, 1e3)} if fit_EI else {})}
-    source = SOURCES["exact"]
-    unseen = None
+    """The exact model, solved without a nominal (:mod:`.quick_exact`)."""
+    member = Member(length, mass, EA, inclination, boundary, plane)
     try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            # the inputs are the nominal: nothing to judge them against (check_plausibility off)
-            try:
-                result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
-            except BoundError as err:
-                if not (fit_EI and at_lower_EI(err)):
-                    raise
-                # The modes show no stretch (a long stay's: ξ in the thousands): EI is not seen, and a string it is.
-                unseen = err
-                fit_EI, params, bounds = False, "tension", {"tension": (0.05, 2.0)}
-                campaign = replace(campaign, cable=replace(cable, EI=0.0))
-                result = identify(campaign, params=params, bounds=bounds, check_plausibility=False)
-        t, u = result.value("tension")
-    except (ComputationError, InputError, FloatingPointError, ArithmeticError) as err:
-        return MethodEstimate("exact", None, None, f"the exact model's fit failed: {err}", source,
-                              failed=isinstance(err, (ComputationError, FloatingPointError, ArithmeticError)))
-    said = [str(n) for n in result.notes] + [str(w.message) for w in caught]
-    if unseen is not None:
-        said.insert(0, "EI is not seen by these modes (its fit went to its lower bound): the tension of a string "
-                       "(EI 0), high by EI's share, which these modes say is below their 1σ")
-    extra: dict = {"EI": None, "EI_uncertainty": None}
-    if fit_EI:
-        extra["EI"], extra["EI_uncertainty"] = result.value("EI")
-        extra["EI_source"] = "fitted with the tension (two modes or more, no --EI)"
-    elif EI is not None:
-        extra["EI"], extra["EI_source"] = EI, "given"
-    elif unseen is not None:
-        extra["EI_source"] = "taken as 0 (the modes show no stretch: EI's fit went to its lower bound)"
-    else:
-        extra["EI_source"] = "taken as 0 (one frequency and no --EI: a string)"
-    if result.uncertainty_sources:  # the tension's σ from the frequencies and from the tolerances held, N
-        i = next(i for i, q in enumerate(result.parameters) if q.kind == "tension")
-        q, x = result.parameters[i], float(result.estimate[i])
-        extra["uncertainty_from_frequencies"] = q.value_uncertainty(x, result.uncertainty_sources["frequencies"][i])
-        extra["uncertainty_from_tolerances"] = q.value_uncertainty(x, result.uncertainty_sources["tolerances"][i])
-        extra["tolerances_held"] = dict(result.uncertainty_sources["held"])
-    extra["reduced_chi2"] = _num(result.reduced_chi2)
-    extra["covariance_scale"] = float(result.covariance_scale)
-    extra["fitted"] = params
-    return MethodEstimate("exact", t, u, "; ".join(dict.fromkeys(said)) or None, source, (), extra)
+        answer = exact_tension(member, freqs, sigma, modes, EI, tolerance)
+    except (ComputationError, FloatingPointError, ArithmeticError) as err:
+        return MethodEstimate("exact", None, None, f"the exact model's computation failed: {err}", SOURCES["exact"],
+                              failed=True)
+    if answer.failed:
+        return MethodEstimate("exact", None, None, f"no tension: {answer.reason}", SOURCES["exact"], failed=True)
+    extra = {"EI": answer.EI, "EI_uncertainty": answer.EI_uncertainty, "EI_source": answer.EI_source,
+             **answer.extra}
+    return MethodEstimate("exact", answer.tension, answer.uncertainty, "; ".join(answer.notes) or None,
+                          SOURCES["exact"], (), extra)
 
 
 def quick_tension(length: float, mass: float, frequencies: Sequence[float], modes: Sequence[int] | None = None,
@@ -500,8 +456,6 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
         "taut_string": taut,
         "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
         **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
-        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary,
-                        tension_start(length, mass, freqs, modes, EI, float(np.mean(taut.per_mode))), tolerance,
-                        plane),
+        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, held, plane),
     }
     return QuickTensionResult(inputs, methods)
