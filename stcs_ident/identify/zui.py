@@ -1,0 +1,292 @@
+"""The practical formulas of Zui, Shinke & Namita (1996): a cable's tension from one frequency, its length,
+mass per length and bending stiffness, with the formula's error band measured against the exact model.
+
+Source: :data:`SOURCE`. The paper itself could not be read; the coefficients are those quoted by a public
+implementation (named in :data:`SOURCE`), typed into :data:`ROWS`. With m the mass per length, l the
+length, f_n the frequency of mode n, C = √(EI / (m l⁴)) and ξ = l √(T/EI):
+
+- mode 1: ξ ≥ 17: T = 4 m (f₁ l)² [1 − 2.20 C/f₁ − 0.550 (C/f₁)²];
+  6 ≤ ξ ≤ 17: T = 4 m (f₁ l)² [0.865 − 11.6 (C/f₁)²]; 0 ≤ ξ ≤ 6: T = 4 m (f₁ l)² [0.828 − 10.5 (C/f₁)²];
+- mode 2: ξ ≥ 60: T = m (f₂ l)² [1 − 4.40 C/f₂ − 1.10 (C/f₂)²];
+  17 ≤ ξ ≤ 60: T = m (f₂ l)² [1.03 − 6.33 C/f₂ − 1.58 (C/f₂)²]; 0 ≤ ξ ≤ 17: T = m (f₂ l)² [0.882 − 85.0 (C/f₂)²];
+- mode n ≥ 3 (long cables), ξ ≥ 200 only: T = 4 m (f_n l / n)² [1 − 2.20 n C/f_n].
+
+ξ depends on T, so :func:`zui_tension` iterates (:func:`zui_tension` says how). The paper chooses between the
+mode-1 and mode-2 sets by a sag parameter Γ whose definition could not be verified: it is not applied here,
+and nothing here accounts for sag (the formulas' accuracy is measured on a cable without sag).
+
+Accuracy: :data:`ERROR_BANDS`, the largest |T_zui / T_true − 1| of each row over intervals of ξ (of ξ/n
+for the mode-n row, whose error grows as (nπ/ξ)²), measured against the exact dynamic-stiffness model of a
+clamped-clamped tensioned beam without sag by ``benchmarks/zui_bands.py``, which also writes the table in
+docs/tension.md. Where a row's error is beyond use (:data:`EXCLUDED`), an answer gets no tension, with the
+reason.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.checks import frequency as checked_frequency
+from ..core.checks import in_band, mode_number
+
+SOURCE = ("Zui, H., Shinke, T., Namita, Y. (1996). Practical formulas for estimation of cable tension by "
+          "vibration method. J. Struct. Eng. (ASCE) 122(6), 651–656. The paper itself could not be read; its "
+          "coefficients as quoted by the public implementation GitHub Levi-Ackerman/TumuWithoutTCP, "
+          "src/edu/scut/se/lee/util/Data.java, function getForce3 (introduced in commit bd9e913, unchanged at "
+          "42e749b).")
+
+
+@dataclass(frozen=True)
+class ZuiRow:
+    """One formula of Zui et al. (1996): T = lead · m (f l / q)² [a0 − a1 q C/f − a2 (C/f)²], valid for
+    ``xi_min`` ≤ ξ ≤ ``xi_max``; q = n for the mode-n row (``mode`` None), 1 for the mode-1 and mode-2 rows."""
+
+    label: str
+    mode: int | None
+    xi_min: float
+    xi_max: float
+    lead: float
+    a0: float
+    a1: float
+    a2: float
+
+    def applies(self, mode: int) -> bool:
+        """Whether this row is one of mode ``mode``'s."""
+        return self.mode == mode if self.mode is not None else mode >= 3
+
+    def contains(self, xi: float) -> bool:
+        """Whether ξ lies in the row's range (its ends included)."""
+        return self.xi_min <= xi <= self.xi_max
+
+    def tension(self, length: float, mass: float, frequency: float, mode: int, EI: float) -> float:
+        """The row's tension, N (≤ 0 where the bracket is)."""
+        q = mode if self.mode is None else 1
+        r = math.sqrt(EI / (mass * length**4)) / frequency
+        return self.lead * mass * (frequency * length / q) ** 2 * (self.a0 - self.a1 * q * r - self.a2 * r * r)
+
+    def dT_df(self, length: float, mass: float, frequency: float, mode: int, EI: float) -> float:
+        """dT/df at this row, N/Hz: lead · m l² / q² (2 a0 f − a1 q C)."""
+        q = mode if self.mode is None else 1
+        c = math.sqrt(EI / (mass * length**4))
+        return self.lead * mass * length**2 / q**2 * (2 * self.a0 * frequency - self.a1 * q * c)
+
+
+#: The formulas as quoted in :data:`SOURCE`, each mode's rows from the highest ξ down (a ξ on a shared end
+#: takes the higher row).
+ROWS = (
+    ZuiRow("mode 1, xi >= 17", 1, 17.0, math.inf, 4.0, 1.0, 2.20, 0.550),
+    ZuiRow("mode 1, 6 <= xi <= 17", 1, 6.0, 17.0, 4.0, 0.865, 0.0, 11.6),
+    ZuiRow("mode 1, 0 <= xi <= 6", 1, 0.0, 6.0, 4.0, 0.828, 0.0, 10.5),
+    ZuiRow("mode 2, xi >= 60", 2, 60.0, math.inf, 1.0, 1.0, 4.40, 1.10),
+    ZuiRow("mode 2, 17 <= xi <= 60", 2, 17.0, 60.0, 1.0, 1.03, 6.33, 1.58),
+    ZuiRow("mode 2, 0 <= xi <= 17", 2, 0.0, 17.0, 1.0, 0.882, 0.0, 85.0),
+    ZuiRow("mode n >= 3, xi >= 200", None, 200.0, math.inf, 4.0, 1.0, 2.20, 0.0),
+)
+ROW = {row.label: row for row in ROWS}
+
+#: The mode-n row's band is measured for modes 3 … MAX_MODE; a higher mode gets no answer.
+MAX_MODE = 60
+
+#: Relative tension error bands: row label → ((low, high, band), …), the band the largest |T_zui/T_true − 1|
+#: over low ≤ ξ < high (ξ/n for the mode-n row; the last interval's high included), rounded up to two
+#: significant digits. ξ is the answer's own (:attr:`ZuiEstimate.xi`). Generated by
+#: ``python benchmarks/zui_bands.py`` against the exact model of a clamped-clamped beam without sag (20,000
+#: log-spaced ξ from 0.05 to 10⁴ for modes 1 and 2, 1,000 from 180 to 10⁵ for each mode 3 to 60; beyond, the
+#: error keeps falling as 1/ξ); it prints these values when they differ. Do not edit by hand.
+ERROR_BANDS: dict[str, tuple[tuple[float, float, float], ...]] = {
+    "mode 1, xi >= 17": ((17.0, 20.0, 0.024), (20.0, 25.0, 0.013), (25.0, 200.0, 0.004), (200.0, math.inf, 0.0018)),
+    "mode 1, 6 <= xi <= 17": ((6.0, 17.0, 0.013),),
+    "mode 1, 0 <= xi <= 6": ((0.3, 6.0, 0.03),),
+    "mode 2, xi >= 60": ((60.0, 100.0, 0.0055), (100.0, math.inf, 0.00095)),
+    "mode 2, 17 <= xi <= 60": ((17.0, 20.0, 0.051), (20.0, 25.0, 0.026), (25.0, 60.0, 0.008)),
+    "mode 2, 0 <= xi <= 17": ((0.7, 17.0, 0.025),),
+    "mode n >= 3, xi >= 200": ((10.0, 20.0, 0.11), (20.0, 40.0, 0.025), (40.0, 100.0, 0.0061),
+                               (100.0, math.inf, 0.00092)),
+}
+
+_NEAR_ZERO = ("grows to 100 % as xi -> 0 (the tension tends to 0 and the formula's bracket to a difference of "
+              "near-equal terms)")
+#: Parts of a row's range where the formula is beyond use: row label → (low, high, why), on the variable of
+#: :data:`ERROR_BANDS`, measured by the same script. An answer there gets no tension.
+EXCLUDED: dict[str, tuple[float, float, str]] = {
+    "mode 1, 0 <= xi <= 6": (0.0, 0.3, f"the error exceeds 3 % there and {_NEAR_ZERO}"),
+    "mode 2, 0 <= xi <= 17": (0.0, 0.7, f"the error exceeds 2.5 % there and {_NEAR_ZERO}"),
+    "mode n >= 3, xi >= 200": (0.0, 10.0, "the error exceeds 11 % there (the formula lacks the term (n pi / xi)^2)"),
+}
+
+#: Most steps of the iteration between rows (each step changes the row; a mode has three rows).
+MAX_STEPS = 10
+
+
+@dataclass(frozen=True)
+class ZuiEstimate:
+    """The answer of :func:`zui_tension`.
+
+    Attributes
+    ----------
+    tension : float or None
+        T, N; None when no row applies (``reason`` says why).
+    xi : float or None
+        ξ = l √(T/EI) of the tension found (of the last step's tension when there is none; None when no
+        step had a positive tension).
+    row : str or None
+        The row used, e.g. ``"mode 1, 6 <= xi <= 17"`` (:data:`ROWS`); None with no answer.
+    error_band : float or None
+        The row's measured relative error band where ``xi`` falls (:data:`ERROR_BANDS`):
+        |tension / T_true − 1| ≤ error_band, T_true that of the exact model of a clamped beam without sag.
+    dT_df : float or None
+        dT/df of the row's formula at the measured frequency (the row held fixed), N/Hz: σ_T = |dT/df| σ_f.
+    reason : str or None
+        Why there is no answer (None when there is one).
+    note : str or None
+        How the row was chosen when the iteration did not settle by itself (a cycle between two rows at their
+        shared end); None otherwise.
+    """
+
+    tension: float | None
+    xi: float | None
+    row: str | None
+    error_band: float | None
+    dT_df: float | None
+    reason: str | None = None
+    note: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        """Whether there is a tension."""
+        return self.tension is not None
+
+
+def band_variable(row: ZuiRow, xi: float, mode: int) -> float:
+    """The variable the bands of ``row`` are given on: ξ, or ξ/n for the mode-n row."""
+    return xi / mode if row.mode is None else xi
+
+
+def band_index(row: ZuiRow, xi: float, mode: int) -> int | None:
+    """Which of ``row``'s intervals in :data:`ERROR_BANDS` holds ξ (each low ≤ x < high, the last one's high
+    included), ξ clipped into the row's range first (for an answer chosen in a cycle just outside it); None in
+    an excluded part (:data:`EXCLUDED`)."""
+    x = band_variable(row, min(max(xi, row.xi_min), row.xi_max), mode)
+    intervals = ERROR_BANDS[row.label]
+    for i, (low, high, _) in enumerate(intervals):
+        if low <= x < high or (i == len(intervals) - 1 and x == high):
+            return i
+    return None
+
+
+def error_band(row: ZuiRow, xi: float, mode: int) -> float | None:
+    """The measured relative error band of ``row`` at ξ (:func:`band_index`); None in an excluded part."""
+    i = band_index(row, xi, mode)
+    return None if i is None else ERROR_BANDS[row.label][i][2]
+
+
+def pick_row(mode: int, xi: float) -> ZuiRow | None:
+    """The first row of ``mode`` whose range holds ξ (the higher one on a shared end); None if none does."""
+    for row in ROWS:
+        if row.applies(mode) and row.contains(xi):
+            return row
+    return None
+
+
+def zui_tension(length: float, mass: float, frequency: float, mode: int, EI: float) -> ZuiEstimate:
+    """Tension from one frequency by the formulas of Zui et al. (1996), with the formula's measured error band.
+
+    ξ depends on T, so the row is found by iteration: from the taut string, T = 4 m l² f_n² / n², ξ is
+    computed, its row gives a new T, and so on until the row holds its own ξ (a T ≤ 0 counts as ξ = 0). If
+    the rows cycle instead (row A's T gives a ξ in row B and B's a ξ in A, at their shared end), the row of
+    the cycle whose ξ lies nearest its own range (ratio of ξ to the range's end; the first visited on a tie)
+    is used, and ``note`` says so.
+
+    Parameters
+    ----------
+    length : float
+        l, m.
+    mass : float
+        m, mass per length, kg/m.
+    frequency : float
+        f_n, the measured frequency of mode ``mode``, Hz.
+    mode : int
+        n ≥ 1. Modes 1 and 2 use their own rows; n ≥ 3 only the ξ ≥ 200 row.
+    EI : float
+        Bending stiffness, N m² (> 0).
+
+    Returns
+    -------
+    ZuiEstimate
+        With ``tension`` None and a ``reason`` when no row applies: a mode ≥ 3 with ξ < 200, a T ≤ 0, a ξ
+        in a row's excluded part (:data:`EXCLUDED`), a mode above :data:`MAX_MODE`.
+
+    Raises
+    ------
+    ModelError
+        An input that is not a finite positive number in its band (naming it).
+    """
+    length = in_band(length, "length", "length")
+    mass = in_band(mass, "mass_per_length", "mass_per_length")
+    frequency = checked_frequency(frequency, "frequency")
+    mode = mode_number(int(mode) if isinstance(mode, np.integer) else mode, "mode")
+    EI = in_band(EI, "EI", "EI")
+
+    def none(reason: str, xi: float | None = None) -> ZuiEstimate:
+        return ZuiEstimate(None, xi, None, None, None, reason)
+
+    if mode > MAX_MODE:
+        return none(f"mode {mode} is above {MAX_MODE}, the highest the mode-n row's error band was measured for")
+    row, tension, xi, note = settle_row(length, mass, frequency, mode, EI)
+    if row is None:
+        return none(f"xi = {xi:.4g}, below 200: for a mode n >= 3 the formulas hold only for xi >= 200", xi)
+    if tension <= 0:
+        return none(f"the formula of row {row.label!r} gives T = {tension:.4g} N <= 0: the frequency is at or "
+                    f"below the clamped beam's without tension (C = sqrt(EI/(m l^4)), f/C = "
+                    f"{frequency / math.sqrt(EI / (mass * length**4)):.4g})", None)
+    band = error_band(row, xi, mode)
+    if band is None:
+        variable = "xi/n" if row.mode is None else "xi"
+        value = band_variable(row, xi, mode)
+        _, high, why = EXCLUDED.get(row.label, (0.0, math.nan, "no error band was measured there"))
+        return none(f"row {row.label!r} at {variable} = {value:.4g} (below {high:g}) is left out: {why}", xi)
+    return ZuiEstimate(tension, xi, row.label, band, row.dT_df(length, mass, frequency, mode, EI), None, note)
+
+
+def settle_row(length: float, mass: float, frequency: float, mode: int,
+               EI: float) -> tuple[ZuiRow | None, float, float, str | None]:
+    """The iteration of :func:`zui_tension` on checked inputs: (row, its tension, the ξ of that tension, note).
+
+    The row is None when a mode n ≥ 3 has ξ < 200 (the tension is then the last step's, or the taut
+    string's). The tension may be ≤ 0 (its ξ is then 0). No band is looked up: ``benchmarks/zui_bands.py``
+    measures the error with it, the excluded parts too.
+    """
+
+    def xi_of(tension: float) -> float:
+        return length * math.sqrt(tension / EI) if tension > 0 else 0.0
+
+    tension = 4 * mass * length**2 * frequency**2 / mode**2
+    xi = xi_of(tension)
+    visited: list[tuple[ZuiRow, float, float]] = []  # (row, its T, the ξ of that T)
+    for _ in range(MAX_STEPS):
+        row = pick_row(mode, xi)
+        if row is None:
+            return None, tension, xi, None
+        if any(r is row for r, _, _ in visited):  # a cycle: choose among its rows
+            cycle = visited[next(i for i, (r, _, _) in enumerate(visited) if r is row):]
+            row, tension, xi = min(cycle, key=lambda v: _outside(v[0], v[2]))
+            return row, tension, xi, (
+                f"the rows {' and '.join(repr(r.label) for r, _, _ in cycle)} cycle (each one's tension gives a "
+                f"xi in the other's range): used {row.label!r}, whose xi = {xi:.4g} lies nearest its range")
+        tension = row.tension(length, mass, frequency, mode, EI)
+        xi = xi_of(tension)
+        visited.append((row, tension, xi))
+        if row.contains(xi):
+            return row, tension, xi, None
+    raise AssertionError("unreachable: each step visits a new row of at most three, so a cycle ends the loop")
+
+
+def _outside(row: ZuiRow, xi: float) -> float:
+    """How far ξ lies outside ``row``'s range, as |log| of its ratio to the nearer end (0 inside)."""
+    if row.contains(xi):
+        return 0.0
+    end = row.xi_min if xi < row.xi_min else row.xi_max
+    return abs(math.log(xi / end)) if xi > 0 else math.inf
