@@ -66,28 +66,49 @@ def field_options() -> dict[str, str]:
             "mass_per_length_tolerance": "--mass-tolerance"}
 
 
+def force_unit(values) -> tuple[str, float]:
+    """N, kN or MN by the largest magnitude among ``values`` (N), and its factor."""
+    size = max((abs(v) for v in values if v is not None), default=0.0)
+    return next(((unit, f) for unit, f in (("MN", 1e6), ("kN", 1e3)) if size >= f), ("N", 1.0))
+
+
 def tension_text(result) -> str:
-    """The table of methods, then each method's note."""
+    """The table of the methods that give a tension (a range for the exact model with EI unknown and one mode),
+    the exact model's EI and other end condition, one line naming the methods left out, then the notes."""
     inputs = result.inputs
     sigma = inputs["uncertainty"]
     sigma_text = f"{sigma[0]:.3g} Hz" if len(set(sigma)) == 1 else ", ".join(f"{s:.3g}" for s in sigma) + " Hz"
-    lines = [(f"length {inputs['length']:g} m, mass {inputs['mass']:g} kg/m, modes "
+    k = len(inputs["modes"])
+    lines = [(f"length {inputs['length']:g} m, mass {inputs['mass']:g} kg/m, mode{'s' if k > 1 else ''} "
               f"{', '.join(map(str, inputs['modes']))}, {inputs['boundary']} ends, inclination "
               f"{inputs['inclination']:g} deg" + (", out-of-plane modes" if inputs.get("plane") == "out" else "")),
-             f"frequency 1σ: {sigma_text}, {inputs['uncertainty_source']}",
-             "",
-             f"{'method':<13} {'tension (kN)':>14} {'1σ (kN)':>10}"]
-    for name, m in result.methods.items():
-        if m.tension is None:
-            lines.append(f"{name:<13} {'-':>14} {'-':>10}")
-        else:
-            lines.append(f"{name:<13} {m.tension / 1e3:>14.6g} {m.uncertainty / 1e3:>10.3g}")
-    exact = result.methods["exact"]
-    if exact.extra.get("EI_source"):
+             f"frequency 1σ: {sigma_text}, {inputs['uncertainty_source']}", ""]
+    methods = result.methods
+    exact = methods["exact"]
+    shown = [m.tension for m in methods.values()] + [exact.extra.get("upper")]
+    unit, factor = force_unit(shown)
+    lines.append(f"{'method':<13} {f'tension ({unit})':>16} {f'1σ ({unit})':>10}")
+    left = []
+    for name, m in methods.items():
+        if m.tension is not None:
+            lines.append(f"{name:<13} {m.tension / factor:>16.6g} {m.uncertainty / factor:>10.3g}")
+        elif name == "exact" and m.extra.get("upper") is not None:
+            span = f"{m.extra['lower'] / factor:.4g} to {m.extra['upper'] / factor:.4g}"
+            lines.append(f"{name:<13} {span:>16} {'(range)':>10}")
+        elif name != "mehrabi1998":
+            left.append(name)
+    EI_source = exact.extra.get("EI_source")
+    if exact.tension is not None and EI_source:
         EI, EIs = exact.extra.get("EI"), exact.extra.get("EI_uncertainty")
-        shown = "0" if EI is None else f"{EI:.4g}" + (f" ± {EIs:.2g}" if EIs is not None else "")
-        lines.append(f"exact model's EI: {shown} N m^2, {exact.extra['EI_source']}")
-    notes = [f"  {name}: {m.note}" for name, m in result.methods.items() if m.note]
+        shown_EI = "0" if EI is None else f"{EI:.4g}" + (f" ± {EIs:.2g}" if EIs is not None else "")
+        lines.append(f"exact model's EI: {shown_EI} N m^2, {EI_source}")
+    other = exact.extra.get("other_boundary", {})
+    if other.get("note"):
+        lines.append(f"exact model {other['note']}")
+    if left:
+        lines.append("left out: " + "; ".join(f"{name} ({methods[name].note})" for name in left))
+    notes = [f"  {name}: {m.note}" for name, m in methods.items()
+             if m.note and m.tension is not None or (name == "exact" and m.note and name not in left)]
     if notes:
         lines += ["", "notes:"] + notes
     return "\n".join(lines) + "\n"

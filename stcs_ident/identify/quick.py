@@ -38,8 +38,11 @@ from ..core.model import finite_number, frequency, in_band, mode_number
 from ..core.notes import Note
 from ..core.planes import PLANES
 from ..core.result import Result
+from ..forward.statics import irvine_lambda2
 from .problem import printed_step
 from .quick_exact import Member, exact_tension
+from .zui import SOURCE as ZUI_SOURCE
+from .zui import zui_tension
 
 BOUNDARIES = ("clamped", "pinned")
 
@@ -50,23 +53,21 @@ SOURCES = {
     "beam": "tensioned beam: pinned ends f_n = f_n^string sqrt(1 + n^2 pi^2 EI / (T l^2)) (exact); clamped ends "
             "f_n = f_n^string (1 + 2/xi + (4 + n^2 pi^2 / 2) / xi^2), xi = l sqrt(T/EI) (large-xi expansion); "
             "stcs_ident.forward.reference.beam_pinned and beam_clamped_asymptotic",
-    "zui1996": "Zui, H., Shinke, T., Namita, Y. (1996). Practical formulas for estimation of cable tension by "
-               "vibration method. J. Struct. Eng. (ASCE) 122(6), 651-656.",
+    "zui1996": ZUI_SOURCE,
     "mehrabi1998": "Mehrabi, A. B., Tabatabai, H. (1998). Unified finite difference formulation for free vibration "
                    "of cables. J. Struct. Eng. (ASCE) 124(11), 1313-1322.",
     "exact": "exact dynamic stiffness of a tensioned, sagging beam (docs/model.md), fitted by identify()",
 }
 
-#: The practical formulas left out, and why (the key stays in the result, tension None, with this note).
-UNSOURCED = {
-    name: ("not implemented: the formula's coefficients could not be read in the paper or in a source quoting "
-           "it when this was written, and are not reconstructed from memory; use 'exact' (or 'beam' with EI)")
-    for name in ("zui1996", "mehrabi1998")
-}
+#: Why ``mehrabi1998`` has no tension (the key stays in the JSON, as the contract has it; the text omits it).
+UNSOURCED = "left out: no source of its coefficients could be read (not reconstructed from memory)"
 
 #: With EI given, the taut string is left out (tension None) when its leading bias from bending exceeds this:
 #: 4/ξ with clamped ends (ξ < 20), n²π²/ξ² with pinned ends.
 TAUT_MAX_BIAS = 0.2
+
+#: Irvine's λ² above which sag matters to the practical formulas (said in their note).
+SAG_MATTERS = 0.3
 
 #: The clamped-end expansion is used for a mode n when ξ ≥ max(CLAMPED_MIN_XI, CLAMPED_XI_PER_MODE · n):
 #: there its tension is within 1.5 % of the exact clamped beam's (tests/test_tension.py checks it).
@@ -288,23 +289,39 @@ def _taut(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
     extra = {"formula": "T = 4 m l^2 f_n^2 / n^2"}
     if scatter is not None:
         extra["scatter"] = scatter
-    note = None
-    if EI:
-        # the leading bias in tension (T goes as f²) of the lowest mode given: 2 × 2/ξ from clamped ends,
-        # n²π²/ξ² from the bending of a pinned beam
-        xi = length * math.sqrt(t / EI)
-        n = float(modes[0])
-        bias = 4 / xi if boundary == "clamped" else n * n * math.pi**2 / xi**2
-        extra["xi"], extra["estimated_bias"] = xi, bias
-        if bias > TAUT_MAX_BIAS:
-            return MethodEstimate("taut_string", None, None,
-                                  f"bending dominates: with the given EI, xi = l sqrt(T/EI) = {xi:.3g} and the taut "
-                                  f"string would be about {100 * bias:.2g} % high (limit {100 * TAUT_MAX_BIAS:g} %)",
-                                  SOURCES["taut_string"], tuple(map(float, per)), extra)
-        cause = "4/xi, the clamped ends" if boundary == "clamped" else f"n^2 pi^2/xi^2 at mode {n:g}"
-        note = (f"ignores bending: with the given EI, xi = l sqrt(T/EI) = {xi:.3g}, and it is about "
-                f"{100 * bias:.2g} % high from bending alone ({cause})")
-    return MethodEstimate("taut_string", t, u, note, SOURCES["taut_string"], tuple(map(float, per)), extra)
+    return MethodEstimate("taut_string", t, u, None, SOURCES["taut_string"], tuple(map(float, per)), extra)
+
+
+def taut_bias(length, tension, EI, mode, boundary) -> float:
+    """The taut string's relative excess in tension over a tensioned beam's, from the clamped-end expansion
+    (T_string/T = (1 + 2/ξ + (4 + n²π²/2)/ξ²)²; leading term 4/ξ) or the pinned beam's exact n²π²/ξ²."""
+    xi = length * math.sqrt(tension / EI)
+    if boundary == "clamped":
+        return (1 + 2 / xi + (4 + mode * mode * math.pi**2 / 2) / xi**2) ** 2 - 1
+    return mode * mode * math.pi**2 / xi**2
+
+
+def _taut_beside_exact(taut: MethodEstimate, exact: MethodEstimate, length, modes, EI, boundary) -> MethodEstimate:
+    """The taut string's note, in the table's own numbers: its excess over the exact model's tension; left out
+    (with EI given) when that excess is above :data:`TAUT_MAX_BIAS`."""
+    if exact.tension is None and exact.extra.get("upper") is not None:
+        return replace(taut, note="an upper bound: with EI unknown bending can only lower the tension (the exact "
+                                  "model's range)")
+    EI_used = exact.extra.get("EI") if exact.tension is not None else EI
+    if not EI_used or taut.tension is None:
+        return taut
+    if exact.tension is not None and exact.tension > 0:
+        bias, basis = taut.tension / exact.tension - 1, "above the exact model's tension"
+        xi = length * math.sqrt(exact.tension / EI_used)
+    else:  # no exact tension: the expansion at the taut string's own ξ (an underestimate of ξ's effect)
+        bias = taut_bias(length, taut.tension, EI_used, float(modes[0]), boundary)
+        basis, xi = "high from bending alone (by the tensioned beam's expansion)", length * math.sqrt(taut.tension / EI_used)
+    extra = {**taut.extra, "xi": xi, "estimated_bias": bias}
+    if EI and bias > TAUT_MAX_BIAS:
+        return replace(taut, tension=None, uncertainty=None, extra=extra,
+                       note=f"{100 * bias:.3g} % {basis}: bending dominates at xi = {xi:.3g} (limit "
+                            f"{100 * TAUT_MAX_BIAS:g} %)")
+    return replace(taut, extra=extra, note=f"ignores bending and sag: {100 * bias:.3g} % {basis} (xi = {xi:.3g})")
 
 
 def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
@@ -337,6 +354,33 @@ def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
     if scatter is not None:
         extra["scatter"] = scatter
     return MethodEstimate("beam", t, u, note, SOURCES["beam"], tuple(map(float, per)), extra)
+
+
+def _zui(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
+    """Zui, Shinke & Namita (1996) per mode (:mod:`.zui`), averaged as the other formulas; its error band the
+    largest of the modes' (measured against the exact model of a clamped cable without sag)."""
+    if not EI:
+        return MethodEstimate("zui1996", None, None, "needs EI (--EI)", SOURCES["zui1996"])
+    if boundary != "clamped":
+        return MethodEstimate("zui1996", None, None, "its formulas are for clamped ends", SOURCES["zui1996"])
+    answers = [zui_tension(length, mass, float(f), int(n), EI) for f, n in zip(freqs, modes)]
+    per = np.array([a.tension if a.ok else np.nan for a in answers])
+    if not np.any(np.isfinite(per)):
+        return MethodEstimate("zui1996", None, None, f"outside its rows: {answers[0].reason}", SOURCES["zui1996"],
+                              tuple(map(float, per)))
+    dTdf = np.array([a.dT_df if a.ok else np.nan for a in answers])
+    t, u, scatter = _mean(per, np.abs(dTdf) * sigma)
+    used = [(int(n), a) for n, a in zip(modes, answers) if a.ok]
+    band = max(a.error_band for _, a in used)
+    rows = "; ".join(f"mode {n}: row '{a.row}' at xi = {a.xi:.3g}" for n, a in used)
+    left = [f"mode {int(n)} ({a.reason})" for n, a in zip(modes, answers) if not a.ok]
+    note = (f"{rows}; error band ±{100 * band:.2g} % (measured against the exact model, clamped ends, no sag)"
+            + (f"; left out: {', '.join(left)}" if left else ""))
+    extra = {"formula": "Zui, Shinke & Namita (1996), the row of each mode's xi", "rows": [a.row for _, a in used],
+             "xi": [a.xi for _, a in used], "error_band": band}
+    if scatter is not None:
+        extra["scatter"] = scatter
+    return MethodEstimate("zui1996", t, u, note, SOURCES["zui1996"], tuple(map(float, per)), extra)
 
 
 def _with_tolerances(method, length, mass, freqs, modes, sigma, EI, boundary, tolerance) -> MethodEstimate:
@@ -452,10 +496,19 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
               "uncertainty_source": uncertainty_source or "stated", "tolerance": tolerance, "plane": plane}
     held = {key: tolerance.get(key, kinds.get(key).tolerance.default) for key in ("length", "mass_per_length", "EI")}
     taut = _with_tolerances(_taut, length, mass, freqs, modes, sigma, EI, boundary, held)
+    exact = _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, held, plane)
+    zui = _with_tolerances(_zui, length, mass, freqs, modes, sigma, EI, boundary, held)
+    if zui.tension is not None and EA is not None and plane == "in":
+        # the paper's sag criterion (its Γ) could not be verified: where Irvine's λ² says sag matters, say so
+        lambda2 = irvine_lambda2(Member(length, mass, EA, inclination, boundary, plane).cable(), zui.tension)
+        if lambda2 > SAG_MATTERS:
+            zui = replace(zui, note=f"{zui.note}; sag matters here (Irvine's lambda^2 = {lambda2:.3g}) and the "
+                                    "formulas' own sag criterion is not applied", extra={**zui.extra, "lambda2": lambda2})
     methods = {
-        "taut_string": taut,
+        "taut_string": _taut_beside_exact(taut, exact, length, modes, EI, boundary),
         "beam": _with_tolerances(_beam, length, mass, freqs, modes, sigma, EI, boundary, held),
-        **{name: MethodEstimate(name, None, None, UNSOURCED[name], SOURCES[name]) for name in UNSOURCED},
-        "exact": _exact(length, mass, freqs, modes, sigma, EI, EA, inclination, boundary, held, plane),
+        "zui1996": zui,
+        "mehrabi1998": MethodEstimate("mehrabi1998", None, None, UNSOURCED, SOURCES["mehrabi1998"]),
+        "exact": exact,
     }
     return QuickTensionResult(inputs, methods)

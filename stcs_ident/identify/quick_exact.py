@@ -56,11 +56,11 @@ STEP = 1e-5
 #: A tension below this share of the string's is "gone to zero" in a fit (its lower bound).
 ZERO_TENSION = 1e-6
 
-EI_CEILING_NOTE = ("the lower end assumes the stiffest section a steel cable of this mass per length can have, a "
-                   "solid circular bar (EI = E A^2/(4 pi), A = m/rho, rho 7850 kg/m^3, E 200 GPa); a tube or a "
-                   "member stiffer than steel for its weight can be stiffer: give --EI then")
-UNSEEN_NOTE = ("EI is not seen by these modes (its fit went to 0): the tension of a string (EI 0), high by EI's "
-               "share, which these modes say is below their 1σ")
+EI_CEILING_NOTE = ("assumes the stiffest section a steel cable of this mass per length can have, a solid circular "
+                   "bar (EI = E A^2/(4 pi), A = m/rho, rho 7850 kg/m^3, E 200 GPa; a tube or a member stiffer than "
+                   "steel for its weight can be stiffer: give EI then)")
+UNSEEN_NOTE = ("EI is not seen by these modes (a string fits them as well, its chi2 within 1 of the fit with EI): "
+               "a range, not a ±")
 
 
 def force(value: float) -> str:
@@ -226,9 +226,8 @@ def _range(member: Member, f: float, sigma: float, n: int, tolerance: dict) -> E
         return ExactAnswer(failed=True, reason=str(err))
     upper = hi.tension + 3 * hi.sigma
     lower = max(0.0, lo.tension - 3 * lo.sigma)
-    notes = [f"EI unknown and one mode: the tension lies between {force(lower)} and {force(upper)}; the upper end "
-             "is a string's (EI 0), " + EI_CEILING_NOTE + "; each end widened by 3σ of the frequency and the "
-             "tolerances"]
+    notes = ["EI unknown and one mode: a range, not a ±; its upper end is a string's tension (EI 0), its lower "
+             + EI_CEILING_NOTE + "; each end widened by 3σ of the frequency and the tolerances"]
     if hi.others:
         notes.append("other tensions give the same frequency as a string (a sagging cable's crossover): "
                      f"{', '.join(force(t) for t in sorted(hi.others))}; the highest is taken")
@@ -241,8 +240,10 @@ def _range(member: Member, f: float, sigma: float, n: int, tolerance: dict) -> E
 # ---- two modes or more: a fit -------------------------------------------------------------------------------
 
 def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI: float | None,
-         tolerance: dict) -> ExactAnswer:
-    """Least squares in x = (ln(T/T_s), √EI / s_ref), or x = (ln(T/T_s),) with EI held."""
+         tolerance: dict, rescaled: bool = False) -> ExactAnswer:
+    """Least squares in x = (ln(T/T_s), √EI / s_ref), or x = (ln(T/T_s),) with EI held. With a prior and a
+    significant misfit of the frequencies, refitted with their σ scaled (``rescaled``): the prior then weighs
+    in the estimate as much as in its σ."""
     from scipy.optimize import least_squares
 
     from .nuisance import propagate
@@ -308,9 +309,6 @@ def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI
             f"the fit's tension went to zero ({force(T)}, its lower bound): the modes say bending alone, or their "
             "numbers, the length or the mass are not what was given"))
     notes = []
-    unseen = not held and x[1] <= 1e-9
-    if unseen and EI is None:  # the modes do not see EI: a string's tension, with its σ from T alone
-        return _fit(member, f, sigma, modes, 0.0, tolerance)
     r, J = jac_at(x)
     base, _ = covariance(J)
     # the tolerances of the length and the mass per length, as nuisances (their Jacobian times their width)
@@ -321,31 +319,42 @@ def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI
         rr = residuals(np.array([x, x]), up if key == "length" else 1.0, up if key == "mass_per_length" else 1.0)
         A[:, j] = (rr[0] - rr[1]) / (2 * STEP) * w
     n = f.size
-    cov, chi2 = propagate(J[:n], A[:n], r[:n], base) if nuis else (base, float(r[:n] @ r[:n]))
-    # the frequencies' degrees of freedom: n less the parameters they fit, the trace of their hat matrix (with a
-    # prior, EI counts by the frequencies' share of its information); a prior at odds with them is said, not
-    # taken for a misfit of the frequencies
-    dof = n - float(np.trace(J[:n] @ np.nan_to_num(base, posinf=0.0) @ J[:n].T))
-    scale, note = covariance_scale(chi2, dof if dof >= 0.5 else 0, tolerances=bool(nuis))
+    A_d = A[:n] if nuis else np.zeros((n, 1))
+    # the frequencies' misfit: χ² of their own best fit (no prior: a prior at odds with them is said, not taken
+    # for a misfit of theirs) under the data covariance the tolerances make, on n - p degrees of freedom
+    _, chi2 = propagate(J[:n], A_d, r[:n], base)
+    dof = n - p
+    scale, note = covariance_scale(chi2, dof, tolerances=bool(nuis))
     if note is not None and note.kind == "covariance_scaled":
         notes.append(str(note))
+        if prior and not rescaled:
+            inner = _fit(member, f, sigma * math.sqrt(scale), modes, EI, tolerance, rescaled=True)
+            if inner.failed:
+                return inner
+            return replace(inner, notes=(str(note), *inner.notes), extra={
+                **inner.extra, "covariance_scale": float(scale), "reduced_chi2": chi2 / dof,
+                "uncertainty_from_frequencies": inner.extra["uncertainty_from_frequencies"]})
     if prior and abs(r[-1]) > 3:
         notes.append(f"the frequencies put EI at {E:.4g} N m^2, {abs(r[-1]):.1f}σ of its tolerance from the given "
                      f"{EI:.4g}: the given EI is likely wrong")
-    C = scale * base + (cov - base)
+    # the frequencies' share scaled (their rows weighted by 1/√scale), the prior's and the tolerances' not
+    weight = 1.0 / math.sqrt(scale)
+    J = J.copy()
+    J[:n] *= weight
+    base, _ = covariance(J)
+    C, _ = propagate(J[:n], A_d * weight, r[:n] * weight, base)
     sigma_T = T * math.sqrt(C[0, 0])
-    extra = {"uncertainty_from_frequencies": T * math.sqrt(scale * base[0, 0]),
-             "uncertainty_from_tolerances": T * math.sqrt(max(cov[0, 0] - base[0, 0], 0.0)),
-             "tolerances_held": {key: w for key, w in nuis}, "reduced_chi2": chi2 / dof if dof >= 0.5 else None,
-             "covariance_scale": float(scale), "fitted": "tension" if held else "tension,EI",
+    extra = {"uncertainty_from_frequencies": T * math.sqrt(base[0, 0]),
+             "uncertainty_from_tolerances": T * math.sqrt(max(C[0, 0] - base[0, 0], 0.0)),
+             "tolerances_held": {key: w for key, w in nuis}, "reduced_chi2": chi2 / dof if dof > 0 else None,
+             "covariance_scale": float(scale), "fitted": "tension" if held else "tension,EI", "chi2": float(r[:n] @ r[:n]),
              "solved": "least squares from a scan"}
     if held:
-        return ExactAnswer(T, sigma_T, EI=EI, EI_source="given" if EI else "taken as 0", notes=tuple(notes),
+        return ExactAnswer(T, sigma_T, EI=EI, EI_source="given" if EI else "given as 0 (a string)", notes=tuple(notes),
                            extra=extra)
     sigma_EI = 2 * x[1] * s_ref**2 * math.sqrt(C[1, 1])
     if prior:
-        data_rows = J[: f.size]
-        info = data_rows.T @ data_rows
+        info = J[:n].T @ J[:n]
         try:
             data_var = float(np.linalg.inv(info)[1, 1])
             p_data = 1.0 / data_var if data_var > 0 else 0.0
@@ -370,18 +379,34 @@ def _solve(member, f, sigma, modes, EI, tolerance) -> ExactAnswer:
         answer = _one_mode(member, float(f[0]), float(sigma[0]), int(modes[0]), EI, tolerance)
         return replace(answer, EI=EI, EI_source="given" if EI else "given as 0 (a string)")
     answer = _fit(member, f, sigma, modes, EI, tolerance)
-    if EI is None and answer.EI == 0.0 and not answer.failed:
-        answer = replace(answer, EI=None, EI_source="taken as 0 (the modes show no stretch: EI's fit went to 0)",
-                         notes=(UNSEEN_NOTE, *answer.notes))
-    return answer
+    if EI is not None or answer.failed:
+        return answer
+    # EI unknown: do the modes see it? A string (EI 0) that fits them as well (Δχ² < 1) says not; the answer is
+    # then the range between the string's tension and the one with a solid steel bar's EI, as with one mode
+    held = {k: v for k, v in tolerance.items() if k != "EI"}
+    string = _fit(member, f, sigma, modes, 0.0, held)
+    if string.failed or string.extra["chi2"] - answer.extra["chi2"] >= 1.0:
+        return answer
+    ceiling = steel_bar_EI(member.mass)
+    bar = _fit(member, f, sigma, modes, ceiling, held)
+    upper = string.tension + 3 * string.uncertainty
+    lower = 0.0 if bar.failed else max(0.0, bar.tension - 3 * bar.uncertainty)
+    notes = (UNSEEN_NOTE + "; its upper end is a string's tension (EI 0), its lower " + EI_CEILING_NOTE
+             + "; each end widened by 3σ",)
+    extra = {"lower": lower, "upper": upper, "string_tension": string.tension, "steel_bar_EI": ceiling,
+             "steel_bar_tension": None if bar.failed else bar.tension, "fitted": "tension (EI 0; the steel bar's)",
+             "solved": "least squares with EI 0 and with the steel bar's EI"}
+    return ExactAnswer(lower=lower, upper=upper, EI_source="not seen by these modes: a range between EI 0 and a "
+                       "solid steel bar's", notes=notes, extra=extra)
 
 
 def exact_tension(member: Member, frequencies, sigma, modes, EI: float | None, tolerance: dict) -> ExactAnswer:
     """The exact model's tension for ``member`` from measured ``frequencies`` (Hz, 1σ ``sigma``) of ``modes``.
 
     ``EI``: N m², or None (unknown); ``tolerance``: relative 1σ of ``length``, ``mass_per_length`` and a given
-    ``EI`` (0 or absent: exact). The answer under the other end condition is in ``extra["other_boundary"]``,
-    and a note says when the two differ by more than the σ.
+    ``EI`` (0 or absent: exact). The answer under the other end condition is in ``extra["other_boundary"]``
+    (``boundary``, ``tension``, ``uncertainty``, ``change``, or ``lower``/``upper``; ``note`` says whether the two
+    differ by more than the σ).
     """
     f, sigma, modes = (np.asarray(v, float) for v in (frequencies, sigma, modes))
     modes = modes.astype(int)
@@ -396,12 +421,12 @@ def exact_tension(member: Member, frequencies, sigma, modes, EI: float | None, t
     said = {"boundary": ends, "tension": other.tension, "uncertainty": other.uncertainty}
     if other.tension is None:
         said = {"boundary": ends, "lower": other.lower, "upper": other.upper}
-    notes = list(answer.notes)
-    if answer.tension is not None and other.tension is not None:
-        change = other.tension / answer.tension - 1 if answer.tension > 0 else math.inf
-        if abs(other.tension - answer.tension) > answer.uncertainty:
-            notes.append(f"with {ends} ends the tension would be {force(other.tension)} ({100 * change:+.3g} %), more "
-                         "than this 1σ apart: the end condition matters here")
-    elif answer.lower is not None and other.lower is not None and abs(other.lower - answer.lower) > 0.01 * answer.upper:
-        notes.append(f"with {ends} ends the range would be {force(other.lower)} to {force(other.upper)}")
-    return replace(answer, notes=tuple(notes), extra={**answer.extra, "other_boundary": said})
+    if answer.tension is not None and other.tension is not None and answer.tension > 0:
+        change = other.tension / answer.tension - 1
+        apart = abs(other.tension - answer.tension) > answer.uncertainty
+        said["change"] = change
+        said["note"] = (f"with {ends} ends {force(other.tension)} ({100 * change:+.3g} %), "
+                        + ("more than the 1σ apart: the end condition matters here" if apart else "within the 1σ"))
+    elif answer.lower is not None and other.lower is not None:
+        said["note"] = f"with {ends} ends between {force(other.lower)} and {force(other.upper)}"
+    return replace(answer, extra={**answer.extra, "other_boundary": said})
