@@ -21,8 +21,9 @@ def add_parser(sub) -> None:
     given.add_argument("--record", metavar="FILE", help="an acceleration record (any format spectra reads): its peaks "
                                                          "picked and numbered from their own spacing")
     parser.add_argument("--modes", metavar="1,2,...", help="their mode numbers (default 1, 2, ...)")
-    parser.add_argument("--EI", metavar="N_M2", help="bending stiffness, N m^2 (default: fitted with two modes "
-                                                     "or more, else 0)")
+    parser.add_argument("--EI", metavar="N_M2", help="bending stiffness, N m^2, known to --EI-tolerance: with one "
+                                                     "mode held, with more a prior of the fit (default: fitted with "
+                                                     "two modes or more; with one mode the answer is a range)")
     parser.add_argument("--EA", metavar="N", help="axial stiffness, N, for sag-extensibility (default: ignored)")
     parser.add_argument("--inclination", default="0", metavar="DEG", help="chord angle from horizontal, degrees")
     parser.add_argument("--boundary", choices=("clamped", "pinned"), default="clamped", help="both ends")
@@ -31,8 +32,9 @@ def add_parser(sub) -> None:
                              "or out (out-of-plane: no sag-extensibility, --EA unused); default in")
     parser.add_argument("--uncertainty", metavar="HZ", help="1σ of the frequencies, Hz, one for all or one each "
                                                             "(default: their printed rounding / sqrt 12)")
-    parser.add_argument("--EI-tolerance", metavar="REL", help="relative 1σ of a given --EI, carried into the "
-                                                              "exact model's σ (default 0.3; 0: exact)")
+    parser.add_argument("--EI-tolerance", metavar="REL", help="relative 1σ of a given --EI: carried into the σ "
+                                                              "with one mode, the prior's width with more "
+                                                              "(default 0.3; 0: exact, held)")
     parser.add_argument("--length-tolerance", metavar="REL", help="relative 1σ of --length (default 0.002)")
     parser.add_argument("--mass-tolerance", metavar="REL", help="relative 1σ of --mass (default 0.01)")
     add_reader_options(parser, "--record")

@@ -2,26 +2,28 @@
 
 :func:`quick_tension` puts side by side, each with its 1σ:
 
-- ``taut_string``: T = 4 m l² f_n² / n² (the vibrating string; ignores bending and sag; with EI given,
-  left out when its bending bias exceeds :data:`TAUT_MAX_BIAS`);
+- ``taut_string``: T = 4 m l² f_n² / n² (the vibrating string; ignores bending and sag; its note gives its
+  excess over the exact model's tension; with EI given, left out when that exceeds :data:`TAUT_MAX_BIAS`);
 - ``beam``: the tensioned-beam formulas the exact solver is checked against
   (:mod:`stcs_ident.forward.reference`), inverted for the tension, when EI is given:
   pinned ends exactly, clamped ends by the large-ξ expansion;
-- ``zui1996`` and ``mehrabi1998``: the practical formulas of Zui, Shinke & Namita (1996) and of
-  Mehrabi & Tabatabai (1998). Their coefficients could not be read in any source available when this
-  module was written, and they are not reconstructed from memory: both keys say so in their ``note``
-  and give ``tension`` None (see :data:`UNSOURCED`);
-- ``exact``: the exact dynamic-stiffness model (sag-extensibility with EA, inclination, the chosen
-  ends), fitted by :func:`stcs_ident.identify.api.identify` to the frequencies: the tension alone when
-  EI is given (or with one frequency, where EI is taken as 0), the tension and EI with two modes or more
-  and no EI; ``plane="out"`` fits the out-of-plane family (no sag-extensibility: EA plays no part).
+- ``zui1996``: the practical formulas of Zui, Shinke & Namita (1996) (:mod:`.zui`, coefficients as quoted by a
+  public implementation), with EI given and clamped ends, each answer with the formula's error band measured
+  against the exact model;
+- ``mehrabi1998``: Mehrabi & Tabatabai (1998): no source of its coefficients could be read, and they are not
+  reconstructed from memory: the key stays (the JSON contract), ``tension`` None, with :data:`UNSOURCED`;
+- ``exact``: the exact dynamic-stiffness model (sag-extensibility with EA, inclination, the chosen ends),
+  solved without a nominal (:mod:`.quick_exact`): one mode with EI given, a bracketed root; two modes or
+  more, a least-squares fit from a scan, a given EI its prior; one mode (or modes that do not see EI) with EI
+  unknown, a range (``lower``, ``upper``) between a solid steel bar's EI and a string's; the other end
+  condition beside it; ``plane="out"`` fits the out-of-plane family (no sag-extensibility: EA plays no part).
 
 Uncertainty: every formula's σ is the frequency σ propagated through dT/df (first order); with several
 modes the per-mode estimates are averaged and the σ of the mean combines that propagation with their
 scatter, σ² = σ_prop² + s²/k (s the sample standard deviation of the k estimates): a spread larger than
 the frequencies explain (a taut-string tension rising with the mode, from bending) then shows in the σ.
-The exact model's σ is the fit's covariance (scaled by the reduced χ² when the misfit is significant,
-as ``identify`` does).
+The exact model's σ is first order with one mode, the fit's covariance with more (its frequencies' share
+scaled by the reduced χ² when the misfit is significant, as ``identify`` does).
 """
 
 from __future__ import annotations
@@ -56,7 +58,8 @@ SOURCES = {
     "zui1996": ZUI_SOURCE,
     "mehrabi1998": "Mehrabi, A. B., Tabatabai, H. (1998). Unified finite difference formulation for free vibration "
                    "of cables. J. Struct. Eng. (ASCE) 124(11), 1313-1322.",
-    "exact": "exact dynamic stiffness of a tensioned, sagging beam (docs/model.md), fitted by identify()",
+    "exact": "exact dynamic stiffness of a tensioned, sagging beam (docs/model.md), solved for the tension: a "
+             "bracketed root with one mode, least squares from a scan with more (stcs_ident.identify.quick_exact)",
 }
 
 #: Why ``mehrabi1998`` has no tension (the key stays in the JSON, as the contract has it; the text omits it).
@@ -326,7 +329,7 @@ def _taut_beside_exact(taut: MethodEstimate, exact: MethodEstimate, length, mode
 
 def _beam(length, mass, freqs, modes, sigma, EI, boundary) -> MethodEstimate:
     if not EI:
-        return MethodEstimate("beam", None, None, "needs the bending stiffness (--EI, > 0)", SOURCES["beam"])
+        return MethodEstimate("beam", None, None, "needs EI (--EI)", SOURCES["beam"])
     if boundary == "pinned":
         per = pinned_beam_tension(length, mass, freqs, modes, EI)
         per = np.where(per > 0, per, np.nan)
@@ -440,8 +443,9 @@ def quick_tension(length: float, mass: float, frequencies: Sequence[float], mode
     modes : sequence of int, optional
         Their mode numbers (default 1, 2, ...).
     EI : float, optional
-        Bending stiffness, N m². Given: the exact model fits the tension alone. Not given: with one
-        frequency EI is taken as 0; with two modes or more it is fitted with the tension.
+        Bending stiffness, N m², known to ``EI_tolerance``. Given: with one mode the exact model solves for
+        the tension with EI held; with two modes or more it fits EI too, the given value its prior. Not given:
+        fitted with two modes or more; with one mode the answer is a range.
     EA : float, optional
         Axial stiffness, N (sag-extensibility in the exact model); None ignores it.
     inclination : float
