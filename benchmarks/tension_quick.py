@@ -14,9 +14,10 @@ standard deviation; EI's draw truncated at 2.5σ below, where it would reach zer
 - ``five-modes``: a cable (ξ 20-200) with five modes measured to 1e-4 relative and EI given a factor 2 off
   (half of the cases ×2, half ÷2): the share with the tension within 0.5 % and EI within 10 % of the truth
   (goal 100 %), and the 1σ / 3σ coverage;
-- ``timing``: the median time of one quick answer (one mode, EI given; goal < 0.5 s).
+- ``timing``: the median wall time of the whole command, one mode with EI given (goal < 0.5 s), with
+  ``--baseline PYTHON`` beside another installation's.
 
-    python benchmarks/tension_quick.py [--cases N] [--seed S]
+    python benchmarks/tension_quick.py [--cases N] [--seed S] [--baseline PYTHON] [--lognormal]
 """
 
 from __future__ import annotations
@@ -119,6 +120,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=200, help="cases per condition (default 200)")
     parser.add_argument("--seed", type=int, default=5000, help="first seed (default 5000)")
+    parser.add_argument("--baseline", metavar="PYTHON", help="also time the command with another installation's "
+                                                             "Python (the code before, say)")
     parser.add_argument("--lognormal", action="store_true", help="truth = known exp(t z) instead of known (1 + t z)")
     args = parser.parse_args(argv)
     global LOGNORMAL
@@ -147,13 +150,24 @@ def main(argv=None) -> int:
     print(f"five-modes   (xi 20-200, EI given x2 or /2): tension within 0.5 % and EI within 10 % in "
           f"{100 * np.mean([g['ok'] for g in fives]):.1f} %; within 1σ / 2σ / 3σ: {shares([g['z'] for g in fives])}")
 
-    times = []
-    for s in seeds[:20]:
-        t0 = time.perf_counter()
-        stiff(s, True)
-        times.append(time.perf_counter() - t0)
-    print(f"timing       one mode, EI given (with the FE truth): median {1e3 * np.median(times):.0f} ms")
+    for python in [sys.executable] + ([args.baseline] if args.baseline else []):
+        print(f"timing       {python}: `stcs-ident tension` one mode, EI given, the whole command: median "
+              f"{1e3 * command_time(python):.0f} ms of 7")
     return 0
+
+
+def command_time(python: str, repeat: int = 7) -> float:
+    """Median wall time of the whole command (interpreter start, imports, answer), one mode with EI given."""
+    import subprocess
+
+    args = [python, "-m", "stcs_ident.cli.main", "tension", "--length", "8", "--mass", "40", "--frequencies", "12.5",
+            "--EI", "2e5"]
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run(args, check=True, capture_output=True)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
 
 
 if __name__ == "__main__":

@@ -48,13 +48,13 @@ def _given(args: argparse.Namespace) -> list[str]:
 def reading_from_args(args: argparse.Namespace, has_record: bool, record: str):
     """The :class:`~stcs_ident.io.test_record.RecordReading` of the reader options given (None without a
     record); a reader option given without a record is refused naming it and ``record``."""
-    from ..io.test_record import RecordReading
-
     given = _given(args)
     if not has_record:
         if given:
             raise InputError(f"is a reader option: it goes with {record}", field=given[0])
         return None
+    from ..io.test_record import RecordReading  # the readers (pandas) only where there is a record
+
     options, positions, directions = {}, {}, {}
     for option in given:
         key = option[2:].replace("-", "_")

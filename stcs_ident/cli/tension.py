@@ -119,7 +119,6 @@ def tension_text(result) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run ``tension``; returns the exit status (1 when the exact model's fit failed)."""
     from ..identify.quick import quick_tension, rounding_uncertainty
-    from ..report.forward import to_json
 
     reading = reading_from_args(args, args.record is not None, "--record")
     if args.record is not None:
@@ -138,6 +137,8 @@ def run(args: argparse.Namespace) -> int:
                            length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
                            mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"), plane=args.plane)
     if args.json:
+        from ..report.forward import to_json  # pandas with it: only when a JSON is asked for
+
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":
         sys.stdout.write(tension_text(result))

@@ -42,7 +42,7 @@ from ..core.planes import PLANES
 from ..core.result import Result
 from ..forward.statics import irvine_lambda2
 from .problem import printed_step
-from .quick_exact import Member, exact_tension
+from .quick_exact import Member, bracketed_root, exact_tension
 from .zui import SOURCE as ZUI_SOURCE
 from .zui import zui_tension
 
@@ -107,20 +107,19 @@ def clamped_beam_tension(length, mass_per_length, frequency_hz, mode, EI):
     The expansion grows with T only where ξ² > 4 + n²π²/2; the root is sought there. Returns NaN when
     the frequency is below that branch (a beam too stiff for the expansion).
     """
-    from scipy.optimize import brentq
-
     c = 4 + mode * mode * math.pi**2 / 2
     lo = c * EI / length**2 * (1 + 1e-12)
 
     def g(t):
         return clamped_beam_frequency(length, mass_per_length, t, EI, mode) - frequency_hz
 
-    if g(lo) >= 0:
+    g_lo = g(lo)
+    if g_lo >= 0:
         return math.nan
     hi = max(2 * lo, float(taut_string_tension(length, mass_per_length, frequency_hz, mode)))
     while g(hi) < 0:
         hi *= 2
-    return brentq(g, lo, hi, xtol=1e-300, rtol=1e-14)
+    return bracketed_root(g, lo, hi, g_lo, g(hi), rtol=1e-14)
 
 
 # ---- results ------------------------------------------------------------------------------------------------

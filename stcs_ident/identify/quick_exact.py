@@ -37,8 +37,8 @@ import numpy as np
 from ..core.formatting import plus_minus
 from ..core.model import Boundary, Cable
 
-__all__ = ["EI_CEILING_NOTE", "STEEL_DENSITY", "STEEL_MODULUS", "ExactAnswer", "Member", "exact_tension",
-           "steel_bar_EI"]
+__all__ = ["EI_CEILING_NOTE", "STEEL_DENSITY", "STEEL_MODULUS", "ExactAnswer", "Member", "bracketed_root",
+           "exact_tension", "steel_bar_EI"]
 
 #: Nominal steel: density (kg/m³) and Young's modulus (Pa) of the solid bar that bounds EI from the mass.
 STEEL_DENSITY = 7850.0
@@ -132,6 +132,32 @@ class ExactAnswer:
 
 # ---- one mode: a root ---------------------------------------------------------------------------------------
 
+def bracketed_root(g, a: float, b: float, ga: float, gb: float, rtol: float = 1e-13) -> float:
+    """The root of ``g`` in [a, b] (g(a), g(b) of opposite signs) by the Illinois method (regula falsi whose
+    retained end's value is halved when it is kept twice: superlinear on a smooth monotonic g, and it never
+    leaves the bracket). Here rather than scipy's brentq so that one mode's answer does not import
+    scipy.optimize (0.3 s of the command's 0.6 s)."""
+    side = 0
+    for _ in range(200):
+        c = b - gb * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
+        if not a < c < b and not b < c < a:
+            c = 0.5 * (a + b)
+        gc = g(c)
+        if gc == 0 or abs(b - a) <= rtol * abs(c):
+            return c
+        if (gc < 0) == (gb < 0):  # c replaces b; a is kept
+            b, gb = c, gc
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            a, ga = c, gc
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return c
+
+
 @dataclass(frozen=True)
 class _Root:
     tension: float
@@ -147,8 +173,6 @@ class _Root:
 
 def _root(member: Member, f: float, sigma: float, n: int, EI: float, tolerance: dict) -> _Root:
     """T with f_n(T) = f, and its σ; raises ValueError with the reason when there is none."""
-    from scipy.optimize import brentq
-
     top = member.string_tension(f, n)
     grid = top * SCAN
     for _ in range(4):
@@ -162,8 +186,8 @@ def _root(member: Member, f: float, sigma: float, n: int, EI: float, tolerance: 
     brackets = np.flatnonzero((d[:-1] < 0) != (d[1:] < 0))
     roots = []
     for i in brackets:
-        roots.append(brentq(lambda t: float(member.frequencies(t, EI, [n]).ravel()[0]) - f, grid[i], grid[i + 1],
-                            xtol=1e-300, rtol=1e-13))
+        roots.append(bracketed_root(lambda t: float(member.frequencies(t, EI, [n]).ravel()[0]) - f,
+                                    grid[i], grid[i + 1], d[i], d[i + 1]))
     if roots:
         T, extended = max(roots), False
         at = T
