@@ -264,10 +264,17 @@ def _range(member: Member, f: float, sigma: float, n: int, tolerance: dict) -> E
 # ---- two modes or more: a fit -------------------------------------------------------------------------------
 
 def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI: float | None,
-         tolerance: dict, rescaled: bool = False) -> ExactAnswer:
-    """Least squares in x = (ln(T/T_s), √EI / s_ref), or x = (ln(T/T_s),) with EI held. With a prior and a
-    significant misfit of the frequencies, refitted with their σ scaled (``rescaled``): the prior then weighs
-    in the estimate as much as in its σ."""
+         tolerance: dict, fixed: bool = False) -> ExactAnswer:
+    """Least squares in x = (ln(T/T_s), √EI / s_ref), or x = (ln(T/T_s),) with EI held.
+
+    The frequencies' σ is scaled by the reduced χ² where their misfit is significant. Without a prior that is
+    the χ² of the fit, on n − p degrees of freedom. With a prior the scale changes the estimate (the prior
+    weighs more against scaled frequencies), so it is found self-consistently: refitted with the frequencies'
+    σ scaled until the scale equals their χ² at that estimate over n less the parameters they fit (the trace
+    of their hat matrix). A misnumbered record's modes that a free EI would bend to fit then keep the misfit
+    that the prior's EI leaves. ``fixed``: fit with ``sigma`` as given, no scaling (that loop's step)."""
+    if EI is not None and EI and tolerance.get("EI") and not fixed:
+        return _prior_fit(member, f, sigma, modes, EI, tolerance)
     from scipy.optimize import least_squares
 
     from .nuisance import propagate
@@ -346,18 +353,15 @@ def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI
     A_d = A[:n] if nuis else np.zeros((n, 1))
     # the frequencies' misfit: χ² of their own best fit (no prior: a prior at odds with them is said, not taken
     # for a misfit of theirs) under the data covariance the tolerances make, on n - p degrees of freedom
-    _, chi2 = propagate(J[:n], A_d, r[:n], base)
-    dof = n - p
-    scale, note = covariance_scale(chi2, dof, tolerances=bool(nuis))
-    if note is not None and note.kind == "covariance_scaled":
-        notes.append(str(note))
-        if prior and not rescaled:
-            inner = _fit(member, f, sigma * math.sqrt(scale), modes, EI, tolerance, rescaled=True)
-            if inner.failed:
-                return inner
-            return replace(inner, notes=(str(note), *inner.notes), extra={
-                **inner.extra, "covariance_scale": float(scale), "reduced_chi2": chi2 / dof,
-                "uncertainty_from_frequencies": inner.extra["uncertainty_from_frequencies"]})
+    if fixed:
+        scale, chi2, dof = 1.0, gls_chi2(r[:n], A_d), n - p
+    else:
+        # the frequencies' misfit: χ² of their own best fit under the data covariance the tolerances make
+        _, chi2 = propagate(J[:n], A_d, r[:n], base)
+        dof = n - p
+        scale, note = covariance_scale(chi2, dof, tolerances=bool(nuis))
+        if note is not None and note.kind == "covariance_scaled":
+            notes.append(str(note))
     if prior and abs(r[-1]) > 3:
         notes.append(f"the frequencies put EI at {E:.4g} N m^2, {abs(r[-1]):.1f}σ of its tolerance from the given "
                      f"{EI:.4g}: the given EI is likely wrong")
@@ -372,7 +376,8 @@ def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI
              "uncertainty_from_tolerances": T * math.sqrt(max(C[0, 0] - base[0, 0], 0.0)),
              "tolerances_held": {key: w for key, w in nuis}, "reduced_chi2": chi2 / dof if dof > 0 else None,
              "covariance_scale": float(scale), "fitted": "tension" if held else "tension,EI", "chi2": float(r[:n] @ r[:n]),
-             "solved": "least squares from a scan"}
+             "solved": "least squares from a scan", "chi2_gls": gls_chi2(r[:n], A_d),
+             "fitted_by_frequencies": float(np.trace(J[:n] @ np.nan_to_num(base, posinf=0.0) @ J[:n].T))}
     if held:
         return ExactAnswer(T, sigma_T, EI=EI, EI_source="given" if EI else "given as 0 (a string)", notes=tuple(notes),
                            extra=extra)
@@ -392,6 +397,36 @@ def _fit(member: Member, f: np.ndarray, sigma: np.ndarray, modes: np.ndarray, EI
     else:
         source = "fitted with the tension (two modes or more, no EI given)"
     return ExactAnswer(T, sigma_T, EI=E, EI_uncertainty=sigma_EI, EI_source=source, notes=tuple(notes), extra=extra)
+
+
+def gls_chi2(r: np.ndarray, A: np.ndarray) -> float:
+    """rᵀ V⁻¹ r with V = I + A Aᵀ (the data covariance with the tolerances' share, in units of σ)."""
+    V = np.eye(r.size) + A @ A.T
+    try:
+        return float(r @ np.linalg.solve(V, r))
+    except np.linalg.LinAlgError:
+        return float(r @ np.linalg.lstsq(V, r, rcond=None)[0])
+
+
+def _prior_fit(member, f, sigma, modes, EI, tolerance) -> ExactAnswer:
+    """:func:`_fit` with EI's prior and the frequencies' σ scaled self-consistently (see there)."""
+    from .uncertainty import covariance_scale
+
+    scale, note, chi2, dof = 1.0, None, 0.0, 0
+    for _ in range(8):
+        answer = _fit(member, f, sigma * math.sqrt(scale), modes, EI, tolerance, fixed=True)
+        if answer.failed:
+            return answer
+        chi2 = answer.extra["chi2_gls"] * scale  # in units of the stated σ
+        dof = f.size - answer.extra["fitted_by_frequencies"]
+        new, note = covariance_scale(chi2, dof if dof >= 0.5 else 0, tolerances=bool(answer.extra["tolerances_held"]))
+        if abs(new - scale) <= 0.01 * scale:
+            break
+        scale = new
+    if scale > 1 and note is not None:
+        answer = replace(answer, notes=(str(note), *answer.notes))
+    return replace(answer, extra={**answer.extra, "covariance_scale": float(scale),
+                                  "reduced_chi2": chi2 / dof if dof >= 0.5 else None})
 
 
 # ---- the answer ---------------------------------------------------------------------------------------------
