@@ -211,8 +211,14 @@ class QuickTensionResult(Result):
         return {"methods": pd.DataFrame(rows, columns=["method", "tension_N", "uncertainty_N", "note"])}
 
     def headline(self) -> str:
-        shown = [f"{k} {m.tension / 1e3:.5g} ± {m.uncertainty / 1e3:.2g} kN" for k, m in self.methods.items()
+        from ..core.formatting import plus_minus
+
+        shown = [f"{k} {plus_minus(m.tension, m.uncertainty, 'N')}" for k, m in self.methods.items()
                  if m.tension is not None and m.uncertainty is not None]
+        exact = self.methods["exact"]
+        if exact.tension is None and exact.extra.get("upper") is not None:
+            shown.append(f"exact between {plus_minus(exact.extra['lower'], None, 'N', digits=4)} and "
+                         f"{plus_minus(exact.extra['upper'], None, 'N', digits=4)}")
         k = len(self.inputs["frequencies"])
         return f"{k} frequenc{'ies' if k != 1 else 'y'}; " + "; ".join(shown)
 
