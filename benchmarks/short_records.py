@@ -78,10 +78,12 @@ def run_case(kind: str, duration: float, damping_class: str, seed: int) -> dict:
         out["why"] = f"spectra: {str(err)[:80]}"
         return out
     true_f = np.asarray(truth.frequencies, float)
-    for n, f, s, doubtful in zip(spectra.modes, spectra.frequencies, spectra.uncertainty, spectra.doubtful):
+    for n, f, s, doubtful, z in zip(spectra.modes, spectra.frequencies, spectra.uncertainty, spectra.doubtful,
+                                    spectra.damping):
         if n - 1 >= true_f.size:
             continue
         out["modes"].append((int(n), float(f), float(s), float(true_f[n - 1]), bool(doubtful)))
+        out.setdefault("damping_ratios", []).append((int(n), float(z), float(zeta)))
     # a sure mode whose 1σ is 5 % of its frequency or more says nothing of the tension (and identify refuses a σ
     # above its frequency): counted, left out, as tension --record does
     out["useless"] = sum(not d and s >= 0.05 * f for _, f, s, _, d in out["modes"])
@@ -143,6 +145,7 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=36000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--kind", action="append", choices=KINDS)
+    parser.add_argument("--pickle", help="write the per-record results here (for a closer look)")
     parser.add_argument("--list-off", action="store_true", help="list the numbered modes off their truth")
     args = parser.parse_args(argv)
     print_header()
@@ -151,6 +154,10 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(run_case, *zip(*jobs)))
+    if args.pickle:
+        import pickle
+
+        Path(args.pickle).write_bytes(pickle.dumps(results))
     print(f"{len(results)} records in {time.perf_counter() - t0:.0f} s")
     summarise(results)
     if args.list_off:

@@ -79,8 +79,11 @@ def test_nothing_is_proposed_without_a_detection_nor_beside_one():
 @pytest.mark.slow
 def test_short_records_find_most_modes_with_a_wider_1_sigma_coverage():
     """12 sixty-second records of the bare stay. Guards set below the figures measured on them (the docstring's
-    archive gives alike): with the proposals 14.9 peaks a record (without: 1.0), 60 % of them within 1σ of the
-    true mode and 96.6 % within 3σ (without: 42 and 83 %). The 1σ is still short of honest on such records (docs/track.md)."""
+    archive gives alike): with the proposals 16.0 peaks a record (without: 8.8), 61.5 % of them within 1σ of the
+    true mode and 97.4 % within 3σ (without: 65.7 and 96.2 %). Before the raw valley told apart the modes of a
+    short record's coarse overview (detection._separated), the detection alone found 1.0 a record (the others
+    suppressed as the strongest one's shoulders) and the proposals 14.9 (60 / 96.6 %). The 1σ is still short of
+    honest on such records (docs/track.md)."""
     with_, without = [], []
     counts = {"with": 0, "without": 0}
     for seed in range(100, 112):
@@ -90,6 +93,8 @@ def test_short_records_find_most_modes_with_a_wider_1_sigma_coverage():
             counts[name] += n
             out.extend(z)
     with_, without = np.array(with_), np.array(without)
-    assert counts["with"] >= 2 * counts["without"], counts
-    assert np.mean(with_ < 3) >= 0.93, np.mean(with_ < 3)
-    assert np.mean(with_ < 3) > np.mean(without < 3), (np.mean(with_ < 3), np.mean(without < 3))
+    assert counts["without"] >= 6 * 12, counts  # the detection alone: 8.8 a record (1.0 when merged)
+    assert counts["with"] >= 1.5 * counts["without"], counts  # the proposals add the undetected ones (1.83x)
+    assert np.mean(with_ < 3) >= 0.95, np.mean(with_ < 3)
+    # the proposals' extra, weaker modes do not cost coverage beyond the spread of ~100-200 peaks (2 %)
+    assert np.mean(with_ < 3) >= np.mean(without < 3) - 0.02, (np.mean(with_ < 3), np.mean(without < 3))
