@@ -123,17 +123,24 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         from .plausibility import check_plausibility as check
 
         check(campaign, measurements, settings.tension_model)
-    nuisance = nuisance_parameters(campaign, [m.test for m in measurements], parameters) if tolerances else ()
-    problem = Problem(campaign, measurements, parameters, settings.tension_model, nuisance=nuisance)
-    reset_warm_starts()  # the result depends on these inputs alone, not on what this process solved before
-    if method == "lsq":
-        from .lsq import fit_lsq
 
-        result = fit_lsq(problem, settings=settings, **options)
-    else:
+    def run(chosen) -> IdentificationResult:
+        free = parameters if chosen is measurements else parse_parameters(
+            campaign, [m.test for m in chosen], params, bounds)
+        nuisance = nuisance_parameters(campaign, [m.test for m in chosen], free) if tolerances else ()
+        problem = Problem(campaign, chosen, free, settings.tension_model, nuisance=nuisance)
+        reset_warm_starts()  # the result depends on these inputs alone, not on what this process solved before
+        if method == "lsq":
+            from .lsq import fit_lsq
+
+            return fit_lsq(problem, settings=settings, **options)
         from .contour import fit_contour
 
-        result = fit_contour(problem, settings=settings, **options)
+        return fit_contour(problem, settings=settings, **options)
+
+    result = run(measurements)
+    if result.failure is not None:
+        result = without_failed_tests(result, measurements, run)
     from dataclasses import replace
 
     if skipped:
@@ -147,6 +154,54 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
     if result.failure is not None:
         raise BoundError(str(result.failure), result)
     return result
+
+
+#: A joint fit over many tests leaves out at most this share of them (at least one, from three tests on) whose
+#: data put it at a bound; more, and the campaign itself is wrong (every stated tension off): the fit fails.
+MAX_FAILED_SHARE = 0.25
+
+
+def without_failed_tests(result: IdentificationResult, measurements, run) -> IdentificationResult:
+    """A joint fit stopped at a bound, refitted without the test(s) whose data put it there (issue 36: a joint
+    fit over many tests does not fail as a whole because one test's evidence is weak or wrong).
+
+    A bound reached by a test's own parameter (its tension) is that test's failure: it is left out and the rest
+    refitted. A bound reached by a shared one (EI) is the failure of the test without which the rest fits (of
+    those with two modes or more, which carry EI; the one leaving the smallest reduced χ²). At most
+    :data:`MAX_FAILED_SHARE` of the tests (at least one, from three tests on) are left out so; where that does
+    not make a fit, the first failure stands. The result lists them in ``failed_tests`` with the reason, and
+    says so in a note.
+    """
+    from dataclasses import replace
+
+    limit = int(MAX_FAILED_SHARE * len(measurements)) if len(measurements) >= 4 else (1 if len(measurements) == 3
+                                                                                       else 0)
+    current, failed, trial = list(measurements), [], result
+    while trial.failure is not None and len(failed) < max(limit, 0):
+        name = trial.failure.parameters[0]
+        own = [m for m in current if name.endswith(f"[{m.test.name}]")]
+        if own:
+            choice = (own[0], run([m for m in current if m is not own[0]]))
+        else:
+            choice = None
+            for m in (m for m in current if m.modes.size >= 2):
+                attempt = run([k for k in current if k is not m])
+                if attempt.failure is None and (choice is None or _reduced(attempt) < _reduced(choice[1])):
+                    choice = (m, attempt)
+            if choice is None:
+                break
+        failed.append((choice[0].test.name, str(trial.failure)))
+        current, trial = [m for m in current if m is not choice[0]], choice[1]
+    if trial.failure is not None or not failed:
+        return result
+    note = Note.make("tests_failed", "fitted without {tests}: their data put the joint fit at a bound (each "
+                     "test's failure, listed in failed_tests; the rest fitted)",
+                     tests=", ".join(f"{n} ({why})" for n, why in failed))
+    return replace(trial, failed_tests=tuple(failed), notes=(note, *trial.notes))
+
+
+def _reduced(result: IdentificationResult) -> float:
+    return result.chi2 / max(result.dof, 1)
 
 
 def default_params(measurements) -> tuple[str, Note | None]:

@@ -152,6 +152,9 @@ class IdentificationResult(Result):
         before/after frequencies, but its ``uncertainty`` is NaN: no value
         with a standard deviation is reported. :func:`~stcs_ident.identify.identify`
         raises :class:`~stcs_ident.core.errors.BoundError` carrying it.
+    failed_tests : tuple of (test, reason)
+        Tests left out of a joint fit because their data put it at a bound
+        (:func:`~stcs_ident.identify.api.without_failed_tests`): each one's failure, the rest fitted.
     """
 
     method: str
@@ -171,6 +174,7 @@ class IdentificationResult(Result):
     settings: Settings = field(default_factory=Settings)
     uncertainty_sources: dict = field(default_factory=dict)
     failure: Note | None = None
+    failed_tests: tuple[tuple[str, str], ...] = ()
 
     main_table = "parameters"
 
@@ -331,6 +335,7 @@ class IdentificationResult(Result):
             "rms_error_after": _float(self.rms_after),
             "notes": [str(n) for n in self.notes],
             "skipped": [{"test": n, "reason": r} for n, r in self.skipped],
+            "failed_tests": [{"test": n, "reason": r} for n, r in self.failed_tests],
             "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
             "settings": self.settings.summary(),
         }
