@@ -277,11 +277,11 @@ def _separated(overview: Overview, weak: Candidate, strong: Candidate, separatio
     """
     df = overview.frequency[1] - overview.frequency[0]
     lo, hi = sorted((weak.index, strong.index))
-    # An average of many segments (a short record's coarse overview) barely ripples: where its own valley between
-    # the two falls to the floor, they are two resonances, whatever the width taken on a running mean over 5
-    # cells (a Hz or more there, which merged modes a Hz apart into one and suppressed all but the strongest as
-    # its shoulders: 1 of 3 equal modes 1.16 Hz apart found on 60-s records).
-    if (weak.dof >= SMOOTH_DOF and hi - lo >= 3 * overview.cell
+    # An ambient overview averaged over many segments (a short record's coarse one) barely ripples: where its own
+    # valley between the two falls to the floor, they are two resonances, whatever the width taken on a running
+    # mean over 5 cells (a Hz or more there, which merged modes a Hz apart into one and suppressed all but the
+    # strongest as its shoulders: 1 of 3 equal modes 1.16 Hz apart found on 60-s records).
+    if (overview.random_ripple and weak.dof >= SMOOTH_DOF and hi - lo >= 3 * overview.cell
             and np.min(weak.spectrum[lo : hi + 1]) <= max(1.0, weak.spectrum[weak.index] / weak.threshold)):
         return True
     if abs(weak.frequency - strong.frequency) <= 0.5 * strong.half_power_width:
