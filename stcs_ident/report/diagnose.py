@@ -66,9 +66,18 @@ def diagnosis_text(diagnosis) -> str:
         lines += ["", *damping[:-1]]
     for note in d.notes:
         lines.append(f"Note: {note}")
-    for name, reason in d.skipped:
-        lines.append(f"Skipped {name}: {reason}")
+    lines += [f"Skipped {line}" for line in skipped_lines(d.skipped)]
     return "\n".join(lines) + "\n"
+
+
+def skipped_lines(skipped) -> list[str]:
+    """One line per reason: ``9 tests (no measured frequencies and no record): case1-L1, case1-L2, ...`` (a
+    test alone: ``case1-L1: reason``), in the order the reasons first appear."""
+    by_reason: dict[str, list[str]] = {}
+    for name, reason in skipped:
+        by_reason.setdefault(reason, []).append(name)
+    return [f"{names[0]}: {reason}" if len(names) == 1 else f"{len(names)} tests ({reason}): {', '.join(names)}"
+            for reason, names in by_reason.items()]
 
 
 def baseline_label(diagnosis) -> str:
@@ -109,7 +118,7 @@ def _data_section(d, spectra) -> list[str]:
                                "frequencies": "frequencies from", "uncertainty_Hz": "uncertainty (Hz)",
                                "uncertainty from": "uncertainty from"})]
     if d.skipped:
-        out.append("Skipped tests: " + "; ".join(f"{name} ({reason})" for name, reason in d.skipped) + ".\n")
+        out.append("Skipped " + "; ".join(skipped_lines(d.skipped)) + ".\n")
     out.append(f"Effects considered: {', '.join(d.considered) or 'none'}.\n")
     return out
 
@@ -280,7 +289,6 @@ def _notes_section(d) -> list[str]:
     notes = list(d.notes) + [f"{effects_label(d.corrected.effects)}: {note}" for note in d.corrected.notes]
     if d.baseline is not None and d.baseline is not d.corrected:
         notes += [f"baseline ({effects_label(d.baseline.effects)}): {note}" for note in d.baseline.notes]
-    notes += [f"skipped {name}: {reason}" for name, reason in d.skipped]
     out = ["## Notes", ""] + [f"- {note}" for note in notes] if notes else []
     return out + ([""] if notes else [])
 
