@@ -354,6 +354,8 @@ def test_track_writes_its_records_as_csv_beside_the_parquet_table(tmp_path, caps
     assert list(csv.columns) == list(parquet.columns) and len(csv) == len(parquet) == 2  # 72 min every 30 min
     assert csv["tension"].tolist() == parquet["tension"].tolist()  # floats written at full precision
     assert csv["frequencies"].tolist() == [";".join(str(float(f)) for f in fs) for fs in parquet["frequencies"]]
+    # every list alike: the doubtful flags too (they were a numpy repr, "[False False ...]")
+    assert csv["doubtful"].tolist() == [";".join("true" if d else "false" for d in ds) for ds in parquet["doubtful"]]
     assert pd.to_datetime(csv["start_time"]).tolist() == parquet["start_time"].tolist()
     assert "of 2 records with a tension" in stdout
 

@@ -55,13 +55,15 @@ def write_report(result, out: str | Path | None = None) -> Path:
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     """The records table (``records.parquet``) with plain cells for CSV.
 
-    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``, ``damping``,
+    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``, ``doubtful``, ``damping``,
     ``damping_sigma``) become their values joined by
-    ``;`` and ``start_time`` an ISO 8601 string; every other column is as in the Parquet table.
+    ``;`` (``doubtful`` as ``true``/``false``) and ``start_time`` an ISO 8601 string; every other column is as in
+    the Parquet table.
     """
     plain = table.copy()
     for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float),
-                       ("damping", float), ("damping_sigma", float)):
+                       ("doubtful", lambda x: "true" if x else "false"), ("damping", float),
+                       ("damping_sigma", float)):
         if name in plain:  # str of a float is its shortest round-trip form
             plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
     if "start_time" in plain:
