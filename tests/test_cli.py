@@ -358,6 +358,8 @@ def test_track_writes_its_records_as_csv_beside_the_parquet_table(tmp_path, caps
     assert csv["doubtful"].tolist() == [";".join("true" if d else "false" for d in ds) for ds in parquet["doubtful"]]
     assert pd.to_datetime(csv["start_time"]).tolist() == parquet["start_time"].tolist()
     assert "of 2 records with a tension" in stdout
+    # an hour of records is no monitoring yet: stdout says so, not "no lasting change" (issue 37)
+    assert "not monitoring yet" in stdout and "no lasting change" not in stdout
 
 
 def test_diagnose_workers_caps_the_processes(tmp_path, capsys, monkeypatch):
