@@ -26,7 +26,14 @@ Expected periodogram
     the frequency by up to one σ in long records) is bounded by α, so a
     mode is always a peak, never a mere wiggle. Other modes add
     α_j Re H(u_j) with fixed poles and α_j ≥ 0, and noise and far tails a
-    constant (≥ 0) and a slope. Nothing else: with a curvature term, a
+    line that is ≥ 0 across the band (two ramps, each ≥ 0, from either
+    edge). A line of free slope could go to zero inside the band, where the
+    mode's dispersive part (negative beyond its half-power point on one
+    side) cancels the rest: the model's mean then dips to nothing at one
+    bin whose periodogram happens to be tiny, and log E_k rewards it by
+    several units (a 60-s record of a stay: mode 16 at 14.57 Hz fitted at
+    14.43 ± 0.012 Hz, −12σ, its mean 1e-3 at a bin of 6e-4 among bins of
+    about 10). Nothing else: with a curvature term, a
     dispersive part of a neighbour or a neighbour of either sign, the
     background alone could carve a bump between two neighbours and mimic
     (and weaken the test of) the mode. The periodogram bins are then
@@ -41,17 +48,22 @@ Uncertainty
     F = Σ ∂E ∂Eᵀ / E², with the linear coefficients marginalised, each
     variance widened to the sandwich (misfit-robust) estimate where that
     is larger: in crowded bands of broad resonances the fixed shapes of
-    the neighbours are only approximate.
+    the neighbours are only approximate. On a peak fewer than about 50
+    bins wide the likelihood is not Gaussian in frequency (shoulders,
+    second maxima on clusters of noise bins): the 1σ is then widened to
+    the spread of the profile likelihood where that is larger
+    (:mod:`.profile`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .decay_fit import pole_statistics
 from .options import FitOptions
+from .profile import frequency_spread
 from .whittle import (
     TINY,
     BandProblem,
@@ -62,7 +74,7 @@ from .whittle import (
     null_neg_log_likelihood,
 )
 
-__all__ = ["AmbientFit", "fejer_lorentzian", "fit_ambient"]
+__all__ = ["AmbientFit", "fejer_lorentzian", "fit_ambient", "widen_to_spread"]
 
 # The iterations and the start's ζ grid are :class:`.options.FitOptions`.
 SERIAL_BLAS_SIZE = 2048  # elements: OpenBLAS runs a complex matrix-vector product this small on one thread
@@ -107,6 +119,9 @@ class AmbientFit:
     significance: float
     converged: bool
     misfit: float = 1.0
+    # What :func:`widen_to_spread` needs (the band, the fit, its limits and covariance), kept by a fit made with
+    # ``spread=False``.
+    band: tuple | None = field(default=None, repr=False, compare=False)
 
 
 def _expected(theta: np.ndarray, problem: BandProblem):
@@ -240,6 +255,7 @@ def fit_ambient(
     peak_width: float = 0.0,
     max_damping: float = 0.2,
     options: FitOptions | None = None,
+    spread: bool = True,
 ) -> AmbientFit | None:
     """Fit one mode to the band [f_initial ± half_width] of an ambient record.
 
@@ -266,6 +282,11 @@ def fit_ambient(
         Upper bound on ζ during the search.
     options : FitOptions, optional
         Iterations and the start's ζ grid (default: the calibrated values).
+    spread : bool
+        Widen the frequency's 1σ to the spread of the profile likelihood where that is larger
+        (:mod:`.profile`; a peak fewer than :data:`.profile.GAUSSIAN_BINS` bins wide). False gives the
+        curvature's 1σ alone and keeps what :func:`widen_to_spread` needs: for a caller that fits many
+        bands and keeps few (the profile costs several fits' time).
 
     Returns
     -------
@@ -284,8 +305,8 @@ def fit_ambient(
     u = mode_shape(white[near])
     y = _serial_product(white, u.conj())
     fixed = _fixed_basis(k * df, f_initial, half_width, neighbours, k, n_samples, dt)
-    # Linear coefficients: mode (p, q), neighbours, constant, slope; powers are ≥ 0.
-    nonnegative = np.array([True, True] + [True] * len(neighbours) + [True, False])
+    # Linear coefficients: mode (p, q), neighbours, the background's two ramps; all are powers, ≥ 0.
+    nonnegative = np.ones(2 + len(neighbours) + 2, dtype=bool)
     problem = BandProblem(np.abs(y) ** 2, 2 * np.pi * k / n_samples, n_samples, dt, fixed, nonnegative)
     # Starting frequencies: the overview's, and the band's maximum after smoothing over 3 bins (a narrow
     # peak) and over a quarter of the overview's width (a broad one, whose bins scatter).
@@ -308,13 +329,38 @@ def fit_ambient(
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
         return None
+    band = (problem, theta, limits, cov)
+    if spread:
+        cov = _spread_covariance(*band)
     null = null_neg_log_likelihood(problem)
     significance = np.sqrt(max(2.0 * (null - neg_log_likelihood(mean, problem.periodogram)), 0.0))
     variance_y = 2.0 * (theta[2] + theta[3])  # c(0) = 2α of the modal term in y, α = p + q
     shape = u * noise_scale
     shape = shape / np.linalg.norm(shape)
     amplitude = np.sqrt(max(variance_y, 0.0)) * np.abs(u) * noise_scale * np.sign(np.cos(np.angle(u)))
-    return _result(theta[:2], cov, amplitude, shape, significance, ok, misfit)
+    fit = _result(theta[:2], cov, amplitude, shape, significance, ok, misfit)
+    return fit if spread else replace(fit, band=band)
+
+
+def widen_to_spread(fit: AmbientFit) -> AmbientFit:
+    """A fit made with ``spread=False``, its frequency's 1σ widened as ``spread=True`` would have (the same pole)."""
+    if fit.band is None:
+        return fit
+    theta = fit.band[1]
+    _, f_std, _, _ = pole_statistics(theta[0], theta[1], _spread_covariance(*fit.band))
+    return replace(fit, frequency_std=max(fit.frequency_std, f_std), band=None)
+
+
+def _spread_covariance(problem: BandProblem, theta: np.ndarray, limits, cov: np.ndarray) -> np.ndarray:
+    """The covariance of (f_d, σ) with the frequency's variance widened to the profile likelihood's spread
+    where that is larger (:mod:`.profile`)."""
+    std = float(np.sqrt(cov[0, 0]))
+    reach = max(8.0 * std, 6.0 * theta[1] / (2 * np.pi))
+    spread = frequency_spread(problem, theta, std, reach, limits)
+    if not spread > std:
+        return cov
+    widen = np.array([spread / std, 1.0])
+    return cov * np.outer(widen, widen)
 
 
 def _fixed_basis(freq, f_centre, half_width, neighbours, k, n, dt) -> np.ndarray:
@@ -323,7 +369,8 @@ def _fixed_basis(freq, f_centre, half_width, neighbours, k, n, dt) -> np.ndarray
     for fj, sj in neighbours:
         h, _ = fejer_lorentzian(complex(-sj * dt, 2 * np.pi * fj * dt), phase, n, derivative=False)
         columns.append(h.real)
-    columns += [np.ones(freq.size), (freq - f_centre) / half_width]
+    x = (freq - f_centre) / half_width
+    columns += [(1 - x) / 2, (1 + x) / 2]  # the background: a line ≥ 0 across the band, as two ramps ≥ 0
     return np.column_stack(columns)
 
 

@@ -107,7 +107,7 @@ from scipy import fft
 
 from ..core.errors import InputError
 from ..core.record import Record, check_finite
-from .ambient_fit import AmbientFit, fit_ambient
+from .ambient_fit import AmbientFit, fit_ambient, widen_to_spread
 from .decay_fit import DecayFit, event_spectra, fit_decay
 from .detection import Candidate, detect_multiresolution, expected_proposals
 from .events import Event, detect_events, whole_record_event
@@ -305,7 +305,7 @@ def _refine_decays(x, fs, events, overview: Overview, candidates, names, band, o
         if fit is None:
             peaks.append(_overview_peak(c, overview, names, snr_db))
         elif isinstance(fit, AmbientFit):
-            peaks.append(_ambient_peak(c, fit, overview, names, snr_db))
+            peaks.append(_ambient_peak(c, widen_to_spread(fit), overview, names, snr_db))
         else:
             std = with_common_wander(fit.frequency_std, fit.frequency, fit.event_variances, tau2)
             peak = _decay_peak(c, replace(fit, frequency_std=std), names, snr_db)
@@ -418,7 +418,7 @@ def _whittle_band(x: np.ndarray, fs: float, overview: Overview, options: Picking
         floor = np.array([np.interp(f0, overview.frequency, col) for col in overview.channel_floor.T])
         noise_scale = np.sqrt(floor * fs / 2.0)
         return fit_ambient(cache["dft"], n, fs, f0, half_width, noise_scale, poles, peak_width=peak_width,
-                           max_damping=max_damping, options=options.fit)
+                           max_damping=max_damping, options=options.fit, spread=False)
 
     return fit_band
 
@@ -441,6 +441,9 @@ def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band, 
                                 detection_options=options.detection, floor_options=options.floor)
     if extra:
         pairs = fitted(sorted([c for c, _ in pairs] + extra, key=lambda c: c.frequency))
+    # The kept fits' 1σ widened to the profile likelihood's spread (.profile): only theirs, since the profile
+    # costs several fits' time and refine's decisions need the pole alone.
+    pairs = [(c, fit if fit is None else widen_to_spread(fit)) for c, fit in pairs]
     snr_db = options.filters.channel_snr_db
     peaks = []
     for c, fit in pairs:

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TINY", "BandProblem", "band_design", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
-           "null_neg_log_likelihood"]
+__all__ = ["TINY", "BandProblem", "band_design", "designs", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
+           "null_neg_log_likelihood", "whittle_linear_many"]
 
 TINY = np.finfo(float).tiny
 
@@ -45,8 +45,8 @@ class BandProblem:
     phase: np.ndarray  # 2πk/N
     n_samples: int
     dt: float
-    fixed: np.ndarray  # (m, q) fixed real basis columns: neighbours, constant, slope
-    nonnegative: np.ndarray  # (2 + q,) bool: linear coefficients that are powers (mode, neighbours, constant)
+    fixed: np.ndarray  # (m, q) fixed real basis columns: neighbours, then the background (see _whittle_linear)
+    nonnegative: np.ndarray  # (2 + q,) bool: linear coefficients that are powers (mode, neighbours, background)
 
 
 def band_design(theta_nl: np.ndarray, problem: BandProblem, derivative: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
@@ -93,14 +93,17 @@ def _whittle_linear(
 ) -> tuple[np.ndarray, float]:
     """Whittle fit of a mean linear in its coefficients, by damped Fisher scoring (iteratively reweighted LS).
 
-    It starts from the flat mean (the last-but-one column is the constant
-    of the background) and halves each step until the mean stays positive
+    It starts from the flat mean (the last two columns are the background:
+    a constant and a slope, or, where the last is a power, two ramps from
+    the band's edges that sum to a constant) and halves each step until the mean stays positive
     and the likelihood does not fall, so it never ends worse than the flat
     background. Coefficients that are powers stay ≥ 0: a neighbour's tail
     taken negative would carve a bump out of a constant and mimic a mode.
     """
     lin = np.zeros(basis.shape[1])
     lin[-2] = np.mean(periodogram)
+    if nonnegative[-1]:  # the background as two nonnegative edge ramps: both at the mean make it flat
+        lin[-1] = lin[-2]
     mean = basis @ lin
     nll = neg_log_likelihood(mean, periodogram)
     for _ in range(iterations):
@@ -151,12 +154,12 @@ def _weighted_least_squares(basis, target, weight, nonnegative) -> np.ndarray:
 
 def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) -> np.ndarray:
     """The best (least -log-likelihood) of the starting frequencies × `damping_grid` (ζ), linear terms fitted
-    (all of them at once: :func:`_whittle_linear_many`; the first of equal ones)."""
+    (all of them at once: :func:`whittle_linear_many`; the first of equal ones)."""
     grid = [np.array([f_start, zeta * 2 * np.pi * f_start]) for f_start in starts for zeta in damping_grid]
     grid = [theta_nl for theta_nl in grid if limits[1][0] < theta_nl[1] < limits[1][1]]
     if grid:
-        bases = _designs(np.array(grid), problem)
-        lin, nll = _whittle_linear_many(bases, problem.periodogram, problem.nonnegative, iterations=3)  # starts only
+        bases = designs(np.array(grid), problem)
+        lin, nll = whittle_linear_many(bases, problem.periodogram, problem.nonnegative, iterations=3)  # starts only
         best = int(np.argmin(np.where(np.isnan(nll), np.inf, nll)))
         if nll[best] < np.inf:
             return np.concatenate([grid[best], lin[best]])
@@ -164,7 +167,7 @@ def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) 
     return np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
 
 
-def _designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
+def designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
     """:func:`band_design`'s basis (no derivative) of many (f, σ) rows at once, (c, m, 2 + q)."""
     z = (-thetas[:, 1] * problem.dt + 2j * np.pi * thetas[:, 0] * problem.dt)[:, None]
     h, _ = fejer_lorentzian(z, problem.phase[None, :], problem.n_samples, derivative=False)
@@ -175,7 +178,7 @@ def _designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
     return bases
 
 
-def _whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
+def whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
                          iterations: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_whittle_linear` of many bases (c, m, q) at once: coefficients (c, q) and -log-likelihoods (c,).
 
@@ -186,6 +189,8 @@ def _whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative
     c, _, q = bases.shape
     lin = np.zeros((c, q))
     lin[:, -2] = np.mean(periodogram)
+    if nonnegative[-1]:  # the background as two nonnegative edge ramps (:func:`_whittle_linear`)
+        lin[:, -1] = lin[:, -2]
     mean = np.einsum("cmq,cq->cm", bases, lin)
     nll = _neg_log_likelihood_many(mean, periodogram)
     active = np.ones(c, dtype=bool)
