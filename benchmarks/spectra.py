@@ -52,6 +52,12 @@ Run: ``python benchmarks/spectra.py [--quick]`` (about 1.5 minutes on two idle
 cores; ``--quick``: one record per case, one timing repeat, about 25 s), or
 ``python benchmarks/spectra.py --throughput [--repeat N]`` for the find_peaks
 throughput case alone (N runs, default 5; pyOMA-2 not needed).
+
+``--throughput --baseline PYTHON`` times the same record (pickled) with the
+stcs_ident of PYTHON too (the code before a change, installed in its own
+environment), in turns with this code (``--rounds`` rounds of N runs each, default
+2), and prints both, their ratio and whether the two codes report the same peaks
+(the largest difference of a frequency over its 1σ).
 """
 
 from __future__ import annotations
@@ -327,11 +333,81 @@ def print_case(r: dict) -> dict:
     return {"title": f"{s.name} {case.kind}", "lower": lower, "med": med}
 
 
-def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) -> dict:
-    """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time."""
+def peak_times(record, repeat: int, holder: dict | None = None) -> tuple[list[float], list[float] | None]:
+    """Wall times of ``repeat`` find_peaks calls with BLAS's threads as they come, and as many with BLAS limited
+    to one thread (None without threadpoolctl); ``holder['result']``: the last call's result."""
+    from stcs_ident.spectra.peaks import find_peaks
+
+    holder = {} if holder is None else holder
+    default = wall_times(lambda: holder.update(result=find_peaks(record)), repeat)
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return default, None
+    with threadpool_limits(limits=1, user_api="blas"):
+        return default, wall_times(lambda: find_peaks(record), repeat)
+
+
+def in_turns(record, repeat: int, rounds: int, baseline: str, holder: dict):
+    """This code's and the ``baseline`` Python's find_peaks times on ``record``, ``rounds`` rounds in turns of
+    ``repeat`` runs each (a machine's load drifts: both codes see it alike); the baseline's times, its
+    package and its peaks (frequency, 1σ) in a dict."""
+    import json
+    import pickle
+    import subprocess
+    import tempfile
+
+    from stcs_ident.spectra.peaks import find_peaks
+
+    find_peaks(record)  # warm-up, as the baseline's side does
+    default, single, other = [], [], {"default": [], "single": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "record.pickle")
+        with open(path, "wb") as stream:
+            pickle.dump(record, stream)
+        for _ in range(rounds):
+            d, s = peak_times(record, repeat, holder)
+            default += d
+            single = None if s is None else (single or []) + s
+            done = subprocess.run([baseline, os.path.abspath(__file__), "--time-peaks", path, "--repeat",
+                                   str(repeat)], capture_output=True, text=True, check=True, cwd=tmp)
+            answer = json.loads(done.stdout.strip().splitlines()[-1])
+            other["default"] += answer["default"]
+            other["single"] = None if answer["single"] is None else other["single"] + answer["single"]
+            other.update(package=answer["package"], peaks=answer["peaks"])
+    return default, single, other
+
+
+def time_peaks(path: str, repeat: int) -> None:
+    """``--time-peaks``: find_peaks on a pickled record by whichever stcs_ident this Python imports (after one
+    call to warm up), ``repeat`` runs with BLAS's threads and as many on one; one JSON line."""
+    import json
+    import pickle
+
+    from stcs_ident.spectra.peaks import find_peaks
+
+    with open(path, "rb") as stream:
+        record = pickle.load(stream)
+    result = find_peaks(record)
+    default, single = peak_times(record, repeat)
+    print(json.dumps({"package": os.path.dirname(sys.modules["stcs_ident"].__file__), "default": default,
+                      "single": single, "peaks": [(p.frequency, p.uncertainty) for p in result.peaks]}))
+
+
+def same_peaks(ours, theirs) -> str:
+    """How far the two codes' peaks are apart: their counts, and the largest |Δf| / 1σ of the peaks in order."""
+    if len(ours) != len(theirs):
+        return f"{len(ours)} peaks against the baseline's {len(theirs)}"
+    worst = max((abs(p.frequency - f) / u for p, (f, u) in zip(ours, theirs)), default=0.0)
+    return f"the same {len(ours)} peaks, frequencies within {worst:.1e} of their 1σ"
+
+
+def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None, baseline: str | None = None,
+               rounds: int = 2) -> dict:
+    """16 sensors x 10 min at 256 Hz, ambient, of the stay: find_peaks and (`with_fdd`) pyOMA FDD wall time;
+    with ``baseline`` (another Python) that installation's find_peaks too (:func:`in_turns`)."""
     from stcs_ident.forward import count_below
     from stcs_ident.simulate.simulate import NYQUIST_FRACTION, Ambient
-    from stcs_ident.spectra.peaks import find_peaks
 
     _, stay = structures()
     fs, duration, n_channels = 256.0, 600.0, 16
@@ -348,15 +424,11 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
     repeat = repeat or (1 if quick else 3)
 
     holder = {}
-    ours_default = wall_times(lambda: holder.update(result=find_peaks(record)), repeat)
-    ours_single = None
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        pass
+    if baseline is None:
+        ours_default, ours_single = peak_times(record, repeat, holder)
+        other = None
     else:
-        with threadpool_limits(limits=1, user_api="blas"):
-            ours_single = wall_times(lambda: find_peaks(record), repeat)
+        ours_default, ours_single, other = in_turns(record, repeat, rounds, baseline, holder)
     found = np.array([p.frequency for p in holder["result"].peaks])
     err = np.full(truth.size, np.nan)
     for k, ft in enumerate(truth):
@@ -368,7 +440,8 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
     result = {"shape": record.acceleration.shape, "t_sim": t_sim, "ours": ours_default, "ours_1": ours_single,
               "fdd": None, "nxseg": nxseg, "n_true": n_true, "missed": [k + 1 for k in np.flatnonzero(np.isnan(err))],
               "n_peaks": len(holder["result"].peaks), "err": float(np.nanmedian(err)), "fdd_err": float("nan"),
-              "repeat": repeat}
+              "repeat": repeat, "baseline": other,
+              "same": None if other is None else same_peaks(holder["result"].peaks, other["peaks"])}
     if not with_fdd:
         return result
     from pyoma2.algorithms.fdd import FDD
@@ -390,8 +463,9 @@ def throughput(quick: bool, with_fdd: bool = True, repeat: int | None = None) ->
 def print_throughput(tp: dict) -> None:
     n, c = tp["shape"]
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    runs = len(tp["ours"])
     print(f"\nThroughput: ambient record of the stay, {c} channels x {n / 256.0:g} s at 256 Hz ({n * c:,} samples; "
-          f"simulated in {tp['t_sim']:.1f} s); {tp['repeat']} run{'s' if tp['repeat'] > 1 else ''} each, "
+          f"simulated in {tp['t_sim']:.1f} s); {runs} run{'s' if runs > 1 else ''} each, "
           f"{os.cpu_count()} CPUs, load average {load:.2f}")
     widths = (36, 8, 8, 8, 30)
     head = ("method", "median s", "min s", "target", "modes, median |e|")
@@ -402,12 +476,25 @@ def print_throughput(tp: dict) -> None:
              f"{n_found}/{tp['n_true']} found, {fmt_err(tp['err'])}")]
     if tp["ours_1"] is not None:
         rows.append(("find_peaks, BLAS limited to 1 thread", tp["ours_1"], f"<= {THROUGHPUT_TARGET:g}", "same"))
+    base = tp.get("baseline")
+    if base is not None:
+        rows.append(("baseline find_peaks (blind)", base["default"], "", "the code before"))
+        if base["single"] is not None:
+            rows.append(("baseline, BLAS limited to 1 thread", base["single"], "", "the code before"))
     if tp["fdd"] is not None:
         rows.append((f"pyOMA FDD, nxseg {tp['nxseg']}, at truth", tp["fdd"], "",
                      f"{tp['n_true']} given, {fmt_err(tp['fdd_err'])}"))
     for name, times, target, acc in rows:
         cells = (name, f"{statistics.median(times):.2f}", f"{min(times):.2f}", target, acc)
         print("  " + " ".join(x.rjust(w) for x, w in zip(cells, widths)))
+    if base is not None:
+        pairs = [("threads as they come", tp["ours"], base["default"])]
+        if tp["ours_1"] is not None and base["single"] is not None:
+            pairs.append(("BLAS on 1 thread", tp["ours_1"], base["single"]))
+        print(f"  baseline: {base['package']}; this code / baseline, median and min: " + "; ".join(
+            f"{label} {statistics.median(a) / statistics.median(b):.2f}, {min(a) / min(b):.2f}"
+            for label, a, b in pairs))
+        print(f"  results: {tp['same']}")
     ok = statistics.median(tp["ours"]) <= THROUGHPUT_TARGET
     print(f"  find_peaks within target (median, default threads): {'yes' if ok else 'NO'}; "
           f"{tp['n_peaks']} peaks reported in 0-{0.45 * 256:g} Hz; modes not reported: "
@@ -474,15 +561,23 @@ def main(argv=None) -> int:
                         help="only the per-channel time of a biaxial record read per plane and as one plane")
     parser.add_argument("--repeat", type=int, default=5, help="timing runs with --throughput (default 5)")
     parser.add_argument("--baseline", metavar="PYTHON",
-                        help="with --planes: also time the same records with the stcs_ident of this Python")
+                        help="with --planes or --throughput: also time the same records with the stcs_ident of "
+                             "this Python")
+    parser.add_argument("--rounds", type=int, default=2,
+                        help="with --throughput --baseline: rounds of --repeat runs of each code, in turns (default 2)")
+    parser.add_argument("--time-peaks", metavar="PICKLE", help=argparse.SUPPRESS)  # the baseline's side of it
     args = parser.parse_args(argv)
+    if args.time_peaks:
+        time_peaks(args.time_peaks, max(1, args.repeat))
+        return 0
     if args.planes:
         print_header()
         print_planes_throughput(planes_throughput(max(1, args.repeat), baseline=args.baseline))
         return 0
     print_header()
     if args.throughput:
-        print_throughput(throughput(quick=False, with_fdd=False, repeat=max(1, args.repeat)))
+        print_throughput(throughput(quick=False, with_fdd=False, repeat=max(1, args.repeat), baseline=args.baseline,
+                                    rounds=max(1, args.rounds)))
         return 0
     try:
         import pyoma2

@@ -10,10 +10,17 @@ memory against the bound of the reliability issue: twice the record's
 float64 size plus a fixed overhead (the interpreter and its libraries,
 measured as the peak of the same command on a record of 1000 samples).
 
+With ``--baseline PYTHON`` (an interpreter with another stcs_ident installed,
+the code before a change) the same command runs on the same record with that
+installation too, in turns with this one (``--rounds`` each, default 1), and the
+script prints both times and peaks, their ratios, and whether the two JSON
+outputs hold the same modes.
+
 Run from the repository root::
 
     python benchmarks/spectra_memory.py                      # the 50 × 2,000,000 record
     python benchmarks/spectra_memory.py --samples 200000     # a tenth of it, quicker
+    python benchmarks/spectra_memory.py --baseline /tmp/venv-base/bin/python --rounds 2
 """
 
 from __future__ import annotations
@@ -79,14 +86,18 @@ def campaign(directory: Path, n_samples: int, n_channels: int, rate: float) -> P
     return directory
 
 
-def run_spectra(directory: Path) -> tuple[int, float, float, str]:
-    """Exit status, wall time (s), peak resident memory (MB) and standard error of ``stcs-ident spectra``,
-    run in a child process (its peak alone, from wait4)."""
-    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
-               "spectra", str(directory), "--test", "T2", "--json", str(directory.parent / f"{directory.name}.json")]
+def run_spectra(directory: Path, python: str = sys.executable,
+                output: Path | None = None) -> tuple[int, float, float, str]:
+    """Exit status, wall time (s), peak resident memory (MB) and standard error of ``stcs-ident spectra`` run
+    by ``python`` in a child process (its peak alone, from wait4); its JSON output in ``output`` (default
+    beside the campaign)."""
+    output = directory.parent / f"{directory.name}.json" if output is None else output
+    command = [python, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
+               "spectra", str(directory), "--test", "T2", "--json", str(output)]
     with tempfile.TemporaryFile("w+") as err:
         started = time.perf_counter()
-        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err, text=True)
+        # Not run from the checkout (its source tree would shadow the baseline's installed package).
+        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err, text=True, cwd=directory.parent)
         _, status, usage = os.wait4(child.pid, 0)
         elapsed = time.perf_counter() - started
         err.seek(0)
@@ -98,6 +109,8 @@ def main(argv=None) -> int:
     parser.add_argument("--samples", type=int, default=2_000_000)
     parser.add_argument("--channels", type=int, default=50)
     parser.add_argument("--rate", type=float, default=200.0, help="sampling rate, Hz (default 200)")
+    parser.add_argument("--baseline", metavar="PYTHON", help="also run the command with this Python's stcs_ident")
+    parser.add_argument("--rounds", type=int, default=1, help="with --baseline: runs of each, in turns (default 1)")
     args = parser.parse_args(argv)
     print_header()
     with tempfile.TemporaryDirectory() as tmp:
@@ -108,6 +121,8 @@ def main(argv=None) -> int:
               f"{size / 1e6:.0f} MB on disk, written in {time.perf_counter() - started:.0f} s", flush=True)
         _, _, overhead, _ = run_spectra(campaign(Path(tmp) / "small", 4096, args.channels, args.rate))
         code, elapsed, peak, err = run_spectra(big)
+        if args.baseline:
+            compare_baseline(big, args.baseline, max(1, args.rounds), (code, elapsed, peak))
     float64 = args.samples * args.channels * 8 / 2**20
     bound = 2 * float64 + overhead
     print(f"fixed overhead (the same command on 4096 samples): {overhead:.0f} MB")
@@ -117,6 +132,48 @@ def main(argv=None) -> int:
     if code != 0:
         print(f"exit status {code}:", *err.strip().splitlines()[-3:], sep="\n  ")
     return 0 if peak <= bound and code == 0 else 1
+
+
+def compare_baseline(big: Path, baseline: str, rounds: int, first: tuple[int, float, float]) -> None:
+    """This code's and the ``baseline`` Python's command on the same record, in turns (``first``: this code's
+    run already made); times, peaks, their ratios and whether both report the same modes."""
+    import json
+    import statistics
+
+    ours, theirs = [first], []
+    out = {"this": big.parent / f"{big.name}.json", "baseline": big.parent / "baseline.json"}
+    for k in range(rounds):
+        theirs.append(run_spectra(big, baseline, out["baseline"])[:3])
+        if k + 1 < rounds:
+            ours.append(run_spectra(big)[:3])
+    load = os.getloadavg()[0]
+    print(f"this code and the baseline ({baseline}), {rounds} run{'s' if rounds > 1 else ''} each in turns, "
+          f"load average {load:.2f} at the end:")
+    for label, runs in (("this code", ours), ("baseline", theirs)):
+        times, peaks = [r[1] for r in runs], [r[2] for r in runs]
+        failed = [r[0] for r in runs if r[0] != 0]
+        print(f"  {label:9}: {', '.join(f'{t:.1f}' for t in times)} s (median {statistics.median(times):.1f}), "
+              f"peak {', '.join(f'{p:.0f}' for p in peaks)} MB" + (f"; exit status {failed}" if failed else ""))
+    ratio_t = statistics.median(r[1] for r in ours) / statistics.median(r[1] for r in theirs)
+    ratio_m = max(r[2] for r in ours) / max(r[2] for r in theirs)
+    print(f"  this code / baseline: time {ratio_t:.2f} (medians), peak memory {ratio_m:.2f} (largest)")
+    try:
+        mine, before = (json.loads(out[key].read_text(encoding="utf-8"))["tests"] for key in ("this", "baseline"))
+    except (OSError, ValueError, KeyError) as err:
+        print(f"  outputs not compared: {err}")
+        return
+    print(f"  modes: {modes_compared(mine, before)}")
+
+
+def modes_compared(mine: list, before: list) -> str:
+    """The two JSON outputs' tests' modes: the same count and numbers, and the largest |Δf| / 1σ."""
+    worst, count = 0.0, 0
+    for a, b in zip(mine, before):
+        if a.get("modes") != b.get("modes") or len(a["frequencies"]) != len(b["frequencies"]):
+            return f"test {a.get('name')}: modes {a.get('modes')} against the baseline's {b.get('modes')}"
+        for f, u, g in zip(a["frequencies"], a["uncertainty"], b["frequencies"]):
+            worst, count = max(worst, abs(f - g) / u), count + 1
+    return f"the same {count} numbered modes, frequencies within {worst:.1e} of their 1σ"
 
 
 if __name__ == "__main__":

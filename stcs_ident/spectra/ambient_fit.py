@@ -61,7 +61,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .decay_fit import pole_statistics
+from .decay_fit import one_blas_thread, pole_statistics
 from .options import FitOptions
 from .profile import frequency_spread
 from .whittle import (
@@ -235,6 +235,7 @@ def _serial_product(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
     return out
 
 
+@one_blas_thread
 def mode_shape(dft_white: np.ndarray) -> np.ndarray:
     """First eigenvector of Σ_k X_k X_k^H (unit norm, largest entry real positive)."""
     m = dft_white.T @ dft_white.conj()
@@ -244,6 +245,7 @@ def mode_shape(dft_white: np.ndarray) -> np.ndarray:
     return u * np.exp(-1j * np.angle(u[k]))
 
 
+@one_blas_thread
 def fit_ambient(
     dft: np.ndarray,
     n_samples: int,

@@ -43,7 +43,10 @@ Reported frequency
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import wraps
 
 import numpy as np
 from scipy import stats
@@ -52,9 +55,67 @@ from .decay_covariance import forced_response_covariance
 from .options import FitOptions
 from .wander import between_events_addition
 
-__all__ = ["DecayFit", "EventSpectrum", "event_spectra", "fit_decay", "pole_statistics"]
+__all__ = ["DecayFit", "EventSpectrum", "event_spectra", "fit_decay", "one_blas_thread", "pole_statistics"]
 
 # The iterations, the start's ζ grid and the events' agreement test are :class:`.options.FitOptions`.
+
+
+
+class _OneBlasThread:
+    """BLAS limited to one thread while any decorated function runs (:func:`one_blas_thread`).
+
+    The limit is the process's (OpenBLAS keeps one thread count), so it is counted: set by the first call
+    to enter, restored by the last to leave, whichever Python threads they run in. The controller is
+    made at the first call, when numpy's and scipy's BLAS are loaded (about 1 ms; each limit then about
+    7 µs).
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._depth = 0
+        self._controller = None
+        self._limiter = None
+
+    def __enter__(self) -> None:
+        with self._lock:
+            if self._depth == 0:
+                if self._controller is None:
+                    from threadpoolctl import ThreadpoolController
+
+                    self._controller = ThreadpoolController()
+                self._limiter = self._controller.limit(limits=1, user_api="blas")
+            self._depth += 1
+
+    def __exit__(self, *exc) -> None:
+        with self._lock:
+            self._depth -= 1
+            if self._depth == 0:
+                self._limiter.restore_original_limits()
+                self._limiter = None
+
+
+_ONE_BLAS_THREAD = _OneBlasThread()
+
+
+def one_blas_thread(function: Callable) -> Callable:
+    """Run `function` with BLAS on one thread.
+
+    A band's fit (:func:`fit_decay`, :func:`.ambient_fit.fit_ambient`) is hundreds of small products and
+    solves (bins × a few parameters, channels × channels). OpenBLAS splits the larger of them over its
+    threads (a matrix product from 65536 multiply-adds, a matrix-vector product from 9216 elements), where
+    splitting gains nothing, and on a busy machine each such call waits for a core. Measured on two cores
+    at load 3: the 16-channel, 10-minute ambient record of benchmarks/spectra.py --throughput spent 1.7 s
+    of its 66 Whittle fits in the mode shape's 16 × 16 products alone (2 ms on one thread), find_peaks
+    3.4–4.2 s instead of 0.7; the same record with ten blows (66 decay fits), at load 4–6, 10–15 s instead
+    of 4–5.5.
+    """
+
+    @wraps(function)
+    def on_one_thread(*args, **kwargs):
+        with _ONE_BLAS_THREAD:
+            return function(*args, **kwargs)
+
+    return on_one_thread
 
 
 @dataclass(frozen=True)
@@ -268,6 +329,7 @@ def _initial_decay_rate(f0, bands, dt, weights, sigma_limits, damping_grid) -> f
     return best
 
 
+@one_blas_thread
 def fit_decay(
     spectra: list[EventSpectrum],
     sampling_rate: float,

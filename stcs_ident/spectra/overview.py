@@ -225,26 +225,45 @@ def welch_length(n_samples: int, options: OverviewOptions | None = None) -> int:
 #: Largest block of segment DFTs (all channels, a band of frequencies) held at once, bytes: with the
 #: record itself, what bounds the memory of the ambient overview (:func:`ambient_overview`).
 BLOCK_BYTES = 64 * 2**20
+#: Rows of a segment transposed at a time into the channels-first buffer of :func:`_segment_dfts` (bytes of
+#: the buffer they fill: the rows read stay in cache while their columns are written).
+TRANSPOSE_BYTES = 2**18
 
 
-def _segment_dfts(x: np.ndarray, nperseg: int, window: np.ndarray, budget: int):
-    """``(segment k, first channel, DFTs (n_freq, g))`` of the Hann-windowed, mean-removed segments (50 %
-    overlap), a segment and a group of channels at a time: rows read in order from the row-major record,
-    each step's arrays within ``budget`` bytes."""
+def _segment_dfts(x: np.ndarray, nperseg: int, window: np.ndarray, budget: int, halves: np.ndarray | None = None):
+    """``(segment k, first channel, DFTs (g, n_freq))`` of the Hann-windowed, mean-removed segments (50 %
+    overlap), a segment and a group of g channels at a time, channels first: rows read in order from the
+    row-major record, each step's arrays within ``budget`` bytes. ``halves``: :func:`_half_sums` of ``x``
+    (computed here if not given).
+
+    Each group is transposed into a channels-first buffer, a few rows at a time, so that every DFT runs on
+    contiguous samples: an rfft along the rows of a (g, nperseg) array took half the time of one down the
+    columns of the (nperseg, g) segment (measured, 2**18 samples × 15 channels: 18 against 33 ms), and
+    the strided subtraction of the mean as long again.
+    """
     step = nperseg // 2
     n_segments = _n_segments(x.shape[0], nperseg)
     g = int(np.clip(budget // max(1, 24 * nperseg), 1, x.shape[1]))
-    # Column sums of each half-segment, once: a segment's mean is that of its two halves.
-    halves = np.array([x[j * step:(j + 1) * step].sum(axis=0) for j in range(n_segments + 1)])
-    buffer = np.empty((nperseg, g))
+    if halves is None and 2 * step == nperseg:
+        halves = _half_sums(x, step, n_segments)
+    buffer = np.empty((g, nperseg))
+    rows = max(1, TRANSPOSE_BYTES // (8 * g))
     for k in range(n_segments):
+        segment = x[k * step:k * step + nperseg]
         mean = (halves[k] + halves[k + 1]) / nperseg if 2 * step == nperseg else None
         for c0 in range(0, x.shape[1], g):
-            segment = x[k * step:k * step + nperseg, c0:c0 + g]
-            out = buffer[:, :segment.shape[1]]
-            np.subtract(segment, segment.mean(axis=0) if mean is None else mean[c0:c0 + g], out=out)
-            out *= window[:, None]
-            yield k, c0, rfft(out, axis=0, workers=-1)
+            columns = segment[:, c0:c0 + g]
+            out = buffer[:columns.shape[1]]
+            centre = (columns.mean(axis=0) if mean is None else mean[c0:c0 + g])[:, None]
+            for r in range(0, nperseg, rows):
+                np.subtract(columns[r:r + rows].T, centre, out=out[:, r:r + rows])
+            out *= window
+            yield k, c0, rfft(out, axis=1, workers=-1)
+
+
+def _half_sums(x: np.ndarray, step: int, n_segments: int) -> np.ndarray:
+    """Column sums of each half-segment (``step`` rows), once: a segment's mean is that of its two halves."""
+    return np.array([x[j * step:(j + 1) * step].sum(axis=0) for j in range(n_segments + 1)])
 
 
 def _n_segments(n_samples: int, nperseg: int) -> int:
@@ -264,8 +283,9 @@ def ambient_overview(x: np.ndarray, sampling_rate: float, *, options: OverviewOp
 
     Memory: the spectra a Welch segment at a time, and the cross-spectral
     sums band by band of frequency (each band's DFTs recomputed: a few
-    passes over a large record), so that beside the record about half
-    its size is held at most (or BLOCK_BYTES).
+    passes over a large record; the first band's are kept from the pass of
+    the spectra), so that beside the record about half its size is held at
+    most (or BLOCK_BYTES).
 
     `options`, `floor_options`: Welch segments and floors (default: the
     calibrated values).
@@ -275,53 +295,76 @@ def ambient_overview(x: np.ndarray, sampling_rate: float, *, options: OverviewOp
     window = signal.windows.hann(nperseg, sym=False)
     window_power = float(np.sum(window**2))
     budget = max(BLOCK_BYTES, x.nbytes // 8)
-    power = np.zeros((nperseg // 2 + 1, x.shape[1]))
-    for _, c0, dft in _segment_dfts(x, nperseg, window, budget):
-        power[:, c0:c0 + dft.shape[1]] += np.abs(dft) ** 2
-    psd = _one_sided(power / (n_segments * window_power * sampling_rate))
+    halves = _half_sums(x, nperseg // 2, n_segments) if nperseg % 2 == 0 else None
+    n_freq = nperseg // 2 + 1
+    power = np.zeros((x.shape[1], n_freq))  # channels first, as the DFTs come
+    first = np.empty((min(n_freq, _band_width(budget, n_segments, x.shape[1])), n_segments, x.shape[1]),
+                     dtype=np.complex64)  # the first band of the cross-spectral sums, not yet whitened
+    for k, c0, dft in _segment_dfts(x, nperseg, window, budget, halves):
+        power[c0:c0 + dft.shape[0]] += np.abs(dft) ** 2
+        first[:, k, c0:c0 + dft.shape[0]] = dft[:, :first.shape[0]].T
+    psd = _one_sided(np.ascontiguousarray(power.T) / (n_segments * window_power * sampling_rate))
+    del power
     frequency = np.arange(psd.shape[0]) * sampling_rate / nperseg
     # Equivalent degrees of freedom of Welch's average (Hann, 50 % overlap: correlation 0.167 between segments).
     rho2 = 0.167**2 if n_segments > 1 else 0.0
     dof = 2.0 * n_segments / (1.0 + 2.0 * rho2 * (1.0 - 1.0 / n_segments))
     floor = noise_floor(psd, dof, cell=2, options=floor_options)
-    trace, frobenius = _whitened_sums(x, nperseg, window, floor, window_power * sampling_rate / 2.0, budget)
+    scale = 1.0 / np.sqrt(floor * (window_power * sampling_rate / 2.0))  # E|X|² of noise in a segment DFT
+    trace, frobenius = np.empty(n_freq), np.empty(n_freq)
+    first *= scale[:first.shape[0], None, :]
+    _band_sums(first, 0, trace, frobenius)
+    start = first.shape[0]
+    del first
+    _whitened_sums(x, nperseg, window, scale, budget, halves, trace, frobenius, start)
     combined_dof = _coherent_dof(trace, frobenius, dof, n_channels=x.shape[1])
     channel_dof = np.full(frequency.shape, dof)
     return _overview(frequency, psd, floor, dof, combined_dof, channel_dof, cell=2, random_ripple=True)
 
 
-def _whitened_sums(x: np.ndarray, nperseg: int, window: np.ndarray, floor: np.ndarray, noise_scale: float,
-                   budget: int) -> tuple[np.ndarray, np.ndarray]:
-    """tr S and ‖S‖²_F per bin, S the floor-whitened cross-spectral matrix Σ_k w_k w_kᴴ / K.
+def _band_width(budget: int, n_segments: int, n_channels: int) -> int:
+    """Bins per band of :func:`_whitened_sums`: the segment DFTs of all channels (complex64) in twice ``budget``."""
+    return max(1, 2 * budget // (8 * n_segments * n_channels))
+
+
+def _whitened_sums(x: np.ndarray, nperseg: int, window: np.ndarray, scale: np.ndarray, budget: int,
+                   halves: np.ndarray | None, trace: np.ndarray, frobenius: np.ndarray, start: int = 0) -> None:
+    """tr S and ‖S‖²_F of the bins from ``start`` on, into ``trace`` and ``frobenius``; S the floor-whitened
+    cross-spectral matrix Σ_k w_k w_kᴴ / K, ``scale`` (n_freq, C) the whitening of each bin and channel.
 
     Over bands of frequency whose segment DFTs of all channels (complex64) fit in twice ``budget`` bytes:
-    per band, the DFTs are recomputed and the band kept. ‖S‖²_F from the C × C matrix or, when the
-    segments are fewer than the channels, from the K × K Gram matrix of the segments (the same norm).
+    per band, the DFTs are recomputed and the band kept (:func:`ambient_overview` keeps the first band's
+    from the pass of the spectra).
     """
-    n_freq = floor.shape[0]
-    n_channels = x.shape[1]
+    n_freq, n_channels = scale.shape
     n_segments = _n_segments(x.shape[0], nperseg)
-    scale = 1.0 / np.sqrt(floor * noise_scale)  # E|X|² of noise in a segment DFT
-    trace = np.empty(n_freq)
-    frobenius = np.empty(n_freq)
-    width = max(1, 2 * budget // (8 * n_segments * n_channels))
-    for lo in range(0, n_freq, width):
+    scale_t = np.ascontiguousarray(scale.T)  # channels first, as the DFTs come
+    width = _band_width(budget, n_segments, n_channels)
+    for lo in range(start, n_freq, width):
         hi = min(n_freq, lo + width)
         band = np.empty((hi - lo, n_segments, n_channels), dtype=np.complex64)  # (f, K, C)
-        for k, c0, dft in _segment_dfts(x, nperseg, window, budget):
-            c1 = c0 + dft.shape[1]
-            band[:, k, c0:c1] = dft[lo:hi] * scale[lo:hi, c0:c1]
-        for a in range(0, hi - lo, 4096):  # the products in sub-bands: bounded temporaries
-            w = band[a:a + 4096]
-            if n_channels <= n_segments:
-                product = w.conj().transpose(0, 2, 1) @ w  # (f, C, C) = K S
-            else:
-                product = w @ w.conj().transpose(0, 2, 1)  # (f, K, K): the same Frobenius norm
-            rows = slice(lo + a, lo + a + w.shape[0])
-            trace[rows] = np.sum(w.real.astype(float) ** 2 + w.imag.astype(float) ** 2, axis=(1, 2)) / n_segments
-            frobenius[rows] = np.sum(product.real.astype(float) ** 2 + product.imag.astype(float) ** 2,
-                                     axis=(1, 2)) / n_segments**2
-    return trace, frobenius
+        for k, c0, dft in _segment_dfts(x, nperseg, window, budget, halves):
+            c1 = c0 + dft.shape[0]
+            band[:, k, c0:c1] = (dft[:, lo:hi] * scale_t[c0:c1, lo:hi]).T
+        _band_sums(band, lo, trace, frobenius)
+        del band
+
+
+def _band_sums(band: np.ndarray, lo: int, trace: np.ndarray, frobenius: np.ndarray) -> None:
+    """tr S and ‖S‖²_F of the whitened segment DFTs ``band`` (f, K, C) of the bins from ``lo`` on: ‖S‖²_F from
+    the C × C matrix or, when the segments are fewer than the channels, from the K × K Gram matrix of the
+    segments (the same norm)."""
+    _, n_segments, n_channels = band.shape
+    for a in range(0, band.shape[0], 4096):  # the products in sub-bands: bounded temporaries
+        w = band[a:a + 4096]
+        if n_channels <= n_segments:
+            product = w.conj().transpose(0, 2, 1) @ w  # (f, C, C) = K S
+        else:
+            product = w @ w.conj().transpose(0, 2, 1)  # (f, K, K): the same Frobenius norm
+        rows = slice(lo + a, lo + a + w.shape[0])
+        trace[rows] = np.sum(w.real.astype(float) ** 2 + w.imag.astype(float) ** 2, axis=(1, 2)) / n_segments
+        frobenius[rows] = np.sum(product.real.astype(float) ** 2 + product.imag.astype(float) ** 2,
+                                 axis=(1, 2)) / n_segments**2
 
 
 def _coherent_dof(trace: np.ndarray, frobenius: np.ndarray, dof: float, n_channels: int) -> np.ndarray:

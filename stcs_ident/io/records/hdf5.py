@@ -240,13 +240,37 @@ def _read_dataset(h5: h5py.File, name: str, file: str) -> np.ndarray:
                              "float64) are read", field=name, file=file)
         if h5py.check_string_dtype(node.dtype) is not None:
             return np.asarray(node.asstr("utf-8")[()], dtype=object)
-        if node.dtype.kind == "f" and node.ndim > 0:  # straight into float64: no second copy of a large record
+        if node.dtype.kind == "f" and node.ndim > 0:  # into float64: no second copy of a large record
             out = np.empty(node.shape, dtype=np.float64)
             if node.size:
-                node.read_direct(out)
+                _read_float64(node, out)
             return out
         return np.asarray(node[()])
     except InputError:
         raise
     except (OSError, RuntimeError, KeyError, ValueError, TypeError) as err:  # UnicodeDecodeError is a ValueError
         raise InputError(f"cannot read the dataset: {one_line(err)}", field=name, file=file) from None
+
+
+#: Bytes of a block of rows of a float32 dataset read before conversion (:func:`_read_float64`).
+READ_BLOCK_BYTES = 16 * 2**20
+
+
+def _read_float64(node: h5py.Dataset, out: np.ndarray) -> None:
+    """The float dataset ``node`` into the float64 array ``out`` of its shape.
+
+    A float64 dataset is read straight in; another (float32, as loggers write) a block of rows at a time in
+    its own type, converted by numpy: HDF5's own conversion took 1.7 s for a record of 50 channels ×
+    2,000,000 float32 samples (400 MB) that the blocks read and convert in 0.13 s (from the page cache; the
+    same values, float32 to float64 being exact).
+    """
+    if node.dtype == out.dtype or node.ndim != 2:
+        node.read_direct(out)
+        return
+    rows = max(1, READ_BLOCK_BYTES // max(1, node.dtype.itemsize * node.shape[1]))
+    buffer = np.empty((min(rows, node.shape[0]), node.shape[1]), dtype=node.dtype)
+    for lo in range(0, node.shape[0], rows):
+        hi = min(node.shape[0], lo + rows)
+        block = buffer[:hi - lo]
+        node.read_direct(block, np.s_[lo:hi], np.s_[0:hi - lo])
+        out[lo:hi] = block

@@ -76,8 +76,8 @@ def _column_statistics(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     total = np.zeros(x.shape[1])
     for lo in range(0, n, BLOCK_ROWS):
         block = x[lo:lo + BLOCK_ROWS]
-        low = np.minimum(low, block.min(axis=0))
-        high = np.maximum(high, block.max(axis=0))
+        low = np.minimum(low, _column_reduce(np.minimum, block))
+        high = np.maximum(high, _column_reduce(np.maximum, block))
         total += block.sum(axis=0)
     mean = total / n
     squares = np.zeros(x.shape[1])
@@ -89,6 +89,17 @@ def _column_statistics(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
         at_low += (block == low).sum(axis=0)
         at_high += (block == high).sum(axis=0)
     return low, high, np.sqrt(squares / n), np.maximum(at_low, at_high)
+
+
+def _column_reduce(ufunc: np.ufunc, block: np.ndarray) -> np.ndarray:
+    """``ufunc.reduce(block, axis=0)`` for a minimum or maximum (exact in any order): of a row-major block, its
+    rows folded in 16s into rows 16 times as long first (np.min along the rows of a 65536 × 50 block took
+    10.7 ms, 3.0 ms so: numpy's loop along short rows is slow)."""
+    fold = next((k for k in (16, 8, 4, 2) if block.shape[0] % k == 0), 1)
+    if fold == 1 or not block.flags.c_contiguous:
+        return ufunc.reduce(block, axis=0)
+    wide = ufunc.reduce(block.reshape(-1, fold * block.shape[1]), axis=0)
+    return ufunc.reduce(wide.reshape(fold, block.shape[1]), axis=0)
 
 
 def _clip_reason(signal: np.ndarray, low: float, high: float) -> str | None:
