@@ -87,10 +87,10 @@ def campaign(directory: Path, n_samples: int, n_channels: int, rate: float) -> P
 
 
 def run_spectra(directory: Path, python: str = sys.executable,
-                output: Path | None = None) -> tuple[int, float, float, str]:
-    """Exit status, wall time (s), peak resident memory (MB) and standard error of ``stcs-ident spectra`` run
-    by ``python`` in a child process (its peak alone, from wait4); its JSON output in ``output`` (default
-    beside the campaign)."""
+                output: Path | None = None) -> tuple[int, float, float, str, float]:
+    """Exit status, wall time (s), peak resident memory (MB), standard error and CPU time (s, user + system:
+    what a busy machine inflates least) of ``stcs-ident spectra`` run by ``python`` in a child process (its
+    peak and CPU alone, from wait4); its JSON output in ``output`` (default beside the campaign)."""
     output = directory.parent / f"{directory.name}.json" if output is None else output
     command = [python, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
                "spectra", str(directory), "--test", "T2", "--json", str(output)]
@@ -101,7 +101,8 @@ def run_spectra(directory: Path, python: str = sys.executable,
         _, status, usage = os.wait4(child.pid, 0)
         elapsed = time.perf_counter() - started
         err.seek(0)
-        return os.waitstatus_to_exitcode(status), elapsed, usage.ru_maxrss / 1024, err.read()
+        return (os.waitstatus_to_exitcode(status), elapsed, usage.ru_maxrss / 1024, err.read(),
+                usage.ru_utime + usage.ru_stime)
 
 
 def main(argv=None) -> int:
@@ -119,14 +120,14 @@ def main(argv=None) -> int:
         size = (big / "records" / "T2.h5").stat().st_size
         print(f"record: {args.channels} channels x {args.samples} samples float32 at {args.rate:g} Hz, "
               f"{size / 1e6:.0f} MB on disk, written in {time.perf_counter() - started:.0f} s", flush=True)
-        _, _, overhead, _ = run_spectra(campaign(Path(tmp) / "small", 4096, args.channels, args.rate))
-        code, elapsed, peak, err = run_spectra(big)
+        overhead = run_spectra(campaign(Path(tmp) / "small", 4096, args.channels, args.rate))[2]
+        code, elapsed, peak, err, cpu = run_spectra(big)
         if args.baseline:
-            compare_baseline(big, args.baseline, max(1, args.rounds), (code, elapsed, peak))
+            compare_baseline(big, args.baseline, max(1, args.rounds), (code, elapsed, peak, cpu))
     float64 = args.samples * args.channels * 8 / 2**20
     bound = 2 * float64 + overhead
     print(f"fixed overhead (the same command on 4096 samples): {overhead:.0f} MB")
-    print(f"spectra on the record: {elapsed:.1f} s, peak resident memory {peak:.0f} MB; bound 2 x {float64:.0f} MB "
+    print(f"spectra on the record: {elapsed:.1f} s ({cpu:.1f} s of CPU), peak resident memory {peak:.0f} MB; bound 2 x {float64:.0f} MB "
           f"(float64 size) + {overhead:.0f} MB = {bound:.0f} MB: {'within' if peak <= bound else 'EXCEEDED'} "
           f"({peak / float64:.2f} x the float64 size)")
     if code != 0:
@@ -134,7 +135,7 @@ def main(argv=None) -> int:
     return 0 if peak <= bound and code == 0 else 1
 
 
-def compare_baseline(big: Path, baseline: str, rounds: int, first: tuple[int, float, float]) -> None:
+def compare_baseline(big: Path, baseline: str, rounds: int, first: tuple[int, float, float, float]) -> None:
     """This code's and the ``baseline`` Python's command on the same record, in turns (``first``: this code's
     run already made); times, peaks, their ratios and whether both report the same modes."""
     import json
@@ -143,26 +144,35 @@ def compare_baseline(big: Path, baseline: str, rounds: int, first: tuple[int, fl
     ours, theirs = [first], []
     out = {"this": big.parent / f"{big.name}.json", "baseline": big.parent / "baseline.json"}
     for k in range(rounds):
-        theirs.append(run_spectra(big, baseline, out["baseline"])[:3])
+        theirs.append(_kept(run_spectra(big, baseline, out["baseline"])))
         if k + 1 < rounds:
-            ours.append(run_spectra(big)[:3])
+            ours.append(_kept(run_spectra(big)))
     load = os.getloadavg()[0]
     print(f"this code and the baseline ({baseline}), {rounds} run{'s' if rounds > 1 else ''} each in turns, "
           f"load average {load:.2f} at the end:")
     for label, runs in (("this code", ours), ("baseline", theirs)):
-        times, peaks = [r[1] for r in runs], [r[2] for r in runs]
+        times, peaks, cpus = [r[1] for r in runs], [r[2] for r in runs], [r[3] for r in runs]
         failed = [r[0] for r in runs if r[0] != 0]
         print(f"  {label:9}: {', '.join(f'{t:.1f}' for t in times)} s (median {statistics.median(times):.1f}), "
-              f"peak {', '.join(f'{p:.0f}' for p in peaks)} MB" + (f"; exit status {failed}" if failed else ""))
+              f"CPU {', '.join(f'{c:.1f}' for c in cpus)} s, peak {', '.join(f'{p:.0f}' for p in peaks)} MB"
+              + (f"; exit status {failed}" if failed else ""))
     ratio_t = statistics.median(r[1] for r in ours) / statistics.median(r[1] for r in theirs)
+    ratio_c = statistics.median(r[3] for r in ours) / statistics.median(r[3] for r in theirs)
     ratio_m = max(r[2] for r in ours) / max(r[2] for r in theirs)
-    print(f"  this code / baseline: time {ratio_t:.2f} (medians), peak memory {ratio_m:.2f} (largest)")
+    print(f"  this code / baseline: time {ratio_t:.2f}, CPU time {ratio_c:.2f} (medians), peak memory "
+          f"{ratio_m:.2f} (largest)")
     try:
         mine, before = (json.loads(out[key].read_text(encoding="utf-8"))["tests"] for key in ("this", "baseline"))
     except (OSError, ValueError, KeyError) as err:
         print(f"  outputs not compared: {err}")
         return
     print(f"  modes: {modes_compared(mine, before)}")
+
+
+def _kept(run: tuple) -> tuple[int, float, float, float]:
+    """Exit status, wall time, peak and CPU time of a :func:`run_spectra` run."""
+    code, elapsed, peak, _, cpu = run
+    return code, elapsed, peak, cpu
 
 
 def modes_compared(mine: list, before: list) -> str:
