@@ -12,7 +12,8 @@ tension,EI`` on the modes it numbers surely. Scored against the simulator's trut
   class, modes 1-4 and 5 and up;
 - numbered modes off by more than max(3σ, 0.5 %) of their true frequency, and how many of those were sure
   (not doubtful);
-- the tension's z, and the fits that failed.
+- the tension's z, and the fits that failed;
+- per mode with a damping ratio, z of ζ against the simulator's modal damping.
 
     python benchmarks/short_records.py [--cases N] [--seed S] [--workers W] [--kind stay|hanger]
 """
@@ -66,7 +67,7 @@ def run_case(kind: str, duration: float, damping_class: str, seed: int) -> dict:
     zeta = rng.uniform(*DAMPING[damping_class])
     positions = [cable.length * rng.uniform(0.03, 0.06), cable.length * rng.uniform(0.08, 0.12)]
     out = {"kind": kind, "duration": duration, "damping": damping_class, "seed": seed, "modes": [], "tension": None,
-           "why": None}
+           "why": None, "damping_ratios": []}
     t0 = time.perf_counter()
     record, truth = simulate_record_with_truth(cable, (), tension, positions, duration=duration, sampling_rate=m["fs"],
                                                damping=zeta, ambient=Ambient(m["wind"]), snr_db=30.0,
@@ -84,12 +85,14 @@ def run_case(kind: str, duration: float, damping_class: str, seed: int) -> dict:
         out["why"] = f"spectra: {str(err)[:80]}"
         return out
     true_f = np.asarray(truth.frequencies, float)
-    for n, f, s, doubtful, z in zip(spectra.modes, spectra.frequencies, spectra.uncertainty, spectra.doubtful,
-                                    spectra.damping):
+    true_z = np.full(true_f.size, zeta) if truth.damping is None else np.asarray(truth.damping, float)
+    for n, f, s, doubtful, z, zs in zip(spectra.modes, spectra.frequencies, spectra.uncertainty, spectra.doubtful,
+                                        spectra.damping, spectra.damping_sigmas()):
         if n - 1 >= true_f.size:
             continue
         out["modes"].append((int(n), float(f), float(s), float(true_f[n - 1]), bool(doubtful)))
-        out.setdefault("damping_ratios", []).append((int(n), float(z), float(zeta)))
+        if np.isfinite(z) and np.isfinite(zs) and zs > 0:
+            out["damping_ratios"].append((int(n), float(z), float(zs), float(true_z[n - 1])))
     # a sure mode whose 1σ is 5 % of its frequency or more says nothing of the tension (and identify refuses a σ
     # above its frequency): counted, left out, as tension --record does
     out["useless"] = sum(not d and s >= 0.05 * f for _, f, s, _, d in out["modes"])
@@ -132,7 +135,7 @@ def summarise(results: list[dict]) -> None:
                 if r["kind"] == kind and key in (r["duration"], r["damping"], "all"):
                     groups[(kind, key)].append(r)
     print(f"{'group':<24} {'freq 1σ/3σ, modes 1-4':>24} {'modes 5+':>24} {'off (sure)':>12} "
-          f"{'tension 1σ/3σ':>22} {'no tension':>10} {'σ ≥ 5 %':>8}")
+          f"{'tension 1σ/3σ':>22} {'no tension':>10} {'σ ≥ 5 %':>8} {'ζ 1σ/3σ':>22}")
     for key, rs in groups.items():
         low = [(f - t) / s for r in rs for n, f, s, t, _ in r["modes"] if n <= 4]
         high = [(f - t) / s for r in rs for n, f, s, t, _ in r["modes"] if n >= 5]
@@ -141,8 +144,9 @@ def summarise(results: list[dict]) -> None:
         none = sum(r["tension"] is None for r in rs)
         useless = sum(r.get("useless", 0) for r in rs)
         label = f"{key[0]} {key[1]:g} s" if isinstance(key[1], float) else f"{key[0]} {key[1]}"
+        zz = [(z - t) / s for r in rs for _, z, s, t in r["damping_ratios"]]
         print(f"{label:<24} {_shares(low):>24} {_shares(high):>24} {len(off):>5} ({sum(not d for _, d in off)}) "
-              f"{_shares(tz):>22} {none:>10} {useless:>8}")
+              f"{_shares(tz):>22} {none:>10} {useless:>8} {_shares(zz):>22}")
 
 
 def main(argv=None) -> int:

@@ -63,7 +63,7 @@ import numpy as np
 
 from .decay_fit import one_blas_thread, pole_statistics
 from .options import FitOptions
-from .profile import frequency_spread
+from .profile import spreads
 from .whittle import (
     TINY,
     BandProblem,
@@ -345,23 +345,23 @@ def fit_ambient(
 
 
 def widen_to_spread(fit: AmbientFit) -> AmbientFit:
-    """A fit made with ``spread=False``, its frequency's 1σ widened as ``spread=True`` would have (the same pole)."""
+    """A fit made with ``spread=False``, its 1σ widened as ``spread=True`` would have (the same pole)."""
     if fit.band is None:
         return fit
     theta = fit.band[1]
-    _, f_std, _, _ = pole_statistics(theta[0], theta[1], _spread_covariance(*fit.band))
-    return replace(fit, frequency_std=max(fit.frequency_std, f_std), band=None)
+    cov = _spread_covariance(*fit.band)
+    _, f_std, _, zeta_std = pole_statistics(theta[0], theta[1], cov)
+    return replace(fit, frequency_std=max(fit.frequency_std, f_std), damping_std=max(fit.damping_std, zeta_std),
+                   decay_rate_std=max(fit.decay_rate_std, float(np.sqrt(cov[1, 1]))), band=None)
 
 
 def _spread_covariance(problem: BandProblem, theta: np.ndarray, limits, cov: np.ndarray) -> np.ndarray:
-    """The covariance of (f_d, σ) with the frequency's variance widened to the profile likelihood's spread
-    where that is larger (:mod:`.profile`)."""
-    std = float(np.sqrt(cov[0, 0]))
-    reach = max(8.0 * std, 6.0 * theta[1] / (2 * np.pi))
-    spread = frequency_spread(problem, theta, std, reach, limits)
-    if not spread > std:
-        return cov
-    widen = np.array([spread / std, 1.0])
+    """The covariance of (f_d, σ), each variance widened to the profile likelihood's spread where that is
+    larger (:mod:`.profile`); the correlation kept."""
+    std = np.sqrt(np.diag(cov))
+    reach = max(8.0 * std[0], 6.0 * theta[1] / (2 * np.pi))
+    spread = np.array(spreads(problem, theta, float(std[0]), reach, limits))
+    widen = np.maximum(spread / std, 1.0)
     return cov * np.outer(widen, widen)
 
 
