@@ -16,6 +16,7 @@ tension,EI`` on the modes it numbers surely. Scored against the simulator's trut
 - per mode with a damping ratio, z of ζ against the simulator's modal damping.
 
     python benchmarks/short_records.py [--cases N] [--seed S] [--workers W] [--kind stay|hanger]
+        [--durations 30 60 120 600 3600]
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from stcs_ident.simulate.simulate import Ambient, simulate_record_with_truth
 from stcs_ident.spectra.pipeline import analyse_record
 
 DURATIONS = (30.0, 60.0, 120.0)
+LONGER = (600.0, 3600.0)  # --durations: 10 and 60 min, the σ's other end
 DAMPING = {"0.2-0.5 %": (0.002, 0.005), "0.5-1 %": (0.005, 0.01), "1-2 %": (0.01, 0.02)}
 KINDS = ("stay", "hanger")
 
@@ -61,7 +63,7 @@ def run_case(kind: str, duration: float, damping_class: str, seed: int) -> dict:
     import warnings
 
     warnings.simplefilter("ignore")  # numbering and identifiability warnings: what they say is scored here
-    rng = np.random.default_rng([seed, KINDS.index(kind), DURATIONS.index(duration), list(DAMPING).index(damping_class)])
+    rng = np.random.default_rng([seed, KINDS.index(kind), (DURATIONS + LONGER).index(duration), list(DAMPING).index(damping_class)])
     m = draw(kind, rng)
     cable, tension = m["cable"], m["tension"]
     zeta = rng.uniform(*DAMPING[damping_class])
@@ -127,10 +129,10 @@ def _shares(z) -> str:
     return f"{100 * np.mean(z <= 1):.0f} / {100 * np.mean(z <= 3):.0f} % (n {z.size})"
 
 
-def summarise(results: list[dict]) -> None:
+def summarise(results: list[dict], durations=DURATIONS) -> None:
     groups = defaultdict(list)
     for kind in KINDS:
-        for key in (*DURATIONS, *DAMPING, "all"):
+        for key in (*durations, *DAMPING, "all"):
             for r in results:
                 if r["kind"] == kind and key in (r["duration"], r["damping"], "all"):
                     groups[(kind, key)].append(r)
@@ -155,11 +157,13 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=36000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--kind", action="append", choices=KINDS)
+    parser.add_argument("--durations", type=float, nargs="+", choices=DURATIONS + LONGER, default=DURATIONS,
+                        help="record lengths, s (default 30 60 120)")
     parser.add_argument("--pickle", help="write the per-record results here (for a closer look)")
     parser.add_argument("--list-off", action="store_true", help="list the numbered modes off their truth")
     args = parser.parse_args(argv)
     print_header()
-    jobs = [(kind, duration, damping, args.seed + k) for kind in (args.kind or KINDS) for duration in DURATIONS
+    jobs = [(kind, duration, damping, args.seed + k) for kind in (args.kind or KINDS) for duration in args.durations
             for damping in DAMPING for k in range(args.cases)]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
@@ -169,7 +173,7 @@ def main(argv=None) -> int:
 
         Path(args.pickle).write_bytes(pickle.dumps(results))
     print(f"{len(results)} records in {time.perf_counter() - t0:.0f} s")
-    summarise(results)
+    summarise(results, tuple(args.durations))
     if args.list_off:
         for r in results:
             for n, f, s, tf, d in r["modes"]:
