@@ -11,7 +11,7 @@ from stcs_ident.simulate.simulate import Ambient, simulate_record_with_truth
 from stcs_ident.spectra import ambient_fit
 from stcs_ident.spectra.ambient_fit import fit_ambient, widen_to_spread
 from stcs_ident.spectra.peaks import find_peaks
-from stcs_ident.spectra.profile import GAUSSIAN_BINS, frequency_spread
+from stcs_ident.spectra.profile import GAUSSIAN_BINS, spreads
 
 
 def test_the_background_is_a_line_that_stays_above_zero_across_the_band():
@@ -41,14 +41,15 @@ def test_a_60_s_stay_mode_is_not_fitted_onto_a_bin_of_nothing():
     assert abs(z) <= 3.0, f"mode 16: {near[0].frequency:.4f} ± {near[0].uncertainty:.4f} Hz, z = {z:+.1f}"
 
 
-def test_the_spread_is_the_curvature_where_the_likelihood_is_gaussian():
-    """Many records of one mode 40 bins wide (below the Gaussian threshold, so the spread is computed): the
-    spread agrees with the curvature's 1σ on the median (the rms of a Gaussian weight is its σ) within 15 %
-    (the profile's grid over the decay rate, factors 1.6 apart, and its few scoring steps)."""
+def test_a_single_regular_maximum_keeps_the_curvatures_1_sigma():
+    """Records of one mode 13 bins wide (below GAUSSIAN_BINS, so the profile is computed): the likelihood has one
+    maximum, and the frequency's 1σ stays the curvature's (the rms of the profile's weight would widen it by
+    1.04-1.3 on a regular peak, more than the estimator's scatter: spectra/profile.py). At most 2 of 12 records
+    may show a second maximum by chance."""
     rng = np.random.default_rng(5)
     n, dt = 3000, 0.02
     f0, zeta = 14.0, 0.0075  # 2σ/2π = 2ζf = 0.21 Hz = 13 bins: fewer than GAUSSIAN_BINS
-    ratios = []
+    widened = 0
     for _ in range(12):
         w = 2 * np.pi * f0
         r = np.exp(-zeta * w * dt)
@@ -60,7 +61,9 @@ def test_the_spread_is_the_curvature_where_the_likelihood_is_gaussian():
         problem, theta, limits, cov = fit.band
         assert theta[1] * n * dt / np.pi < GAUSSIAN_BINS
         std = float(np.sqrt(cov[0, 0]))
-        ratios.append(frequency_spread(problem, theta, std, max(8 * std, 6 * theta[1] / (2 * np.pi)), limits) / std)
-        assert widen_to_spread(fit).frequency_std >= fit.frequency_std
-    assert 0.85 <= np.median(ratios) <= 1.15, np.round(ratios, 2)
-
+        f_spread, s_spread = spreads(problem, theta, std, max(8 * std, 6 * theta[1] / (2 * np.pi)), limits)
+        widened += f_spread > std
+        assert s_spread > 0  # the decay rate's spread is always computed
+        again = widen_to_spread(fit)
+        assert again.frequency_std >= fit.frequency_std and again.damping_std >= fit.damping_std
+    assert widened <= 2

@@ -200,7 +200,9 @@ def test_spectra_find_the_complex_modes_in_the_records(case):
     """find_peaks on a record of the stay with its damper recovers each complex mode's |s|/2π and
     −Re s/|s| within 4σ (16 comparisons: with an honest 1σ all pass but once in 1000 runs; the 1σ of
     ζ is calibrated in tests/test_damping_coverage.py), and resolves the dashpot: the true ζ of modes
-    1–3 stands more than 5σ above the cable's own 0.2 %, which a record without the dashpot would give.
+    1–3 stands more than 4σ above the cable's own 0.2 %, which a record without the dashpot would give (a
+    Gaussian's one-sided tail beyond 4σ is 3e-5; 5σ until the 1σ of a ζ whose peak is a few bins wide became
+    its profile likelihood's spread: on the 30-min record mode 1 is 4.6σ above, its 1σ 1.49e-3 for 1.26e-3).
 
     ambient_field: 30 minutes of wind coloured by a 3 Hz low-pass, a drifting tension (the truth is then the
     time-averaged frequency), 1/f sensor noise, float32 samples.
@@ -220,7 +222,7 @@ def test_spectra_find_the_complex_modes_in_the_records(case):
     assert result.kind == case.split("_")[0]
     z = _scored(result, truth.mean_frequencies, truth.damping)
     assert np.all(np.abs(z[:, :2]) <= 4), z[:, :2]
-    assert np.all(z[:3, 2] - INTRINSIC > 5 * z[:3, 3]), z[:3, 2:]
+    assert np.all(z[:3, 2] - INTRINSIC > 4 * z[:3, 3]), z[:3, 2:]
 
 
 # ---------------------------------------------------------------- the undamped limit and the random load
