@@ -161,6 +161,31 @@ def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_
     assert calls == ["tension"] and "2 dampers (D1, D2)" in row["coefficient_reason"]
 
 
+def test_a_tension_without_a_finite_sigma_is_a_failed_record_not_an_answer(tmp_path, monkeypatch):
+    """A fit that cannot move from its start (the model not evaluated around it) gives the reference tension with
+    an infinite 1σ: that row is failed with its reason, never ``ok`` with the campaign's own tension."""
+    from stcs_ident.track import process
+
+    class Result:
+        def value(self, name):
+            return 4.0e6, math.inf
+
+    class Spectra:
+        modes, mode_planes = (1, 2), ("in", "in")
+        frequencies, uncertainty = np.array([1.1, 2.2]), np.array([1e-3, 1e-3])
+        damping, damping_uncertainty = np.array([0.012, np.nan]), np.array([0.002, np.nan])
+
+    monkeypatch.setattr(process, "identify", lambda *a, **k: Result())
+    monkeypatch.setattr(process, "analyse_record", lambda *a, **k: Spectra())
+    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
+        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
+    bare = CableSpec("stay", str(tmp_path), Campaign("bare", STAY, setups=(Setup("S", ()),),
+                                                     tests=(Test("T", "S", 4.0e6),)), "S", 4.0e6)
+    row = process_record(bare, str(tmp_path / "records" / "r.h5"), "x")
+    assert row["status"] == "failed"
+    assert row["reason"] == "no tension: the fit gave 4e+06 ± inf N"
+
+
 # -- the store, the run, the report --------------------------------------------------------------------------
 
 def test_parts_written_before_the_damper_columns_still_read(tmp_path):

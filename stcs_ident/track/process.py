@@ -32,7 +32,8 @@ one per damper, which one record's damping ratios rarely separate):
 the reason empty.
 
 Whatever goes wrong with one record (unreadable, no start time, no mode
-found, a fit that fails) makes a row with status ``failed`` and the reason;
+found, a fit that fails or gives no finite tension and 1σ) makes a row with
+status ``failed`` and the reason;
 the other records go on.
 """
 
@@ -113,6 +114,9 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
             result = identify(campaign, [test.name], "tension", picked={test.name: spectra}, tolerances=False,
                               check_plausibility=False)
             row["tension"], row["tension_sigma"] = result.value("tension")
+        if not (math.isfinite(row["tension"]) and math.isfinite(row["tension_sigma"]) and row["tension_sigma"] > 0):
+            # the start value with an infinite σ is no answer (the model could not be evaluated around it)
+            raise ComputationError(f"no tension: the fit gave {row['tension']:.6g} ± {row['tension_sigma']:.3g} N")
         row["status"] = "ok"
     except (InputError, ComputationError, FloatingPointError) as err:
         row["reason"] = one_line(str(err))
