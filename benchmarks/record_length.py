@@ -23,7 +23,7 @@ records without a tension and why.
 Run it with the package to measure (``PYTHONPATH=/tmp/base`` measures another source tree; the command-line
 subprocesses inherit it, and the header says which one is imported)::
 
-    python benchmarks/record_length.py --workers 2                        # ~25 min on two shared cores
+    python benchmarks/record_length.py --workers 2                        # ~3 min on two idle cores
     python benchmarks/record_length.py --rows damped-600,bare-60 --keep /tmp/rl
 
 With ``--keep DIR`` the archives and track outputs stay in DIR; an archive already there (with its truth.json)
