@@ -8,10 +8,10 @@ from scipy.signal import lfilter
 
 from stcs_ident.core.model import Cable
 from stcs_ident.simulate.simulate import Ambient, simulate_record_with_truth
-from stcs_ident.spectra import ambient_fit
+from stcs_ident.spectra import ambient_fit, profile
 from stcs_ident.spectra.ambient_fit import fit_ambient, widen_to_spread
 from stcs_ident.spectra.peaks import find_peaks
-from stcs_ident.spectra.profile import GAUSSIAN_BINS, spreads
+from stcs_ident.spectra.profile import DECAY_GAUSSIAN_BINS, GAUSSIAN_BINS, spreads
 
 
 def test_the_background_is_a_line_that_stays_above_zero_across_the_band():
@@ -41,16 +41,11 @@ def test_a_60_s_stay_mode_is_not_fitted_onto_a_bin_of_nothing():
     assert abs(z) <= 3.0, f"mode 16: {near[0].frequency:.4f} ± {near[0].uncertainty:.4f} Hz, z = {z:+.1f}"
 
 
-def test_a_single_regular_maximum_keeps_the_curvatures_1_sigma():
-    """Records of one mode 13 bins wide (below GAUSSIAN_BINS, so the profile is computed): the likelihood has one
-    maximum, and the frequency's 1σ stays the curvature's (the rms of the profile's weight would widen it by
-    1.04-1.3 on a regular peak, more than the estimator's scatter: spectra/profile.py). At most 2 of 12 records
-    may show a second maximum by chance."""
+def _one_mode_bands(zeta: float, records: int = 12, n: int = 3000):
+    """Fits (spread=False) of records of one mode at 14 Hz, n samples at 50 Hz, white noise 5 % beside it."""
     rng = np.random.default_rng(5)
-    n, dt = 3000, 0.02
-    f0, zeta = 14.0, 0.0075  # 2σ/2π = 2ζf = 0.21 Hz = 13 bins: fewer than GAUSSIAN_BINS
-    widened = 0
-    for _ in range(12):
+    dt, f0 = 0.02, 14.0
+    for _ in range(records):
         w = 2 * np.pi * f0
         r = np.exp(-zeta * w * dt)
         x = lfilter([1.0], [1, -2 * r * np.cos(w * dt), r * r], rng.standard_normal(n + 2000))[2000:]
@@ -58,8 +53,20 @@ def test_a_single_regular_maximum_keeps_the_curvatures_1_sigma():
         dft = (np.fft.rfft(x) / np.sqrt(n))[:, None]
         fit = fit_ambient(dft, n, 1 / dt, f0 + 0.02, 1.0, np.ones(1), peak_width=2 * zeta * f0, spread=False)
         assert fit is not None and fit.band is not None
+        yield fit, n * dt
+
+
+def test_a_single_regular_maximum_keeps_the_curvatures_1_sigma():
+    """Records of one mode 13 bins wide (below GAUSSIAN_BINS, so the profile is computed): the likelihood has one
+    maximum, and the frequency's 1σ stays the curvature's (the rms of the profile's weight would widen it by
+    1.04-1.3 on a regular peak, more than the estimator's scatter: spectra/profile.py). At most 2 of 12 records
+    may show a second maximum by chance."""
+    widened = 0
+    n, dt = 3000, 0.02
+    zeta = 0.0075  # 2σ/2π = 2ζf = 0.21 Hz = 13 bins: fewer than DECAY_GAUSSIAN_BINS
+    for fit, _ in _one_mode_bands(zeta):
         problem, theta, limits, cov = fit.band
-        assert theta[1] * n * dt / np.pi < GAUSSIAN_BINS
+        assert theta[1] * n * dt / np.pi < DECAY_GAUSSIAN_BINS
         std = float(np.sqrt(cov[0, 0]))
         f_spread, s_spread = spreads(problem, theta, std, max(8 * std, 6 * theta[1] / (2 * np.pi)), limits)
         widened += f_spread > std
@@ -67,3 +74,23 @@ def test_a_single_regular_maximum_keeps_the_curvatures_1_sigma():
         again = widen_to_spread(fit)
         assert again.frequency_std >= fit.frequency_std and again.damping_std >= fit.damping_std
     assert widened <= 2
+
+
+def test_a_wide_regular_peak_is_screened_and_its_profile_not_computed(monkeypatch):
+    """A mode 25-50 bins wide (ζ 0.75 % on 180 s: 38 bins): the decay rate's spread is its curvature's there, and the frequency's
+    profile is computed only where a screen of SCREEN_DECAYS decay rates is irregular. On these regular peaks
+    the screen is all that is scored (3 decay rates of the 11), and neither 1σ is widened."""
+    scored = []
+    original = profile._values
+
+    def counting(sub, freqs, decays):
+        scored.append(decays.size)
+        return original(sub, freqs, decays)
+
+    monkeypatch.setattr(profile, "_values", counting)
+    for fit, duration in _one_mode_bands(0.0075, records=6, n=9000):
+        problem, theta, limits, cov = fit.band
+        assert DECAY_GAUSSIAN_BINS <= theta[1] * duration / np.pi < GAUSSIAN_BINS
+        std = float(np.sqrt(cov[0, 0]))
+        assert spreads(problem, theta, std, max(8 * std, 6 * theta[1] / (2 * np.pi)), limits) == (0.0, 0.0)
+    assert scored == [profile.SCREEN_DECAYS] * 6

@@ -49,10 +49,10 @@ Uncertainty
     variance widened to the sandwich (misfit-robust) estimate where that
     is larger: in crowded bands of broad resonances the fixed shapes of
     the neighbours are only approximate. On a peak fewer than about 50
-    bins wide the likelihood is not Gaussian in frequency (shoulders,
-    second maxima on clusters of noise bins): the 1σ is then widened to
-    the spread of the profile likelihood where that is larger
-    (:mod:`.profile`).
+    bins wide the likelihood need not be Gaussian (second maxima on
+    clusters of noise bins; below about 25 bins a skewed decay rate): the
+    1σ is then widened to the spread of the profile likelihood where that
+    is larger and, for the frequency, irregular (:mod:`.profile`).
 """
 
 from __future__ import annotations

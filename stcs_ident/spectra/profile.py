@@ -22,8 +22,10 @@ fitted value is the 1σ where it exceeds the curvature's:
   12.6 bins wide: within 1σ 71 / 75 / 69 / 74 % with the curvature,
   87 / 83 / 76 / 75 % with the rms everywhere); and the bridge records of
   the planes' coverage sets went from 72 to 76-80 % within 1σ with it;
-- for the decay rate, always: its likelihood is skewed (a lightly damped
-  mode on a short record may be far more damped than its peak shows).
+- for the decay rate, always on a peak fewer than
+  :data:`DECAY_GAUSSIAN_BINS` wide: its likelihood is skewed (a lightly
+  damped mode on a short record may be far more damped than its peak
+  shows).
 
 Measured (benchmarks/short_records.py --cases 6 --seed 36000, the stays,
 30-120 s, ζ 0.2-2 %): frequencies of mode 5 and up within 1σ / 3σ 61 / 94 %
@@ -52,6 +54,13 @@ LINEAR_ITERATIONS = 6  # Fisher-scoring steps of the linear terms per (f, σ): a
 # likelihood is Gaussian in frequency: the curvature's 1σ is the spread (measured: 600-s records of a mode
 # of 14.9 Hz at ζ 1.5 %, about 270 bins, rms z 0.84 with the curvature alone; 60 s, 27 bins, 2.0).
 GAUSSIAN_BINS = 50.0
+# From this many bins wide the decay rate's likelihood is Gaussian enough: its spread is its curvature's σ
+# (measured on benchmarks/short_records.py's cases, seeds 36000-36001, 30-600 s: the decay rate's spread over
+# its curvature σ, median (90th percentile) 1.16 (1.52) at 0-3 bins, 1.05 (1.17) at 12-25, 0.94 (1.10) at
+# 25-50). Its profile is then not computed, and the frequency's only where a screen of a few decay rates
+# (:data:`SCREEN_DECAYS`) is irregular: those peaks cost the most (the bins scored grow with the width).
+DECAY_GAUSSIAN_BINS = 25.0
+SCREEN_DECAYS = 3  # the decay rates of the screen: the fitted one and its two neighbours on the grid
 # The frequency's profile is irregular (not the single Gaussian-like maximum the curvature describes) where the rms
 # of its weight is this many curvature σ or more: on a regular maximum the ratio is 1.04-1.3 (12 records of a
 # mode 13 bins wide, tests/test_short_record_fits.py), and the rms there widens the 1σ beyond the estimator's
@@ -70,8 +79,8 @@ def _near(problem: BandProblem, lo: float, hi: float, margin: float) -> slice:
 def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, limits) -> tuple[float, float]:
     """Root-mean-square distances from θ[0] (the fitted damped frequency, Hz) and from θ[1] (the decay rate,
     1/s) of the profile-likelihood weight of each, the other profiled out (the frequency's only where its
-    profile has a second maximum, else 0: the module docstring); (0, 0) for a peak wide enough to be Gaussian
-    (:data:`GAUSSIAN_BINS`).
+    profile is irregular, else 0: the module docstring); (0, 0) for a peak wide enough to be Gaussian
+    (:data:`GAUSSIAN_BINS`), and the decay rate's 0 from :data:`DECAY_GAUSSIAN_BINS` wide.
 
     Parameters
     ----------
@@ -86,7 +95,8 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
         The fit's limits; the profile stays inside them.
     """
     f_hat, s_hat = float(theta[0]), float(theta[1])
-    if s_hat * problem.n_samples * problem.dt / np.pi >= GAUSSIAN_BINS:
+    bins = s_hat * problem.n_samples * problem.dt / np.pi
+    if bins >= GAUSSIAN_BINS:
         return 0.0, 0.0
     lo, hi = max(limits[0][0], f_hat - reach), min(limits[0][1], f_hat + reach)
     coarse = np.linspace(lo, hi, GRID_POINTS)
@@ -101,19 +111,34 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
     rows = _near(problem, lo, hi, 10.0 * s_hat / (2 * np.pi))
     sub = BandProblem(problem.periodogram[rows], problem.phase[rows], problem.n_samples, problem.dt,
                       problem.fixed[rows], problem.nonnegative)
+    wide = bins >= DECAY_GAUSSIAN_BINS
+    if wide:  # the decay rate's spread is its curvature's; the frequency's profile only where a screen is irregular
+        screen = _values(sub, freqs, decays[np.argsort(np.abs(np.log(decays / s_hat)))[:SCREEN_DECAYS]]).min(axis=1)
+        if not _irregular(freqs, screen, f_hat, std):
+            return 0.0, 0.0
+    values = _values(sub, freqs, decays)
+    f_profile = values.min(axis=1)
+    f_spread = _rms(freqs, f_profile, f_hat) if _irregular(freqs, f_profile, f_hat, std) else 0.0
+    return f_spread, 0.0 if wide else _rms(decays, values.min(axis=0), s_hat)
+
+
+def _values(sub: BandProblem, freqs: np.ndarray, decays: np.ndarray) -> np.ndarray:
+    """The band's -log-likelihood at each (frequency, decay rate) of the grid, the linear terms fitted at each,
+    (freqs, decays); inf where the model is not valid."""
     grid = np.array([(f, s) for f in freqs for s in decays])
-    block = max(decays.size, (MAX_ELEMENTS // max(1, sub.periodogram.size * (2 + problem.fixed.shape[1]))) // decays.size
+    block = max(decays.size, (MAX_ELEMENTS // max(1, sub.periodogram.size * (2 + sub.fixed.shape[1]))) // decays.size
                 * decays.size)
     values = np.concatenate([
         whittle_linear_many(designs(grid[i:i + block], sub), sub.periodogram, sub.nonnegative,
                             iterations=LINEAR_ITERATIONS)[1]
         for i in range(0, grid.shape[0], block)])
-    values = np.where(np.isfinite(values), values, np.inf).reshape(freqs.size, decays.size)
-    f_profile = values.min(axis=1)
-    f_spread = _rms(freqs, f_profile, f_hat)
-    if f_spread < IRREGULAR * std and not _second_maximum(freqs, f_profile, f_hat, 2.0 * std):
-        f_spread = 0.0
-    return f_spread, _rms(decays, values.min(axis=0), s_hat)
+    return np.where(np.isfinite(values), values, np.inf).reshape(freqs.size, decays.size)
+
+
+def _irregular(freqs: np.ndarray, profile: np.ndarray, f_hat: float, std: float) -> bool:
+    """Whether a frequency profile is irregular: its rms is :data:`IRREGULAR` curvature σ or more, or it has a
+    second maximum (:func:`_second_maximum`)."""
+    return _rms(freqs, profile, f_hat) >= IRREGULAR * std or _second_maximum(freqs, profile, f_hat, 2.0 * std)
 
 
 def _second_maximum(x: np.ndarray, profile: np.ndarray, centre: float, away: float) -> bool:
