@@ -20,6 +20,7 @@ import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -133,3 +134,13 @@ def timed(func, repeat: int):
         value[0] = func()
 
     return statistics.median(wall_times(call, repeat)), value[0]
+
+
+def run_cli(*args) -> float:
+    """Wall time (s) of ``stcs-ident ARGS`` run with this Python's package in a child process (stdout dropped;
+    a failure raises)."""
+    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
+               *map(str, args)]
+    started = time.perf_counter()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - started

@@ -29,10 +29,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import tempfile
-import time
 from datetime import datetime, timedelta
 from pathlib import Path
 
@@ -42,25 +40,19 @@ CAMPAIGN = Path(__file__).resolve().parents[1] / "campaigns" / "damped-stay"
 START = datetime.fromisoformat("2026-03-01T00:00:00+00:00")
 
 
-def _cli(*args) -> float:
-    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
-               *map(str, args)]
-    started = time.perf_counter()
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - started
-
-
 def simulate_and_track(root: Path, days: float, seed: int, workers: int) -> tuple[Path, Path]:
+    from common import run_cli
+
     archive, tracked = root / "archive", root / "tracked"
     leak = START + timedelta(days=days / 2)
     loss = leak + timedelta(days=0.75)
-    seconds = _cli("simulate", CAMPAIGN, "--out", archive, "--archive", days, "--cables", 3, "--duration", 600,
-                   "--sampling-rate", 100, "--seed", seed, "--workers", workers,
-                   "--damper-change", f"C1,leak,{leak.isoformat()},0.3",
-                   "--tension-change", f"C2,{loss.isoformat()},-0.01")
+    seconds = run_cli("simulate", CAMPAIGN, "--out", archive, "--archive", days, "--cables", 3, "--duration", 600,
+                    "--sampling-rate", 100, "--seed", seed, "--workers", workers,
+                    "--damper-change", f"C1,leak,{leak.isoformat()},0.3",
+                    "--tension-change", f"C2,{loss.isoformat()},-0.01")
     n = sum(1 for _ in archive.glob("*/records/*/*.h5"))
     print(f"simulated {n} records in {seconds:.0f} s on {workers} workers", flush=True)
-    seconds = _cli("track", archive, "--out", tracked, "--workers", workers)
+    seconds = run_cli("track", archive, "--out", tracked, "--workers", workers)
     print(f"tracked in {seconds:.0f} s on {workers} workers: {n / seconds / workers:.2f} records/s/core", flush=True)
     return archive, tracked
 

@@ -36,7 +36,6 @@ import argparse
 import json
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -50,14 +49,6 @@ ROWS = {"damped-600": ("600 s, with its damper", 600, True),
         "damped-60": ("60 s, with its damper", 60, True),
         "bare-60": ("60 s, without it", 60, False),
         "bare-600": ("600 s, without it", 600, False)}
-
-
-def _cli(*args) -> float:
-    command = [sys.executable, "-c", "import sys; from stcs_ident.cli.main import main; sys.exit(main(sys.argv[1:]))",
-               *map(str, args)]
-    started = time.perf_counter()
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - started
 
 
 def bare_campaign(root: Path) -> Path:
@@ -87,6 +78,8 @@ def bare_campaign(root: Path) -> Path:
 
 def simulate_and_track(root: Path, key: str, campaign: Path, hours: float, seed: int, workers: int) -> dict:
     """Simulate (unless kept from an earlier run) and track one row's archive; the times."""
+    from common import run_cli
+
     _, duration, _ = ROWS[key]
     archive, tracked = root / key / "archive", root / key / "tracked"
     times = {"simulate": 0.0}
@@ -95,10 +88,10 @@ def simulate_and_track(root: Path, key: str, campaign: Path, hours: float, seed:
     else:
         shutil.rmtree(archive, ignore_errors=True)
         archive.parent.mkdir(parents=True, exist_ok=True)
-        times["simulate"] = _cli("simulate", campaign, "--out", archive, "--archive", hours / 24, "--cables", 2,
-                                 "--duration", duration, "--sampling-rate", 100, "--seed", seed, "--workers", workers)
+        times["simulate"] = run_cli("simulate", campaign, "--out", archive, "--archive", hours / 24, "--cables", 2,
+                                    "--duration", duration, "--sampling-rate", 100, "--seed", seed, "--workers", workers)
     shutil.rmtree(tracked, ignore_errors=True)
-    times["track"] = _cli("track", archive, "--out", tracked, "--workers", workers)
+    times["track"] = run_cli("track", archive, "--out", tracked, "--workers", workers)
     n = sum(1 for _ in archive.glob("*/records/*/*.h5"))
     print(f"{key}: {n} records, simulated in {times['simulate']:.0f} s, tracked in {times['track']:.0f} s "
           f"on {workers} workers", flush=True)

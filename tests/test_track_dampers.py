@@ -116,6 +116,21 @@ def test_process_record_of_a_damped_stay_gives_the_coefficient_within_3_sigma(tm
     assert abs(row["tension"] - 4.0e6) <= 3 * row["tension_sigma"]
 
 
+def _fake_record(monkeypatch, process, identify) -> None:
+    """process_record on a record of two modes (the first with a damping ratio) whose reading and spectra are
+    faked, with ``identify`` in place of the fits."""
+
+    class Spectra:
+        modes, mode_planes = (1, 2), ("in", "in")
+        frequencies, uncertainty = np.array([1.1, 2.2]), np.array([1e-3, 1e-3])
+        damping, damping_uncertainty = np.array([0.012, np.nan]), np.array([0.002, np.nan])
+
+    monkeypatch.setattr(process, "identify", identify)  # looked up in process
+    monkeypatch.setattr(process, "analyse_record", lambda *a, **k: Spectra())
+    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
+        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
+
+
 def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_not_a_value(tmp_path, monkeypatch):
     from stcs_ident.core.errors import BoundError
     from stcs_ident.track import process
@@ -132,15 +147,7 @@ def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_
                 return 4.1e6, 5e3
         return Result()
 
-    class Spectra:
-        modes, mode_planes = (1, 2), ("in", "in")
-        frequencies, uncertainty = np.array([1.1, 2.2]), np.array([1e-3, 1e-3])
-        damping, damping_uncertainty = np.array([0.012, np.nan]), np.array([0.002, np.nan])
-
-    monkeypatch.setattr(process, "identify", fake_identify)  # looked up in process
-    monkeypatch.setattr(process, "analyse_record", lambda *a, **k: Spectra())
-    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
-        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
+    _fake_record(monkeypatch, process, fake_identify)
     spec = CableSpec("stay", str(tmp_path), DAMPED, "S", 4.0e6)
     row = process_record(spec, str(tmp_path / "records" / "r.h5"), "x")
     assert row["status"] == "ok" and row["tension"] == 4.1e6  # the tension kept
@@ -170,15 +177,7 @@ def test_a_tension_without_a_finite_sigma_is_a_failed_record_not_an_answer(tmp_p
         def value(self, name):
             return 4.0e6, math.inf
 
-    class Spectra:
-        modes, mode_planes = (1, 2), ("in", "in")
-        frequencies, uncertainty = np.array([1.1, 2.2]), np.array([1e-3, 1e-3])
-        damping, damping_uncertainty = np.array([0.012, np.nan]), np.array([0.002, np.nan])
-
-    monkeypatch.setattr(process, "identify", lambda *a, **k: Result())
-    monkeypatch.setattr(process, "analyse_record", lambda *a, **k: Spectra())
-    monkeypatch.setattr(process, "open_test_record", lambda campaign, test: ("r.h5", type("R", (), {
-        "start_time": pd.Timestamp("2024-01-01T00:00:00Z"), "temperature": 10.0})()))
+    _fake_record(monkeypatch, process, lambda *a, **k: Result())
     bare = CableSpec("stay", str(tmp_path), Campaign("bare", STAY, setups=(Setup("S", ()),),
                                                      tests=(Test("T", "S", 4.0e6),)), "S", 4.0e6)
     row = process_record(bare, str(tmp_path / "records" / "r.h5"), "x")

@@ -113,10 +113,13 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
                       problem.fixed[rows], problem.nonnegative)
     wide = bins >= DECAY_GAUSSIAN_BINS
     if wide:  # the decay rate's spread is its curvature's; the frequency's profile only where a screen is irregular
-        screen = _values(sub, freqs, decays[np.argsort(np.abs(np.log(decays / s_hat)))[:SCREEN_DECAYS]]).min(axis=1)
-        if not _irregular(freqs, screen, f_hat, std):
+        order = np.argsort(np.abs(np.log(decays / s_hat)))  # the screen's decay rates first
+        screen = _values(sub, freqs, decays[order[:SCREEN_DECAYS]])
+        if not _irregular(freqs, screen.min(axis=1), f_hat, std):
             return 0.0, 0.0
-    values = _values(sub, freqs, decays)
+        values = np.hstack([screen, _values(sub, freqs, decays[order[SCREEN_DECAYS:]])])  # columns in `order`
+    else:
+        values = _values(sub, freqs, decays)
     f_profile = values.min(axis=1)
     f_spread = _rms(freqs, f_profile, f_hat) if _irregular(freqs, f_profile, f_hat, std) else 0.0
     return f_spread, 0.0 if wide else _rms(decays, values.min(axis=0), s_hat)
