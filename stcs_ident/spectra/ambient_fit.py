@@ -141,20 +141,34 @@ def _fisher(grad: np.ndarray, mean: np.ndarray) -> np.ndarray:
 
 
 def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
-    """Fisher-scoring step with power coefficients at zero held there when the step would make them negative."""
+    """Fisher-scoring step with power coefficients at zero held there where the likelihood wants them lower.
+
+    The step minimises the local quadratic model −scoreᵀd + ½ dᵀ F d with the powers at zero kept ≥ 0, by an
+    active set: a power at zero that the unconstrained step takes negative is held, and released again when the
+    model's gradient at the held step says the likelihood would rise with it (its multiplier's sign). Holding
+    without the release left a mode's symmetric part at zero whenever the joint step, through its correlation
+    with the background, went negative while its own score was positive: the line shape then kept its largest
+    dispersive part and its peak off the pole (a hanger's modes 14-20 at ζ 1.5 %, 60 s, all about 1 % low).
+    """
     bounded = np.concatenate([[False, False], nonnegative])
-    free = np.ones(theta.size, dtype=bool)
+    at_zero = bounded & (theta <= 1e-12 * np.abs(theta).max())
+    held = np.zeros(theta.size, dtype=bool)
     step = np.zeros(theta.size)
-    sub = fisher
-    for _ in range(theta.size):
+    for _ in range(2 * theta.size):
+        free = ~held
+        sub = fisher[np.ix_(free, free)]
         scale = np.sqrt(np.maximum(sub.diagonal(), TINY))
         step = np.zeros(theta.size)
         step[free] = np.linalg.lstsq(sub / (scale[:, None] * scale), score[free] / scale, rcond=1e-12)[0] / scale
-        blocked = np.flatnonzero(free & bounded & (theta + step < 0) & (theta <= 1e-12 * np.abs(theta).max()))
-        if blocked.size == 0:
+        blocked = np.flatnonzero(free & at_zero & (step < 0))
+        if blocked.size:
+            held[blocked] = True
+            continue
+        gradient = fisher @ step - score  # of the quadratic model at the step: < 0 where moving up would lower it
+        release = np.flatnonzero(held & (gradient < 0))
+        if release.size == 0:
             break
-        free[blocked] = False
-        sub = fisher[np.ix_(free, free)]
+        held[release[np.argmin(gradient[release])]] = False
     return step
 
 

@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .whittle import BandProblem, designs, whittle_linear_many
+from .whittle import BandProblem, band_design, designs, whittle_linear_many
 
 __all__ = ["spreads"]
 
@@ -60,8 +60,15 @@ LINEAR_ITERATIONS = 6  # Fisher-scoring steps of the linear terms per (f, σ): a
 
 # A peak this many bins wide (2σ/2π over the resolution 1/T) or wider is described by enough bins that its
 # likelihood is Gaussian in frequency: the curvature's 1σ is the spread (measured: 600-s records of a mode
-# of 14.9 Hz at ζ 1.5 %, about 270 bins, rms z 0.84 with the curvature alone; 60 s, 27 bins, 2.0).
+# of 14.9 Hz at ζ 1.5 %, about 270 bins, rms z 0.84 with the curvature alone; 60 s, 27 bins, 2.0) -- unless a
+# probe at ±PROBE_SIGMAS curvature σ finds the profile risen by less than PROBE_RISE on a side (a Gaussian's
+# rises by 2), probed on peaks less than PROBE_CONTRAST times their background high: a weak broad mode's
+# likelihood can be flat across its top (a 60-s hanger's mode 20, 170 bins
+# wide, 5 dB above the floor: the profile rose by 1.2 at 3 curvature σ), and is then profiled as a narrower one.
 GAUSSIAN_BINS = 50.0
+PROBE_SIGMAS = 2.0
+PROBE_RISE = 1.0
+PROBE_CONTRAST = 10.0
 # From this many bins wide the decay rate's likelihood is Gaussian enough: its spread is its curvature's σ
 # (measured on benchmarks/short_records.py's cases, seeds 36000-36001, 30-600 s: the decay rate's spread over
 # its curvature σ, median (90th percentile) 1.16 (1.52) at 0-3 bins, 1.05 (1.17) at 12-25, 0.94 (1.10) at
@@ -110,10 +117,11 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
     """
     f_hat, s_hat = float(theta[0]), float(theta[1])
     bins = s_hat * problem.n_samples * problem.dt / np.pi
-    if bins >= GAUSSIAN_BINS:
+    lo, hi = max(limits[0][0], f_hat - reach), min(limits[0][1], f_hat + reach)
+    if bins >= GAUSSIAN_BINS and (_contrast(problem, theta) >= PROBE_CONTRAST
+                                  or not _flat(problem, f_hat, s_hat, std, limits)):
         return 0.0, 0.0
     wide = bins >= DECAY_GAUSSIAN_BINS
-    lo, hi = max(limits[0][0], f_hat - reach), min(limits[0][1], f_hat + reach)
     top = DECAY_FACTORS[-1]
     for extension in range(EXTENSIONS + 1):
         points = int(np.ceil(GRID_POINTS * (hi - lo) / (2 * reach)))  # the coarse grid's spacing kept as it grows
@@ -161,6 +169,30 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
         return f_spread, 0.0
     order = np.argsort(decays)
     return f_spread, _rms(decays[order], s_profile[order], s_hat)
+
+
+def _contrast(problem: BandProblem, theta: np.ndarray) -> float:
+    """The fitted mode's expected periodogram at its highest over the rest of the model (neighbours and background)
+    at that bin."""
+    basis, _ = band_design(theta[:2], problem, derivative=False)
+    mode = basis[:, :2] @ theta[2:4]
+    k = int(np.argmax(mode))
+    rest = float(basis[k, 2:] @ theta[4:])
+    return float(mode[k] / rest) if rest > 0 else np.inf
+
+
+def _flat(problem: BandProblem, f_hat: float, s_hat: float, std: float, limits) -> bool:
+    """Whether the frequency's profile at ±:data:`PROBE_SIGMAS` curvature σ has risen by less than
+    :data:`PROBE_RISE` on either side (a Gaussian's rises by 2): a likelihood flatter than its curvature says."""
+    freqs = f_hat + np.array([-PROBE_SIGMAS, 0.0, PROBE_SIGMAS]) * std
+    decays = s_hat * DECAY_FACTORS[DECAY_FACTORS.size // 2 - 1: DECAY_FACTORS.size // 2 + 2]
+    if freqs[0] <= limits[0][0] or freqs[-1] >= limits[0][1]:
+        return True
+    rows = _near(problem, freqs[0], freqs[-1], 10.0 * s_hat / (2 * np.pi))
+    sub = BandProblem(problem.periodogram[rows], problem.phase[rows], problem.n_samples, problem.dt,
+                      problem.fixed[rows], problem.nonnegative)
+    profile = _values(sub, freqs, decays).min(axis=1)
+    return bool(min(profile[0], profile[2]) - profile[1] < PROBE_RISE)
 
 
 def _values(sub: BandProblem, freqs: np.ndarray, decays: np.ndarray) -> np.ndarray:
