@@ -406,14 +406,17 @@ def test_a_wide_uncertainty_does_not_swallow_well_located_neighbours():
 
 
 def test_a_flat_whittle_likelihood_is_not_an_estimate():
-    """A pole narrower than the record resolves: ζ at its bound, 1σ of hertz. It must not replace a decay fit."""
+    """A pole narrower than the record resolves: ζ at its bound (its damping ratio NaN, its 1σ the resolution
+    cell's; before, a degenerate information's 1σ of hertz). It must not replace a decay fit."""
     from types import SimpleNamespace
 
     from stcs_ident.spectra.peaks import _sound
 
-    flat = SimpleNamespace(converged=True, frequency_std=5.14)
-    good = SimpleNamespace(converged=True, frequency_std=0.004)
-    assert not _sound(flat, 0.274) and _sound(good, 0.274) and not _sound(None, 0.274)
+    flat = SimpleNamespace(converged=True, frequency_std=5.14, damping=0.004)
+    unresolved = SimpleNamespace(converged=True, frequency_std=0.001, damping=float("nan"))
+    good = SimpleNamespace(converged=True, frequency_std=0.004, damping=0.004)
+    assert not _sound(flat, 0.274) and not _sound(unresolved, 0.274)
+    assert _sound(good, 0.274) and not _sound(None, 0.274)
 
 
 def test_blows_ringing_at_different_frequencies_widen_the_uncertainty():

@@ -142,3 +142,21 @@ def test_one_pole_wider_than_its_familys_spacing_is_a_doubtful_blend():
     for n, f, zeta, doubtful in zip(modes, spectra.frequencies, spectra.damping, spectra.doubtful):
         if not doubtful and n < len(true):
             assert 2 * zeta * f < true[n] - true[n - 1], f"mode {n}: a sure blend"
+
+
+def test_a_line_narrower_than_the_record_resolves_has_its_cells_1_sigma_and_no_damping_ratio():
+    """The stay of seed 36000 (30 s, ζ 0.36 %): mode 1 (0.833 Hz, 0.18 bins wide) was fitted at 0.8265 Hz with ζ
+    3e-14, its decay rate at its bound, and a 1σ of 35 kHz from a degenerate information (the frequency
+    confounded with the line's dispersive part): a useless number counted as covered. Narrower than a hundredth
+    of a bin, its 1σ is the resolution cell's (1/(T√12)) and its damping ratio not estimated."""
+    _, record, true = _stay_record(153.68575255863922, 81.67091711872052, 233468.80996978586, 1663031747.683127,
+                                   0.6200151373534588, 5274501.347228832, [7.23824987128033, 12.94936552606637],
+                                   0.0036261627365435077, 4.157802783979756, 844493949, duration=30.0)
+    result = find_peaks(record, expected=true[:30])
+    near = [p for p in result.peaks if abs(p.frequency - true[0]) < 0.4 * (true[1] - true[0])]
+    assert near, "mode 1 not reported"
+    peak = near[0]
+    assert peak.damping is None and peak.damping_uncertainty is None
+    cell = 1.0 / (30.0 * np.sqrt(12.0))
+    assert abs(peak.uncertainty - cell) <= 1e-9 * cell
+    assert abs(peak.frequency - true[0]) <= 3 * peak.uncertainty

@@ -77,6 +77,12 @@ from .whittle import (
 __all__ = ["AmbientFit", "fejer_lorentzian", "fit_ambient", "widen_to_spread"]
 
 # The iterations and the start's ζ grid are :class:`.options.FitOptions`.
+# A pole fitted narrower than this share of a resolution cell (2σ/2π below UNRESOLVED_BINS / T) has its decay rate at
+# its bound: the record does not resolve its width, and the information of its frequency is degenerate there (the
+# frequency confounded with the line's dispersive part: a 30-s stay's mode 1 at 0.83 Hz fitted with ζ 3e-14 had a
+# 1σ of 35 kHz). Its 1σ is then that of the resolution cell (:func:`_unresolved_covariance`): measured on
+# benchmarks/short_records.py's 30-s stays (seed 36000), 8 such modes off by 0.02-0.53 bins.
+UNRESOLVED_BINS = 0.01
 SERIAL_BLAS_SIZE = 2048  # elements: OpenBLAS runs a complex matrix-vector product this small on one thread
 
 
@@ -91,7 +97,8 @@ class AmbientFit:
     decay_rate, decay_rate_std : float
         σ, 1/s.
     damping, damping_std : float
-        ζ = σ / (2π f_n).
+        ζ = σ / (2π f_n); NaN where the fitted peak is narrower than the record resolves
+        (:data:`UNRESOLVED_BINS`).
     amplitude : ndarray (n_channels,)
         Root-mean-square modal acceleration in each channel, signed by the
         phase of the mode shape relative to its largest entry, m/s².
@@ -345,8 +352,12 @@ def fit_ambient(
         return None
     if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
         return None
-    band = (problem, theta, limits, cov)
-    if spread:
+    duration = n_samples * dt
+    unresolved = theta[1] * duration / np.pi < UNRESOLVED_BINS
+    if unresolved:
+        cov = _unresolved_covariance(duration)
+    band = None if unresolved else (problem, theta, limits, cov)
+    if spread and not unresolved:
         cov = _spread_covariance(*band)
     null = null_neg_log_likelihood(problem)
     significance = np.sqrt(max(2.0 * (null - neg_log_likelihood(mean, problem.periodogram)), 0.0))
@@ -355,7 +366,16 @@ def fit_ambient(
     shape = shape / np.linalg.norm(shape)
     amplitude = np.sqrt(max(variance_y, 0.0)) * np.abs(u) * noise_scale * np.sign(np.cos(np.angle(u)))
     fit = _result(theta[:2], cov, amplitude, shape, significance, ok, misfit)
+    if unresolved:  # its width, and so its damping ratio, is below what the record resolves: not estimated
+        fit = replace(fit, damping=float("nan"), damping_std=float("nan"))
     return fit if spread else replace(fit, band=band)
+
+
+def _unresolved_covariance(duration: float) -> np.ndarray:
+    """The covariance of (f_d, σ) of a pole fitted narrower than the record resolves (:data:`UNRESOLVED_BINS`):
+    each uniform over what one resolution cell allows, the frequency over its bin (1/T) and the decay rate
+    over [0, π/T] (a half-power width of one bin)."""
+    return np.diag([1.0 / (12.0 * duration**2), (np.pi / duration) ** 2 / 12.0])
 
 
 def widen_to_spread(fit: AmbientFit) -> AmbientFit:

@@ -356,12 +356,14 @@ def _sound(fit: AmbientFit | None, half_width: float, options: DecayCheckOptions
     """A converged Whittle fit that locates its mode: 1σ within a quarter (``options.whittle_max_std``) of the
     band's half-width.
 
-    A pole narrower than the record resolves (ζ at its lower bound) leaves
-    the likelihood flat in frequency: the fit "converges" with a 1σ of
-    hertz, which is no estimate.
+    A pole narrower than the record resolves (ζ at its lower bound, its
+    damping ratio NaN: :data:`.ambient_fit.UNRESOLVED_BINS`) is no estimate
+    of a mode that a decay fit describes: the Whittle likelihood is flat in
+    frequency there (its information degenerate; its 1σ is the resolution
+    cell's).
     """
     options = DecayCheckOptions() if options is None else options
-    return fit is not None and fit.converged and bool(np.isfinite(fit.frequency_std)) and (
+    return fit is not None and fit.converged and bool(np.isfinite(fit.frequency_std) and np.isfinite(fit.damping)) and (
         fit.frequency_std <= options.whittle_max_std * half_width
     )
 
@@ -385,8 +387,8 @@ def _ambient_peak(c: Candidate, fit: AmbientFit, overview: Overview, names, chan
     return Peak(
         frequency=fit.frequency,
         uncertainty=fit.frequency_std,
-        damping=fit.damping,
-        damping_uncertainty=fit.damping_std,
+        damping=fit.damping if np.isfinite(fit.damping) else None,  # NaN: narrower than the record resolves
+        damping_uncertainty=fit.damping_std if np.isfinite(fit.damping) else None,
         channels=_channels(snr, names, channel_snr_db),
         amplitude=fit.amplitude,
         snr_db=c.snr_db,
