@@ -24,6 +24,7 @@ from ..core.record import Record
 from ..forward import natural_frequencies
 from ..io.records.validation import check_bandwidth, check_duration, check_positions
 from ..io.test_record import open_test_record
+from .doubtful_modes import blends_doubtful, low_mac_doubtful
 from .numbering import Numbering, number_modes
 from .options import PickingOptions
 from .peak_result import PickingResult
@@ -323,82 +324,6 @@ def _slip_only(test: Test, record: Record, path: str, cable, atts, tension_model
 WIDER_BAND = 10.0
 
 
-#: A numbered mode whose MAC is below this while its plane's family's median MAC is at least
-#: :data:`FAMILY_MAC` is doubtful: its operating shape is not the mode its number names (measured on the slips of
-#: issue 34: a tension typed in kN numbered peaks 10, 18, 21 at MAC 0.48, 0.04, 0.00; a correct campaign's modes
-#: are at 0.95-1.00 wherever the sensors can tell the shapes apart).
-LOW_MAC, FAMILY_MAC = 0.3, 0.8
-
-
-def _low_mac_doubtful(spectra: TestSpectra) -> TestSpectra:
-    """``spectra`` with the numbered modes whose MAC is far below their plane's family's own made doubtful
-    (:data:`LOW_MAC`), with a note naming them."""
-    if spectra.mac is None or not len(spectra.modes):
-        return spectra
-    macs = np.asarray(spectra.mac, float)
-    planes = np.asarray(spectra.mode_planes)
-    low = np.zeros(macs.size, bool)
-    for plane in set(planes.tolist()):
-        own = (planes == plane) & np.isfinite(macs)
-        if own.sum() >= 3 and np.median(macs[own]) >= FAMILY_MAC:
-            low |= own & (macs < LOW_MAC)
-    low &= ~np.asarray(spectra.doubtful, bool)
-    if not low.any():
-        return spectra
-    names = ", ".join(f"{PLANE_NAMES[p] + ' ' if spectra.planes is not None else ''}mode {m} (MAC {a:.2f})"
-                      for m, p, a in zip(np.asarray(spectra.modes)[low], planes[low], macs[low]))
-    note = Note.plain("low_mac", f"{names}: operating shape far from the model's (the family's median MAC is "
-                                 f"{FAMILY_MAC:g} or more): number doubtful")
-    return replace(spectra, doubtful=tuple(bool(d) for d in np.asarray(spectra.doubtful, bool) | low),
-                   plane_notes=spectra.plane_notes + (note,))
-
-
-#: A numbered mode whose fitted half-power width (2ζf) is this many of its family's mode spacings or more is a
-#: blend: one pole fitted where the band holds several of the family's modes (a heavily damped stay's high modes,
-#: or a fit across two of them), its frequency between theirs and its ζ theirs plus their spacing. Measured on
-#: benchmarks/short_records.py's stays (seed 36000, 30-120 s, ζ 0.2-2 %): of 716 numbered modes narrower than
-#: one spacing, 99 % within 3σ and 8 off by more than max(3σ, 0.5 %); of 18 at 1.5 spacings or more, 61 % and 7
-#: off, 3 of them sure (the 4 between 1 and 1.5 spacings: within 3σ).
-BLEND_SPACINGS = 1.0
-
-
-def _blends_doubtful(spectra: TestSpectra) -> TestSpectra:
-    """``spectra`` with its blends (:data:`BLEND_SPACINGS`) made doubtful, their 1σ at least their half-power
-    half-width (ζf: where one pole stands for several, the frequency is known to no better than its width) and
-    their damping ratio not reported (it is the blend's), with a note naming them."""
-    if not len(spectra.modes):
-        return spectra
-    nominal = dict(spectra.plane_nominal) or {"in": spectra.nominal_frequencies}
-    blend = np.zeros(len(spectra.modes), bool)
-    spacing = np.full(len(spectra.modes), np.nan)
-    for k, (mode, plane, f, zeta) in enumerate(zip(spectra.modes, spectra.mode_planes, spectra.frequencies,
-                                                     spectra.damping)):
-        family = nominal.get(plane)
-        if family is None or not np.isfinite(zeta) or mode > len(family) or len(family) < 2:
-            continue
-        neighbours = np.asarray(family, float)[[j for j in (mode - 2, mode) if 0 <= j < len(family)]]
-        own = float(family[mode - 1])
-        spacing[k] = np.mean(np.abs(neighbours - own)) * f / own  # the family's, scaled to the measured mode
-        blend[k] = 2.0 * zeta * f >= BLEND_SPACINGS * spacing[k]
-    if not blend.any():
-        return spectra
-    half_width = np.asarray(spectra.damping, float) * np.asarray(spectra.frequencies, float)
-    unc = np.where(blend, np.maximum(spectra.uncertainty, half_width), spectra.uncertainty)
-    damping = np.where(blend, np.nan, spectra.damping)
-    damping_unc = spectra.damping_uncertainty
-    if damping_unc is not None:
-        damping_unc = np.where(blend, np.nan, damping_unc)
-    planes = spectra.planes is not None
-    names = ", ".join(f"{PLANE_NAMES[p] + ' ' if planes else ''}mode {m} (half-power width {2 * h:.3g} Hz, "
-                      f"spacing {d:.3g} Hz)" for m, p, h, d, b in
-                      zip(spectra.modes, spectra.mode_planes, half_width, spacing, blend) if b)
-    note = Note.plain("blend", f"{names}: one pole wider than its family's mode spacing, a blend of several modes: "
-                               "number doubtful, 1σ widened to its half-power half-width, no damping ratio")
-    return replace(spectra, doubtful=tuple(bool(d) for d in np.asarray(spectra.doubtful, bool) | blend),
-                   uncertainty=unc, damping=damping, damping_uncertainty=damping_unc,
-                   plane_notes=spectra.plane_notes + (note,))
-
-
 def _nominal_family(cable, atts, tension, tension_model: str, plane: str):
     """``n -> the first n nominal frequencies`` of ``plane`` (Hz)."""
     return lambda n: natural_frequencies(cable, atts, tension, max(int(n), 1), tension_model=tension_model,
@@ -408,7 +333,7 @@ def _nominal_family(cable, atts, tension, tension_model: str, plane: str):
 def _with_scale(spectra: TestSpectra, checks: tuple[ScaleCheck, ...]) -> TestSpectra:
     """``spectra`` with its scale checks; where one is implausible, every number doubtful, a warning and a note
     (the peaks' own spacing says the nominal model is on another scale: :mod:`.scale_check`)."""
-    spectra = _blends_doubtful(_low_mac_doubtful(replace(spectra, scale=checks)))
+    spectra = blends_doubtful(low_mac_doubtful(replace(spectra, scale=checks)))
     bad = spectra.implausible_scale
     if not bad:
         return spectra

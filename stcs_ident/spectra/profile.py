@@ -90,11 +90,12 @@ EXTENSIONS = 2
 MAX_ELEMENTS = 1_000_000  # of a block of design matrices (8 MB): the grid is evaluated in blocks this size
 
 
-def _near(problem: BandProblem, lo: float, hi: float, margin: float) -> slice:
+def _near(problem: BandProblem, lo: float, hi: float, margin: float) -> BandProblem:
+    """The band's bins from ``lo − margin`` to ``hi + margin`` Hz, as a problem of their own."""
     freq = problem.phase / (2 * np.pi * problem.dt)
-    first = int(np.searchsorted(freq, lo - margin))
-    last = int(np.searchsorted(freq, hi + margin, side="right"))
-    return slice(first, last)
+    rows = slice(int(np.searchsorted(freq, lo - margin)), int(np.searchsorted(freq, hi + margin, side="right")))
+    return BandProblem(problem.periodogram[rows], problem.phase[rows], problem.n_samples, problem.dt,
+                       problem.fixed[rows], problem.nonnegative)
 
 
 def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, limits) -> tuple[float, float]:
@@ -136,9 +137,7 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
         # The bins that see the scanned poles: the range and ten of the fit's half-power widths beyond it (far
         # bins change the profile's differences by little and cost the most: each alternative is scored on these
         # alone).
-        rows = _near(problem, lo, hi, 10.0 * s_hat / (2 * np.pi))
-        sub = BandProblem(problem.periodogram[rows], problem.phase[rows], problem.n_samples, problem.dt,
-                          problem.fixed[rows], problem.nonnegative)
+        sub = _near(problem, lo, hi, 10.0 * s_hat / (2 * np.pi))
         if wide and extension == 0:  # the decay rate's spread is its curvature's; the frequency's profile only
             order = np.argsort(np.abs(np.log(decays / s_hat)))  # where a screen is irregular (its rates first)
             screen = _values(sub, freqs, decays[order[:SCREEN_DECAYS]])
@@ -154,8 +153,8 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
         f_profile, s_profile = values.min(axis=1), values.min(axis=0)
         low = f_profile - f_profile.min() < EDGE
         grow_lo, grow_hi = low[0] and lo > limits[0][0], low[-1] and hi < limits[0][1]
-        grow_decay = (not wide and s_profile[np.argmax(decays)] - s_profile.min() < EDGE
-                      and decays.max() * np.exp(step) < limits[1][1])
+        grow_decay = (not wide and s_profile[-1] - s_profile.min() < EDGE  # (ascending unless wide)
+                      and decays[-1] * np.exp(step) < limits[1][1])
         if not (grow_lo or grow_hi or grow_decay):
             break
         if grow_lo:
@@ -165,10 +164,7 @@ def spreads(problem: BandProblem, theta: np.ndarray, std: float, reach: float, l
         if grow_decay:
             top *= DECAY_GROWTH
     f_spread = _rms(freqs, f_profile, f_hat) if _irregular(freqs, f_profile, f_hat, std) else 0.0
-    if wide:
-        return f_spread, 0.0
-    order = np.argsort(decays)
-    return f_spread, _rms(decays[order], s_profile[order], s_hat)
+    return f_spread, 0.0 if wide else _rms(decays, s_profile, s_hat)
 
 
 def _contrast(problem: BandProblem, theta: np.ndarray) -> float:
@@ -188,10 +184,7 @@ def _flat(problem: BandProblem, f_hat: float, s_hat: float, std: float, limits) 
     decays = s_hat * DECAY_FACTORS[DECAY_FACTORS.size // 2 - 1: DECAY_FACTORS.size // 2 + 2]
     if freqs[0] <= limits[0][0] or freqs[-1] >= limits[0][1]:
         return True
-    rows = _near(problem, freqs[0], freqs[-1], 10.0 * s_hat / (2 * np.pi))
-    sub = BandProblem(problem.periodogram[rows], problem.phase[rows], problem.n_samples, problem.dt,
-                      problem.fixed[rows], problem.nonnegative)
-    profile = _values(sub, freqs, decays).min(axis=1)
+    profile = _values(_near(problem, freqs[0], freqs[-1], 10.0 * s_hat / (2 * np.pi)), freqs, decays).min(axis=1)
     return bool(min(profile[0], profile[2]) - profile[1] < PROBE_RISE)
 
 
