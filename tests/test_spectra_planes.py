@@ -338,6 +338,7 @@ def _coverage(acceptance, layouts):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("planes_acceptance")  # with -n, on one worker: the 200 records analysed once
 def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
     """With an axial channel (the anchorage's motion seen alone): 68 ± 7 % within 1σ per plane. Measured on
     these seeds (in / out): 1σ 73.7 / 74.0 %, 3σ 99.5 / 100 % since the frequency's 1σ is its profile
@@ -355,6 +356,7 @@ def test_triaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("planes_acceptance")  # with -n, on one worker: the 200 records analysed once
 def test_biaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
     """Without an axial channel a deck mode beside a cable mode is merged with it, seen only by the fit's
     misfit (plane_analysis._misfit). Measured on these seeds (in / out): 1σ 70.7 / 69.6 %, 3σ 98.9 / 98.7 %
@@ -371,6 +373,7 @@ def test_biaxial_records_cover_within_the_issues_one_sigma_band(acceptance):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("planes_acceptance")  # with -n, on one worker: the 200 records analysed once
 def test_acceptance_no_deck_mode_numbered_and_coverage_per_plane(acceptance):
     """The issue's acceptance: no deck mode numbered in 200 records; per plane, 68 ± 7 % within 1σ and ≥ 98 %
     within 3σ. Measured on these seeds (in / out): 1σ 72.2 / 71.8 %, 3σ 99.2 / 99.3 %, no deck mode
