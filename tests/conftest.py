@@ -34,6 +34,29 @@ def pytest_xdist_auto_num_workers(config) -> int | None:
         return os.cpu_count() or 1
 
 
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config, items) -> None:
+    """``--dist loadgroup`` on a pytest that keeps node ids structured (9.2): the group suffix put where it counts.
+
+    pytest-xdist (3.8) tells the controller a test's ``xdist_group`` by appending ``@group`` to its node id on
+    the worker, through the legacy ``_nodeid`` field; pytest 9.2 reads a node's id from ``_id``, so the suffix
+    was silently lost and every grouped test distributed alone (pytest-dev/pytest-xdist#1386, open): a module
+    fixture meant to be made once under ``-n`` was made on every worker (the planes' acceptance set, 170 s of the
+    suite's CPU, twice). Where xdist's suffix is missing it is set here, on the structured id; where xdist sets
+    it (older pytest, a fixed xdist) nothing is done.
+    """
+    if not getattr(config.option, "loadgroup", False):  # not a worker of --dist loadgroup (or no xdist)
+        return
+    from _pytest.nodeid import coerce_node_id  # the structured id's parser (pytest >= 9.2)
+
+    for item in items:
+        names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                        for m in item.iter_markers("xdist_group")})
+        suffix = "@" + "_".join(names)
+        if names and not item.nodeid.endswith(suffix) and hasattr(item, "_id"):
+            item._id = coerce_node_id(item.nodeid + suffix)
+
+
 @pytest.fixture(scope="session")
 def bench_records(tmp_path_factory) -> BenchRecords:
     """``bench_records(bench, effects, seed=0, nominal=None)``: (campaign, spectra by test) of
