@@ -349,13 +349,13 @@ def fit_ambient(
     try:
         cov, misfit = _robust_covariance(grad[:, free], mean, problem.periodogram)
     except np.linalg.LinAlgError:
-        return None
-    if not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
-        return None
+        cov, misfit = None, 1.0
     duration = n_samples * dt
     unresolved = theta[1] * duration / np.pi < UNRESOLVED_BINS
-    if unresolved:
+    if unresolved:  # its information is degenerate (a singular or negative covariance is then no reason to refuse)
         cov = _unresolved_covariance(duration)
+    elif cov is None or not np.all(np.isfinite(cov)) or cov[0, 0] <= 0 or cov[1, 1] <= 0:
+        return None
     band = None if unresolved else (problem, theta, limits, cov)
     if spread and not unresolved:
         cov = _spread_covariance(*band)
