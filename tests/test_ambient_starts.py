@@ -34,10 +34,10 @@ def _problem(seed: int, neighbours: int):
 def test_all_starts_at_once_equal_one_by_one(seed, neighbours):
     problem, f0 = _problem(seed, neighbours)
     grid = np.array([[f, z * 2 * np.pi * f] for f in (f0, f0 + 0.01) for z in np.logspace(-4, -1, 7)])
-    lin, nll = A.whittle_linear_many(A.designs(grid, problem), problem.fixed, problem.periodogram, problem.nonnegative, 3)
+    lin, nll = A.whittle_linear_many(A.designs(grid, problem), problem.periodogram, problem.nonnegative, 3)
     for i, theta in enumerate(grid):
         basis, _ = A.band_design(theta, problem, derivative=False)
-        assert np.allclose(A.designs(theta[None], problem)[0], basis[:, :2].T, rtol=1e-14, atol=0)
+        assert np.allclose(A.designs(theta[None], problem)[0], basis, rtol=1e-14, atol=0)
         one_lin, one_nll = A._whittle_linear(basis, problem.periodogram, problem.nonnegative, iterations=3)
         # 1e-12 and 1e-8 of the largest coefficient: the same arithmetic in another order (batched matrix
         # products, the normal matrix formed once and masked instead of rebuilt from the free columns)

@@ -87,7 +87,7 @@ EDGE = 6.0
 GROWTH = 3.0
 DECAY_GROWTH = 4.0
 EXTENSIONS = 2
-MAX_ELEMENTS = 1_000_000  # of a block of the modes' design columns (8 MB): the grid is evaluated in blocks this size
+MAX_ELEMENTS = 1_000_000  # of a block of design matrices (8 MB): the grid is evaluated in blocks this size
 
 
 def _near(problem: BandProblem, lo: float, hi: float, margin: float) -> BandProblem:
@@ -192,10 +192,10 @@ def _values(sub: BandProblem, freqs: np.ndarray, decays: np.ndarray) -> np.ndarr
     """The band's -log-likelihood at each (frequency, decay rate) of the grid, the linear terms fitted at each,
     (freqs, decays); inf where the model is not valid."""
     grid = np.array([(f, s) for f in freqs for s in decays])
-    block = max(decays.size, (MAX_ELEMENTS // max(1, sub.periodogram.size * 2)) // decays.size
+    block = max(decays.size, (MAX_ELEMENTS // max(1, sub.periodogram.size * (2 + sub.fixed.shape[1]))) // decays.size
                 * decays.size)
     values = np.concatenate([
-        whittle_linear_many(designs(grid[i:i + block], sub), sub.fixed, sub.periodogram, sub.nonnegative,
+        whittle_linear_many(designs(grid[i:i + block], sub), sub.periodogram, sub.nonnegative,
                             iterations=LINEAR_ITERATIONS)[1]
         for i in range(0, grid.shape[0], block)])
     return np.where(np.isfinite(values), values, np.inf).reshape(freqs.size, decays.size)

@@ -193,8 +193,8 @@ def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) 
     grid = [np.array([f_start, zeta * 2 * np.pi * f_start]) for f_start in starts for zeta in damping_grid]
     grid = [theta_nl for theta_nl in grid if limits[1][0] < theta_nl[1] < limits[1][1]]
     if grid:
-        lin, nll = whittle_linear_many(designs(np.array(grid), problem), problem.fixed, problem.periodogram,
-                                       problem.nonnegative, iterations=3)  # starts only
+        bases = designs(np.array(grid), problem)
+        lin, nll = whittle_linear_many(bases, problem.periodogram, problem.nonnegative, iterations=3)  # starts only
         best = int(np.argmin(np.where(np.isnan(nll), np.inf, nll)))
         if nll[best] < np.inf:
             return np.concatenate([grid[best], lin[best]])
@@ -203,56 +203,50 @@ def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) 
 
 
 def designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
-    """The mode's two columns of :func:`band_design`'s basis (no derivative) for many (f, σ) rows at once, as
-    rows: (c, 2, m); the fixed columns, the same for every row, are ``problem.fixed``. The sines and cosines
-    once per distinct frequency, for all its damping ratios (:func:`_turns`)."""
+    """:func:`band_design`'s basis (no derivative) of many (f, σ) rows at once, (c, m, 2 + q); the sines and
+    cosines once per distinct frequency, for all its damping ratios (:func:`_turns`)."""
     omega = 2 * np.pi * thetas[:, 0] * problem.dt
     real = -thetas[:, 1] * problem.dt
-    modal = np.empty((thetas.shape[0], 2, problem.phase.size))
+    bases = np.empty((thetas.shape[0], problem.phase.size, 2 + problem.fixed.shape[1]))
     for value in np.unique(omega):
         rows = np.flatnonzero(omega == value)
         h, _ = _fejer(real[rows, None], _turns(value - problem.phase, problem.n_samples), problem.n_samples,
                       derivative=False)
-        modal[rows, 0, :] = h.real + h.imag
-        modal[rows, 1, :] = h.real - h.imag
-    return modal
+        bases[rows, :, 0] = h.real + h.imag
+        bases[rows, :, 1] = h.real - h.imag
+    bases[:, :, 2:] = problem.fixed
+    return bases
 
 
-def whittle_linear_many(modal: np.ndarray, fixed: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
+def whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
                          iterations: int) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_whittle_linear` of many bases at once, each the mode's columns ``modal`` (c, 2, m: as rows) of its
-    candidate beside the columns ``fixed`` (m, q − 2) shared by all: coefficients (c, q) and -log-likelihoods (c,).
+    """:func:`_whittle_linear` of many bases (c, m, q) at once: coefficients (c, q) and -log-likelihoods (c,).
 
     The same steps candidate by candidate (the flat start, the weighted least squares with the active set,
     the step halved until the likelihood does not fall, a candidate whose step cannot be made to stops), in
     a few array operations for all: the start grid of every band's fit, a third of an ambient record's
-    picking, was numpy's per-call overhead on 6 × 6 systems. The shared columns are never copied per
-    candidate (their products with the weights are matrix products over the bins: a third of the data the
-    full bases were), and the weighted least squares are solved for the candidates still moving only.
-    """
-    c = modal.shape[0]
-    q = 2 + fixed.shape[1]
+    picking, was numpy's per-call overhead on 6 × 6 systems."""
+    c, _, q = bases.shape
     lin = np.zeros((c, q))
     lin[:, -2] = np.mean(periodogram)
     if nonnegative[-1]:  # the background as two nonnegative edge ramps (:func:`_whittle_linear`)
         lin[:, -1] = lin[:, -2]
-    mean = _means(modal, fixed, lin)
+    mean = np.einsum("cmq,cq->cm", bases, lin)
     nll = _neg_log_likelihood_many(mean, periodogram)
     active = np.ones(c, dtype=bool)
     for _ in range(iterations):
         if not active.any():
             break
-        step = np.zeros((c, q))
         with np.errstate(divide="ignore", invalid="ignore"):
-            step[active] = _weighted_least_squares_many(_rows(modal, active), fixed, periodogram,
-                                                        1.0 / mean[active], nonnegative) - lin[active]
+            target = _weighted_least_squares_many(bases, periodogram, 1.0 / mean, nonnegative)
+        step = target - lin
         accepted = np.zeros(c, dtype=bool)
         for _ in range(20):
             todo = active & ~accepted
             if not todo.any():
                 break
             trial = lin[todo] + step[todo]
-            trial_mean = _means(_rows(modal, todo), fixed, trial)
+            trial_mean = np.einsum("cmq,cq->cm", bases[todo], trial)
             trial_nll = _neg_log_likelihood_many(trial_mean, periodogram)
             with np.errstate(invalid="ignore"):
                 ok = trial_nll <= nll[todo]
@@ -264,19 +258,6 @@ def whittle_linear_many(modal: np.ndarray, fixed: np.ndarray, periodogram: np.nd
     return lin, nll
 
 
-def _rows(modal: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """``modal[rows]`` for a boolean ``rows``: the array itself when every row is taken."""
-    return modal if rows.all() else modal[rows]
-
-
-def _means(modal: np.ndarray, fixed: np.ndarray, lin: np.ndarray) -> np.ndarray:
-    """The expected periodogram of each candidate from its coefficients (c, q): (c, m)."""
-    mean = lin[:, 2:] @ fixed.T
-    mean += lin[:, :1] * modal[:, 0]
-    mean += lin[:, 1:2] * modal[:, 1]
-    return mean
-
-
 def _neg_log_likelihood_many(mean: np.ndarray, periodogram: np.ndarray) -> np.ndarray:
     """:func:`neg_log_likelihood` of each row of ``mean``."""
     bad = np.any(mean <= 0, axis=1)
@@ -286,25 +267,13 @@ def _neg_log_likelihood_many(mean: np.ndarray, periodogram: np.ndarray) -> np.nd
     return out
 
 
-def _weighted_least_squares_many(modal, fixed, target, weight, nonnegative) -> np.ndarray:
-    """:func:`_weighted_least_squares` of many bases (``modal`` (c, 2, m) beside the shared ``fixed`` (m, q − 2))
-    and weights (c, m) at once. A dropped column is zeroed: its row and column of the normal matrix are then
-    zero but for the ridge, and its coefficient 0."""
-    c, q, k = modal.shape[0], 2 + fixed.shape[1], fixed.shape[1]
-    w2 = weight * weight
-    weighted = modal * w2[:, None, :]  # (c, 2, m)
-    full = np.empty((c, q, q))  # the normal matrix Bᵀ W² B of all columns; a free set's is its sub-block
-    # (products over the bins as row-by-row sums and plain matrix products: numpy's batched matmul of 2 × m by
-    # m × 2 runs its unblocked loop on these strides)
-    full[:, 0, 0] = np.einsum("cm,cm->c", weighted[:, 0], modal[:, 0])
-    full[:, 1, 1] = np.einsum("cm,cm->c", weighted[:, 1], modal[:, 1])
-    full[:, 0, 1] = full[:, 1, 0] = np.einsum("cm,cm->c", weighted[:, 0], modal[:, 1])
-    full[:, :2, 2:] = (weighted.reshape(2 * c, -1) @ fixed).reshape(c, 2, k)
-    full[:, 2:, :2] = full[:, :2, 2:].transpose(0, 2, 1)
-    full[:, 2:, 2:] = (w2 @ (fixed[:, :, None] * fixed[:, None, :]).reshape(-1, k * k)).reshape(c, k, k)
-    full_rhs = np.empty((c, q))
-    full_rhs[:, :2] = (weighted.reshape(2 * c, -1) @ target).reshape(c, 2)
-    full_rhs[:, 2:] = (w2 * target) @ fixed
+def _weighted_least_squares_many(bases, target, weight, nonnegative) -> np.ndarray:
+    """:func:`_weighted_least_squares` of many bases (c, m, q) and weights (c, m) at once. A dropped column is
+    zeroed: its row and column of the normal matrix are then zero but for the ridge, and its coefficient 0."""
+    c, _, q = bases.shape
+    a_t = np.transpose(bases, (0, 2, 1)) * weight[:, None, :]  # (c, q, m)
+    full = a_t @ np.transpose(a_t, (0, 2, 1))  # the normal matrix of all columns; a free set's is its sub-block
+    full_rhs = np.einsum("cqm,cm->cq", a_t, target[None, :] * weight)
     free = np.ones((c, q), dtype=bool)
     bounded = np.broadcast_to(nonnegative, (c, q)).copy()
     running = np.ones(c, dtype=bool)
