@@ -4,6 +4,7 @@ follows the likelihood where it is not Gaussian (issue 36: honest spectra on sho
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.signal import lfilter
 
 from stcs_ident.core.model import Cable
@@ -144,11 +145,24 @@ def test_one_pole_wider_than_its_familys_spacing_is_a_doubtful_blend():
             assert 2 * zeta * f < true[n] - true[n - 1], f"mode {n}: a sure blend"
 
 
-def test_a_line_narrower_than_the_record_resolves_has_its_cells_1_sigma_and_no_damping_ratio():
+@pytest.mark.parametrize("information", ["as computed", "singular", "negative"])
+def test_a_line_narrower_than_the_record_resolves_has_its_cells_1_sigma_and_no_damping_ratio(information,
+                                                                                            monkeypatch):
     """The stay of seed 36000 (30 s, ζ 0.36 %): mode 1 (0.833 Hz, 0.18 bins wide) was fitted at 0.8265 Hz with ζ
     3e-14, its decay rate at its bound, and a 1σ of 35 kHz from a degenerate information (the frequency
     confounded with the line's dispersive part): a useless number counted as covered. Narrower than a hundredth
-    of a bin, its 1σ is the resolution cell's (1/(T√12)) and its damping ratio not estimated."""
+    of a bin, its 1σ is the resolution cell's (1/(T√12)) and its damping ratio not estimated -- whatever that
+    degenerate information gives: a singular one (LAPACK refuses it) or a negative variance once refused the
+    whole fit, and the mode went unreported (it did when the start's likelihoods moved by 1e-13)."""
+    computed = ambient_fit._robust_covariance
+
+    def degenerate(grad, mean, periodogram):
+        cov, misfit = computed(grad, mean, periodogram)
+        if cov[0, 0] > 1.0 and information == "singular":  # a 1σ of f_d above 1 Hz: the degenerate line's alone
+            raise np.linalg.LinAlgError("singular")
+        return (-np.abs(cov) if cov[0, 0] > 1.0 and information == "negative" else cov), misfit
+
+    monkeypatch.setattr(ambient_fit, "_robust_covariance", degenerate)
     _, record, true = _stay_record(153.68575255863922, 81.67091711872052, 233468.80996978586, 1663031747.683127,
                                    0.6200151373534588, 5274501.347228832, [7.23824987128033, 12.94936552606637],
                                    0.0036261627365435077, 4.157802783979756, 844493949, duration=30.0)

@@ -324,11 +324,12 @@ class Problem:
         return np.where(np.isfinite(c), c, np.inf)
 
 
-#: The tensions and complex roots of the last damped rows solved (one call's) per (cable, attachments, plane, modes, tension model), in
-#: this process: the warm start of the next solve of that model (:meth:`Problem._solve`), whichever fit asks
-#: (a diagnosis's hypotheses and cross-validation folds start near each other's points); and per model without
-#: its attachments, the start of a setup not solved yet (a hypothesis's added mass moves the roots a little; the
-#: warm start's checks refuse what moved too far). At most this many.
+#: The tensions and complex roots of the last damped rows solved (one call's) per (cable, attachments, plane, modes,
+#: tension model), in this process: the warm start of the next solve of that model (:meth:`Problem._solve`, each
+#: row from the kept row of the nearest tension), whichever fit asks (a diagnosis's hypotheses and cross-validation
+#: folds start near each other's points); and per model without its attachments, the start of a setup not solved
+#: yet (a hypothesis's added mass moves the roots a little; the warm start's checks refuse what moved too far). At
+#: most this many.
 MAX_WARM_STARTS = 64
 _LAST_ROOTS = BoundedCache(MAX_WARM_STARTS)
 
@@ -353,7 +354,7 @@ def _nearest_start(last: tuple[np.ndarray, np.ndarray], tension: np.ndarray) -> 
 
     One row kept per model made every row start from the last one: a setup's tests at 4.0 and 4.6 MN then
     started each other's roots, whose real parts (the damper's share of ζ changes with the tension) were off
-    by up to 0.6 of a root's spacing in 1/s, and the secant landed on the damper's real root or failed: a
+    by up to 0.6 1/s, and the secant landed on the damper's real root or failed: a
     damped stay's diagnosis solved a sixth of its rows cold (6 ms each against 0.1 ms warm).
     """
     tensions, roots = last
