@@ -95,7 +95,7 @@ def test_a_dask_local_cluster_gives_the_same_rows(archive, tracked, tmp_path):
     assert len(dask) == 72
     columns = ["cable", "record", "record_id", "start_time", "status", "modes", "frequencies", "frequency_sigma",
                "tension", "tension_sigma", "temperature", "tension_normalised", "level"]
-    pd.testing.assert_frame_equal(local[columns], dask[columns])  # every row, to the last bit
+    pd.testing.assert_frame_equal(local[columns], dask[columns], check_exact=True)  # every row, to the last bit
     assert summary["cables"] == {"C2": tracked[0]["cables"]["C2"]}  # and so the same event
 
 
