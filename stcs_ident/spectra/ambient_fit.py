@@ -74,7 +74,7 @@ from .whittle import (
     null_neg_log_likelihood,
 )
 
-__all__ = ["AmbientFit", "fejer_lorentzian", "fit_ambient", "widen_to_spread"]
+__all__ = ["AmbientFit", "fejer_lorentzian", "fisher_scoring", "fit_ambient", "widen_to_spread"]
 
 # The iterations and the start's ζ grid are :class:`.options.FitOptions`.
 # A pole fitted narrower than this share of a resolution cell (2σ/2π below UNRESOLVED_BINS / T) has its decay rate at
@@ -157,7 +157,7 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     with the background, went negative while its own score was positive: the line shape then kept its largest
     dispersive part and its peak off the pole (a hanger's modes 14-20 at ζ 1.5 %, 60 s, all about 1 % low).
     """
-    bounded = np.concatenate([[False, False], nonnegative])
+    bounded = np.concatenate([np.zeros(theta.size - nonnegative.size, bool), nonnegative])  # after the poles
     at_zero = bounded & (theta <= 1e-12 * np.abs(theta).max())
     held = np.zeros(theta.size, dtype=bool)
     step = np.zeros(theta.size)
@@ -179,13 +179,17 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
     return step
 
 
-def _scoring(theta: np.ndarray, problem: BandProblem, limits,
-             max_iterations: int) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+def fisher_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iterations: int,
+             expected=_expected) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
     """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits).
 
-    Returns θ, whether it converged, and the expected periodogram and its gradient at θ.
+    ``limits`` holds (low, high) of each nonlinear parameter, the first ``len(limits)`` of θ (f and σ of each
+    pole); ``expected(θ, problem)`` gives the expected periodogram and its gradient (one pole: :func:`_expected`;
+    several: :mod:`.two_poles`). Returns θ, whether it converged, and the expected periodogram and its gradient
+    at θ.
     """
-    mean, grad = _expected(theta, problem)
+    poles = len(limits)
+    mean, grad = expected(theta, problem)
     nll = neg_log_likelihood(mean, problem.periodogram)
     for _ in range(max_iterations):
         score = grad.T @ ((problem.periodogram - mean) / mean**2)
@@ -198,14 +202,13 @@ def _scoring(theta: np.ndarray, problem: BandProblem, limits,
             return theta, False, mean, grad  # samples): not converged, and the caller's checks reject the fit
         if not np.all(np.isfinite(step)):
             return theta, False, mean, grad
-        if np.all(np.abs(step[:2]) * np.sqrt(np.maximum(np.diag(fisher)[:2], TINY)) < 1e-4):
+        if np.all(np.abs(step[:poles]) * np.sqrt(np.maximum(np.diag(fisher)[:poles], TINY)) < 1e-4):
             return theta, True, mean, grad
         for _ in range(30):
             trial = theta + step
-            trial[2:] = np.where(problem.nonnegative, np.maximum(trial[2:], 0.0), trial[2:])
-            inside = limits[0][0] < trial[0] < limits[0][1] and limits[1][0] < trial[1] < limits[1][1]
-            if inside:
-                new_mean, new_grad = _expected(trial, problem)
+            trial[poles:] = np.where(problem.nonnegative, np.maximum(trial[poles:], 0.0), trial[poles:])
+            if all(low < value < high for value, (low, high) in zip(trial, limits)):
+                new_mean, new_grad = expected(trial, problem)
                 new_nll = neg_log_likelihood(new_mean, problem.periodogram)
                 if new_nll <= nll:
                     theta, mean, grad, nll = trial, new_mean, new_grad, new_nll
@@ -343,7 +346,7 @@ def fit_ambient(
         (0.0, min(2 * np.pi * half_width, max_damping * 2 * np.pi * f_initial)),
     )
     theta = grid_start(starts, problem, limits, options.ambient_start_damping)
-    theta, ok, mean, grad = _scoring(theta, problem, limits, options.ambient_max_iterations)
+    theta, ok, mean, grad = fisher_scoring(theta, problem, limits, options.ambient_max_iterations)
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
     try:

@@ -42,6 +42,10 @@ class Peak:
     misfit : float
         Of an ambient fit, the misfit-robust 1σ of the frequency over the Fisher information's (about 1 where
         one mode describes its band; 1 for other fits).
+    second_pole : (frequency Hz, 1σ Hz, statistic) or None
+        Of an ambient fit that misfits its band, a second resonance the band holds beside the peak's
+        (:mod:`.two_poles`: its undamped frequency, a 1σ of at least its half-power half-width, and the
+        likelihood-ratio statistic 2 (ℓ₁ − ℓ₂) of two poles against one); None where one pole describes it.
     """
 
     frequency: float
@@ -53,6 +57,7 @@ class Peak:
     snr_db: float
     channel_snr_db: np.ndarray = field(repr=False)
     misfit: float = field(default=1.0, repr=False)
+    second_pole: tuple[float, float, float] | None = field(default=None, repr=False)
 
 
 class PickingResult(Result):

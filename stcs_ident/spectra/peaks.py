@@ -117,6 +117,7 @@ from .peak_filters import at_mains_harmonic, deduplicate, is_mains_hum
 from .peak_result import Peak, PeakResult
 from .refine import refine
 from .residual import residual_candidates
+from .two_poles import second_resonance
 from .wander import common_wander, with_common_wander
 
 __all__ = ["Peak", "PeakResult", "PickingOptions", "find_peaks", "is_mains_hum"]
@@ -444,15 +445,17 @@ def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band, 
     if extra:
         pairs = fitted(sorted([c for c, _ in pairs] + extra, key=lambda c: c.frequency))
     # The kept fits' 1σ widened to the profile likelihood's spread (.profile): only theirs, since the profile
-    # costs several fits' time and refine's decisions need the pole alone.
-    pairs = [(c, fit if fit is None else widen_to_spread(fit)) for c, fit in pairs]
+    # costs several fits' time and refine's decisions need the pole alone; a kept fit that misfits its band is
+    # tested for a second resonance in it (.two_poles).
     snr_db = options.filters.channel_snr_db
     peaks = []
     for c, fit in pairs:
         if fit is None:
             peaks.append(_overview_peak(c, overview, names, snr_db))
         else:
-            peaks.append(_ambient_peak(c, fit, overview, names, snr_db))
+            second = second_resonance(fit)
+            peaks.append(replace(_ambient_peak(c, widen_to_spread(fit), overview, names, snr_db),
+                                 second_pole=second))
     return peaks
 
 

@@ -32,6 +32,7 @@ from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes
 from .plane_options import PlaneOptions
 from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor, shapes_confirm
+from .second_resonances import with_second_resonances
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -333,7 +334,7 @@ def _nominal_family(cable, atts, tension, tension_model: str, plane: str):
 def _with_scale(spectra: TestSpectra, checks: tuple[ScaleCheck, ...]) -> TestSpectra:
     """``spectra`` with its scale checks; where one is implausible, every number doubtful, a warning and a note
     (the peaks' own spacing says the nominal model is on another scale: :mod:`.scale_check`)."""
-    spectra = blends_doubtful(low_mac_doubtful(replace(spectra, scale=checks)))
+    spectra = with_second_resonances(blends_doubtful(low_mac_doubtful(replace(spectra, scale=checks))))
     bad = spectra.implausible_scale
     if not bad:
         return spectra
