@@ -108,3 +108,33 @@ def test_a_deck_mode_merged_with_a_cable_mode_is_reported(monkeypatch):
             assert min(abs(f - s) for s in case.structural) <= 3 * u, (seed, f, u, case.structural)
             assert any(note.kind == "second_resonance" and f"{f:.4f}" in str(note) for note in r.notes)
     assert reported >= 4
+
+
+@pytest.mark.slow
+def test_a_record_read_in_one_plane_widens_a_misfitting_mode():
+    """The biaxial bridge records reduced to their in-plane channels without directions (as a user's record
+    without them is read): a mode whose fit misfits its band has its 1σ widened as a plane's would be (a note
+    says so). Measured on seeds 400-439, stays: the modes within 2 % of a structural frequency 45.5 → 80.0 %
+    within 1σ, 90.9 → 94.5 % within 3σ. Here seeds 500-519 (not looked at before): at least 60 % within 1σ,
+    which the unwidened 1σ (45 %) does not reach, and 90 % within 3σ."""
+    from stcs_ident.core.record import Record
+
+    z, notes = [], 0
+    for seed in range(500, 520):
+        case = make_bridge_case("stay", seed, layout="biaxial")
+        keep = [i for i, d in enumerate(case.record.channel_directions) if d == "in"]
+        record = Record(acceleration=case.record.acceleration[:, keep], sampling_rate=case.record.sampling_rate,
+                        channel_names=tuple(case.record.channel_names[i] for i in keep),
+                        channel_positions=case.record.channel_positions[keep])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = analyse_record(case.campaign, case.test, record, "x")
+        notes += sum(n.kind == "misfit" for n in r.notes)
+        for mode, f, u in zip(r.modes, r.frequencies, r.uncertainty):
+            true = case.truth["in"][mode - 1]
+            if min(abs(true - s) for s in case.structural) < 0.02 * true:
+                z.append(abs(f - true) / u)
+    z = np.array(z)
+    assert z.size >= 15 and notes >= 5
+    assert np.mean(z <= 1) >= 0.6, np.sort(z)
+    assert np.mean(z <= 3) >= 0.9, np.sort(z)

@@ -29,7 +29,7 @@ from .numbering import Numbering, number_modes
 from .options import PickingOptions
 from .peak_result import PickingResult
 from .peaks import PeakResult, find_peaks
-from .plane_analysis import PlanesOutcome, analyse_planes
+from .plane_analysis import PlanesOutcome, analyse_planes, misfit_uncertainty
 from .plane_options import PlaneOptions
 from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor, shapes_confirm
 from .second_resonances import with_second_resonances
@@ -260,6 +260,11 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                              tension_model=tension_model)
     order = [i for i in np.argsort(numbering.modes) if numbering.modes[i] > 0]
     peaks = result.peaks
+    # A numbered mode whose fit misfits its band (a deck's mode merged with it, which a record read in one plane
+    # cannot see apart) has its 1σ widened as a plane's would be without an axial channel (.plane_analysis).
+    widened = {i: misfit_uncertainty(float(unc[i]), peaks[i]) for i in order}
+    widened = {i: u for i, u in widened.items() if u is not None}
+    unc = np.array([widened.get(i, u) for i, u in enumerate(unc)], float)
     macs, shapes = _operating_shapes(record, [peaks[i] for i in order], [int(numbering.modes[i]) for i in order],
                                      numbering, cable, atts, test.tension, tension_model)
     spectra = TestSpectra(
@@ -275,7 +280,9 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
                                       for i in order]),
         nominal_frequencies=np.asarray(nominal, float),
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
-        plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),),
+        plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),)
+        + tuple(Note.plain("misfit", f"mode {int(numbering.modes[i])}: 1σ widened by its own half-power half-width, "
+                                     "its fit misfits its band (a resonance merged with it?)") for i in widened),
     )
     if shapes_confirm(macs, ("in",) * len(order), "in"):  # the shapes confirm the numbers: no slip to look for
         return _with_scale(spectra, ())
