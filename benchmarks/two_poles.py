@@ -9,7 +9,7 @@ pole (its threshold's calibration) and under two, and the second resonances repo
 - ``bridge``: :func:`benchmarks.plane_records.make_bridge_case` records (``--layout``), the second poles reported
   as structural and how many lie within 3σ of a structural frequency (a deck's mode or its harmonic).
 
-    python benchmarks/two_poles.py null [--records 3000] [--seed 2]
+    python benchmarks/two_poles.py null [--records 3000] [--seed 2] [--durations 30 60 120 600]
     python benchmarks/two_poles.py two [--duration 120] [--separation 8] [--ratio 0.5]
     python benchmarks/two_poles.py bridge [--kind stay] [--layout biaxial] [--seed 200] [--records 30]
 """
@@ -47,11 +47,11 @@ def band_fit(x, f0, half_width, zeta):
     return fit_ambient(dft, n, FS, f0, half_width, np.ones(x.shape[1]), peak_width=2 * zeta * f0, spread=False)
 
 
-def null(records: int, seed: int) -> None:
+def null(records: int, seed: int, durations=(30.0, 60.0, 120.0, 600.0)) -> None:
     rng = np.random.default_rng(seed)
     rows = []
     for _ in range(records):
-        duration = float(rng.choice([30.0, 60.0, 120.0, 600.0]))
+        duration = float(rng.choice(durations))
         zeta = float(np.exp(rng.uniform(np.log(0.002), np.log(0.02))))
         f0 = rng.uniform(5, 15)
         x = np.outer(mode(rng, int(FS * duration), f0, zeta), rng.uniform(0.3, 1.0, 2))
@@ -64,7 +64,7 @@ def null(records: int, seed: int) -> None:
     print(f"{len(a)} single-mode bands: statistic 2Δℓ quantiles 50 / 90 / 99 / 99.9 % "
           + " / ".join(f"{np.quantile(a[:, 1], q):.1f}" for q in (0.5, 0.9, 0.99, 0.999))
           + f", largest {a[:, 1].max():.1f}; at the threshold {THRESHOLD:g} or above: {int(np.sum(a[:, 1] >= THRESHOLD))}")
-    for duration in (30.0, 60.0, 120.0, 600.0):
+    for duration in durations:
         s = a[a[:, 0] == duration, 1]
         print(f"  {duration:4.0f} s: {s.size} bands, median {np.median(s):.1f}, 99 % {np.quantile(s, 0.99):.1f}, "
               f"largest {s.max():.1f}")
@@ -114,6 +114,8 @@ def main(argv=None) -> int:
     parser.add_argument("--records", type=int, default=None)
     parser.add_argument("--seed", type=int, default=None)
     parser.add_argument("--duration", type=float, default=120.0)
+    parser.add_argument("--durations", type=float, nargs="+", default=(30.0, 60.0, 120.0, 600.0),
+                        help="null: the record lengths drawn from, s")
     parser.add_argument("--separation", type=float, default=8.0)
     parser.add_argument("--ratio", type=float, default=0.5)
     parser.add_argument("--kind", default="stay", choices=("stay", "hanger"))
@@ -122,7 +124,7 @@ def main(argv=None) -> int:
     print_header()
     t0 = time.perf_counter()
     if args.case == "null":
-        null(args.records or 3000, 2 if args.seed is None else args.seed)
+        null(args.records or 3000, 2 if args.seed is None else args.seed, tuple(args.durations))
     elif args.case == "two":
         two(args.records or 100, 6 if args.seed is None else args.seed, args.duration, args.separation, args.ratio)
     else:
