@@ -32,7 +32,7 @@ from .peaks import PeakResult, find_peaks
 from .plane_analysis import PlanesOutcome, analyse_planes, misfit_uncertainty
 from .plane_options import PlaneOptions
 from .scale_check import MIN_PEAKS, ScaleCheck, check_scale, round_factor, shapes_confirm
-from .second_resonances import with_second_resonances
+from .second_resonances import MISFIT_QUESTION, with_second_resonances
 from .structural import mac, model_shapes, shape_is_meaningful
 
 #: Modes searched by default: enough for identification, few enough that a
@@ -282,7 +282,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
         options=options, record_replaced=tuple(record.replaced), mac=macs, shapes=shapes,
         plane_options=plane_options, plane_notes=(Note.plain("directions", directions_note(record)),)
         + tuple(Note.plain("misfit", f"mode {int(numbering.modes[i])}: 1σ widened by its own half-power half-width, "
-                                     "its fit misfits its band (a resonance merged with it?)") for i in widened),
+                                     f"its fit misfits its band{MISFIT_QUESTION}") for i in widened),
     )
     if shapes_confirm(macs, ("in",) * len(order), "in"):  # the shapes confirm the numbers: no slip to look for
         return _with_scale(spectra, ())
@@ -385,7 +385,7 @@ def _plane_spectra(test: Test, record: Record, path: str, outcome: PlanesOutcome
                                          f"half-width, a structural resonance at {m.overlapped_by:.4f} Hz "
                                          "overlaps it") for m in outcome.modes if m.overlapped_by is not None)
     notes += tuple(Note.plain("misfit", f"{PLANE_NAMES[m.plane]} mode {m.mode}: 1σ widened by its own half-power "
-                                        "half-width, its fit misfits its band (a resonance merged with it?)")
+                                        f"half-width, its fit misfits its band{MISFIT_QUESTION}")
                    for m in outcome.modes if m.misfit)
     spectra = TestSpectra(
         name=test.name, record=path, modes=tuple(m.mode for m in outcome.modes),

@@ -21,12 +21,15 @@ import numpy as np
 from ..core.notes import Note
 from ..core.planes import PLANE_NAMES
 
-__all__ = ["with_second_resonances"]
+__all__ = ["MISFIT_QUESTION", "with_second_resonances"]
+
+#: The end of a ``misfit`` note (:mod:`.pipeline`), the question a second resonance found in the band answers.
+MISFIT_QUESTION = " (a resonance merged with it?)"
 
 
 def with_second_resonances(spectra):
-    """``spectra`` with the second poles of its numbered modes' bands in ``structural`` (module docstring) and a
-    note naming them; unchanged where there are none."""
+    """``spectra`` with the second poles of its numbered modes' bands in ``structural`` (module docstring), each
+    said in its mode's note (:func:`_merged_notes`); unchanged where there are none."""
     planes = spectra.planes is not None
     results = dict(spectra.plane_peaks) if planes else {"in": spectra.peaks}
     reported = [(float(f), float(u)) for f, u in zip(spectra.frequencies, spectra.uncertainty)]
@@ -37,7 +40,7 @@ def with_second_resonances(spectra):
         peak = next((p for p in results[plane].peaks if p.frequency == f), None)
         if peak is not None and peak.second_pole is not None:
             found.append((peak.second_pole, mode, plane, float(f)))
-    added, cable_like, notes = [], [], []
+    added, cable_like, notes = [], [], {}
     for (f2, u2, statistic), mode, plane, own in sorted(found, key=lambda item: -item[0][2]):
         if any(abs(f2 - f) <= 3.0 * u for f, u in reported if f != own):  # a peak reported already: within its 3σ
             continue
@@ -45,15 +48,13 @@ def with_second_resonances(spectra):
         evidence = f"2Δℓ = {statistic:.0f}, two poles against one"
         missing = _expected_missing(spectra, plane, f2, u2)
         reported.append((f2, u2))
+        what = f"a second resonance at {f2:.4f} ± {u2:.2g} Hz in its band ({evidence})"
         if missing is not None:  # where a mode of the plane's family not numbered is expected: not told apart
             cable_like.append((float(f2), float(u2), plane))
-            notes.append(Note.plain("second_resonance", f"{name}: a second resonance at {f2:.4f} ± {u2:.2g} Hz in "
-                                                        f"its band ({evidence}), where mode {missing} is expected: "
-                                                        "unassigned"))
+            notes[name] = f"{what}, where mode {missing} is expected: unassigned"
             continue
         added.append((float(f2), float(u2), f"a second pole in {name}'s band ({evidence})"))
-        notes.append(Note.plain("second_resonance", f"{name}: a second resonance at {f2:.4f} ± {u2:.2g} Hz in its "
-                                                    f"band ({evidence}): structural"))
+        notes[name] = f"{what}: structural"
     if not notes:
         return spectra
     structural = tuple(sorted(spectra.structural + tuple(added), key=lambda s: s[0]))
@@ -62,7 +63,22 @@ def with_second_resonances(spectra):
     if planes and cable_like:
         unassigned_planes = tuple(unassigned_planes or ()) + tuple(plane for _, _, plane in cable_like)
     return replace(spectra, structural=structural, unassigned=unassigned, unassigned_planes=unassigned_planes,
-                   plane_notes=spectra.plane_notes + tuple(notes))
+                   plane_notes=_merged_notes(spectra.plane_notes, notes))
+
+
+def _merged_notes(plane_notes: tuple, found: dict) -> tuple:
+    """``plane_notes`` with each mode's second resonance said once: in the mode's ``misfit`` note where it has one
+    (its fit misfits its band: this is what it holds), else in a note of its own (kind ``second_resonance``)."""
+    out, said = [], set()
+    for note in plane_notes:
+        name = next((n for n in found if note.kind == "misfit" and str(note).startswith(f"{n}: ")), None)
+        if name is None:
+            out.append(note)
+            continue
+        out.append(Note.plain("second_resonance", f"{str(note).replace(MISFIT_QUESTION, '')}: {found[name]}"))
+        said.add(name)
+    out += [Note.plain("second_resonance", f"{name}: {text}") for name, text in found.items() if name not in said]
+    return tuple(out)
 
 
 def _expected_missing(spectra, plane: str, frequency: float, uncertainty: float) -> int | None:
