@@ -180,7 +180,7 @@ def _scoring_step(theta, score, fisher, nonnegative) -> np.ndarray:
 
 
 def fisher_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iterations: int,
-             expected=_expected) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+                   expected=_expected) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
     """Fisher scoring with step halving (mean positive, likelihood not falling, powers ≥ 0, inside the limits).
 
     ``limits`` holds (low, high) of each nonlinear parameter, the first ``len(limits)`` of θ (f and σ of each
