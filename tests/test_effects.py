@@ -5,6 +5,7 @@ effect, and a toy effect added from this file alone that the diagnosis can name.
 from __future__ import annotations
 
 import ast
+import functools
 import json
 import math
 from dataclasses import replace
@@ -57,19 +58,24 @@ def _strings(tree: ast.AST):
             yield node
 
 
+@functools.cache
+def _parsed() -> tuple:
+    return tuple((path, ast.parse(path.read_text(encoding="utf-8"))) for path in sorted(PACKAGE.rglob("*.py")))
+
+
 def _modules():
-    for path in sorted(PACKAGE.rglob("*.py")):
-        yield path, ast.parse(path.read_text(encoding="utf-8"))
+    yield from _parsed()  # each module parsed once per session (the package's every file, for several checks)
 
 
 def test_each_effect_name_is_defined_in_exactly_one_module_of_the_effects_package():
+    defining: dict = {}  # the value of each `name = "<constant>"` assignment -> the modules that make it
+    for path, tree in _modules():
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "name" for t in node.targets)
+                    and isinstance(node.value, ast.Constant)):
+                defining.setdefault(node.value.value, []).append(path.relative_to(PACKAGE).as_posix())
     for name in BUILT_IN:
-        defining = [path.relative_to(PACKAGE).as_posix() for path, tree in _modules()
-                    for node in ast.walk(tree)
-                    if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "name"
-                                                            for t in node.targets)
-                    and isinstance(node.value, ast.Constant) and node.value.value == name]
-        assert defining == [f"effects/{name}.py"], (name, defining)
+        assert defining.get(name, []) == [f"effects/{name}.py"], (name, defining.get(name, []))
 
 
 def test_no_other_list_of_effect_names_remains_in_the_package():
