@@ -32,7 +32,7 @@ from scipy.signal import lfilter
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import print_header
 
-from stcs_ident.spectra.ambient_fit import _marginal_covariance, _serial_product, fit_ambient, mode_shape
+from stcs_ident.spectra.ambient_fit import _serial_product, fit_ambient, marginal_covariance, mode_shape
 from stcs_ident.spectra.decay_fit import pole_statistics
 from stcs_ident.spectra.whittle import TINY, fejer_lorentzian, neg_log_likelihood
 
@@ -139,7 +139,7 @@ def joint(dft, n_samples, fs, f0, s0, neighbours, noise_scale, half_width, max_d
     keep = ~(bounded & (theta <= 0))
     gk = grad[:, keep] / mean[:, None]
     F = gk.T @ gk
-    cov = _marginal_covariance(F)
+    cov = marginal_covariance(F)
     scores = grad[:, keep] * ((I - mean) / mean**2)[:, None]
     inv = np.linalg.pinv(F, rcond=1e-12)
     sand = (inv @ (scores.T @ scores) @ inv)[:2, :2]

@@ -154,7 +154,7 @@ def test_a_line_narrower_than_the_record_resolves_has_its_cells_1_sigma_and_no_d
     of a bin, its 1σ is the resolution cell's (1/(T√12)) and its damping ratio not estimated -- whatever that
     degenerate information gives: a singular one (LAPACK refuses it) or a negative variance once refused the
     whole fit, and the mode went unreported (it did when the start's likelihoods moved by 1e-13)."""
-    computed = ambient_fit._robust_covariance
+    computed = ambient_fit.robust_covariance
 
     def degenerate(grad, mean, periodogram):
         cov, misfit = computed(grad, mean, periodogram)
@@ -162,7 +162,7 @@ def test_a_line_narrower_than_the_record_resolves_has_its_cells_1_sigma_and_no_d
             raise np.linalg.LinAlgError("singular")
         return (-np.abs(cov) if cov[0, 0] > 1.0 and information == "negative" else cov), misfit
 
-    monkeypatch.setattr(ambient_fit, "_robust_covariance", degenerate)
+    monkeypatch.setattr(ambient_fit, "robust_covariance", degenerate)
     _, record, true = _stay_record(153.68575255863922, 81.67091711872052, 233468.80996978586, 1663031747.683127,
                                    0.6200151373534588, 5274501.347228832, [7.23824987128033, 12.94936552606637],
                                    0.0036261627365435077, 4.157802783979756, 844493949, duration=30.0)

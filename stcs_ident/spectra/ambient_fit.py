@@ -74,7 +74,8 @@ from .whittle import (
     null_neg_log_likelihood,
 )
 
-__all__ = ["AmbientFit", "fejer_lorentzian", "fisher_scoring", "fit_ambient", "widen_to_spread"]
+__all__ = ["AmbientFit", "fejer_lorentzian", "fisher_scoring", "fit_ambient", "marginal_covariance",
+           "robust_covariance", "widen_to_spread"]
 
 # The iterations and the start's ζ grid are :class:`.options.FitOptions`.
 # A pole fitted narrower than this share of a resolution cell (2σ/2π below UNRESOLVED_BINS / T) has its decay rate at
@@ -219,29 +220,34 @@ def fisher_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iteratio
     return theta, False, mean, grad
 
 
-def _robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray) -> tuple[np.ndarray, float]:
-    """Covariance of (f, σ): the inverse Fisher information, widened to the sandwich estimate where larger;
-    and the frequency's widening factor (:attr:`AmbientFit.misfit`).
+def robust_covariance(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray,
+                      keep=(0, 1)) -> tuple[np.ndarray, float]:
+    """Covariance of the parameters ``keep`` (a pole's (f, σ): the first two of a one-pole fit), the others
+    marginalised: the inverse Fisher information, widened to the sandwich estimate where larger; and the first
+    one's widening factor (:attr:`AmbientFit.misfit`).
 
     The sandwich F⁻¹ J F⁻¹, J = Σ_k s_k s_kᵀ with the per-bin scores
     s_k = ∂E_k (I_k − E_k) / E_k², equals F⁻¹ when the model is right and
     grows when it is not (wrong neighbour shapes, a second mode in the
     band): each variance is the larger of the two, the correlation F's.
     """
+    keep = list(keep)
     fisher = _fisher(grad, mean)
-    cov = _marginal_covariance(fisher)
+    cov = marginal_covariance(fisher, keep)
     scores = grad * ((periodogram - mean) / mean**2)[:, None]
     inverse = np.linalg.pinv(fisher, rcond=1e-12)
-    sandwich = (inverse @ (scores.T @ scores) @ inverse)[:2, :2]
+    sandwich = (inverse @ (scores.T @ scores) @ inverse)[np.ix_(keep, keep)]
     widen = np.sqrt(np.maximum(np.diag(sandwich) / np.diag(cov), 1.0))
     return cov * np.outer(widen, widen), float(widen[0])
 
 
-def _marginal_covariance(fisher: np.ndarray) -> np.ndarray:
-    """Covariance of the first two parameters with the others marginalised (Schur complement)."""
-    a = fisher[:2, :2]
-    b = fisher[:2, 2:]
-    d = fisher[2:, 2:]
+def marginal_covariance(fisher: np.ndarray, keep=(0, 1)) -> np.ndarray:
+    """Covariance of the parameters ``keep`` with the others marginalised (Schur complement)."""
+    keep = list(keep)
+    rest = [j for j in range(fisher.shape[0]) if j not in keep]
+    a = fisher[np.ix_(keep, keep)]
+    b = fisher[np.ix_(keep, rest)]
+    d = fisher[np.ix_(rest, rest)]
     return np.linalg.inv(a - b @ np.linalg.pinv(d, rcond=1e-12) @ b.T)
 
 
@@ -350,7 +356,7 @@ def fit_ambient(
     # Power coefficients held at zero by their bound are not free: leave them out of the information.
     free = np.concatenate([[True, True], ~(problem.nonnegative & (theta[2:] <= 0))])
     try:
-        cov, misfit = _robust_covariance(grad[:, free], mean, problem.periodogram)
+        cov, misfit = robust_covariance(grad[:, free], mean, problem.periodogram)
     except np.linalg.LinAlgError:
         cov, misfit = None, 1.0
     duration = n_samples * dt

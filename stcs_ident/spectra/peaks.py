@@ -445,17 +445,15 @@ def _refine_ambient(x, fs, events, overview: Overview, candidates, names, band, 
     if extra:
         pairs = fitted(sorted([c for c, _ in pairs] + extra, key=lambda c: c.frequency))
     # The kept fits' 1σ widened to the profile likelihood's spread (.profile): only theirs, since the profile
-    # costs several fits' time and refine's decisions need the pole alone; a kept fit that misfits its band is
-    # tested for a second resonance in it (.two_poles).
+    # costs several fits' time and refine's decisions need the pole alone.
     snr_db = options.filters.channel_snr_db
     peaks = []
     for c, fit in pairs:
         if fit is None:
             peaks.append(_overview_peak(c, overview, names, snr_db))
-        else:
-            second = second_resonance(fit)
+        else:  # a kept fit that misfits its band is tested for a second resonance in it (.two_poles)
             peaks.append(replace(_ambient_peak(c, widen_to_spread(fit), overview, names, snr_db),
-                                 second_pole=second))
+                                 second_pole=second_resonance(fit)))
     return peaks
 
 

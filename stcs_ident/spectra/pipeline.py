@@ -262,8 +262,7 @@ def analyse_record(campaign: Campaign, test: Test, record: Record, path: str, *,
     peaks = result.peaks
     # A numbered mode whose fit misfits its band (a deck's mode merged with it, which a record read in one plane
     # cannot see apart) has its 1σ widened as a plane's would be without an axial channel (.plane_analysis).
-    widened = {i: misfit_uncertainty(float(unc[i]), peaks[i]) for i in order}
-    widened = {i: u for i, u in widened.items() if u is not None}
+    widened = {i: u for i in order if (u := misfit_uncertainty(float(unc[i]), peaks[i])) is not None}
     unc = np.array([widened.get(i, u) for i, u in enumerate(unc)], float)
     macs, shapes = _operating_shapes(record, [peaks[i] for i in order], [int(numbering.modes[i]) for i in order],
                                      numbering, cable, atts, test.tension, tension_model)

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ambient_fit import AmbientFit, fisher_scoring
+from .ambient_fit import AmbientFit, fisher_scoring, robust_covariance
 from .decay_fit import pole_statistics
 from .whittle import BandProblem, designs, fejer_lorentzian, neg_log_likelihood, whittle_linear_many
 
@@ -94,30 +94,6 @@ def _expected(theta: np.ndarray, problem: BandProblem):
     return basis @ theta[4:], grad
 
 
-def _marginal(fisher: np.ndarray, keep) -> np.ndarray:
-    """Covariance of the parameters ``keep`` with the others marginalised (Schur complement)."""
-    rest = np.setdiff1d(np.arange(fisher.shape[0]), keep)
-    a, b, d = fisher[np.ix_(keep, keep)], fisher[np.ix_(keep, rest)], fisher[np.ix_(rest, rest)]
-    return np.linalg.inv(a - b @ np.linalg.pinv(d, rcond=1e-12) @ b.T)
-
-
-def _covariances(grad: np.ndarray, mean: np.ndarray, periodogram: np.ndarray, free: np.ndarray):
-    """Each pole's (f, σ) covariance, marginalised and widened to the sandwich where larger (as
-    :func:`.ambient_fit._robust_covariance`)."""
-    g = grad[:, free] / mean[:, None]
-    fisher = g.T @ g
-    scores = grad[:, free] * ((periodogram - mean) / mean**2)[:, None]
-    inverse = np.linalg.pinv(fisher, rcond=1e-12)
-    sandwich = inverse @ (scores.T @ scores) @ inverse
-    out = []
-    for j in range(2):
-        keep = [2 * j, 2 * j + 1]
-        cov = _marginal(fisher, keep)
-        widen = np.sqrt(np.maximum(np.diag(sandwich)[keep] / np.diag(cov), 1.0))
-        out.append(cov * np.outer(widen, widen))
-    return out
-
-
 def two_poles(problem: BandProblem, theta: np.ndarray, limits, max_iterations: int = 60) -> TwoPoles | None:
     """One pole or two in the band of a one-pole fit (module docstring).
 
@@ -170,7 +146,8 @@ def two_poles(problem: BandProblem, theta: np.ndarray, limits, max_iterations: i
         grad = np.column_stack([grad[:, order], grad[:, 8:]])
     free = np.concatenate([np.ones(4, bool), ~(pair.nonnegative & (fitted[4:] <= 0))])
     try:
-        covariances = _covariances(grad, mean, periodogram, free)
+        covariances = [robust_covariance(grad[:, free], mean, periodogram, keep=(2 * j, 2 * j + 1))[0]
+                       for j in range(2)]
     except np.linalg.LinAlgError:
         covariances = [np.full((2, 2), np.nan)] * 2
     resolved = abs(fitted[2] - fitted[0]) >= RESOLVED_CELLS / cells
