@@ -11,8 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..forward.roots import FORCE_NUMPY
+
+try:  # the optional compiled kernel of whittle_linear_many (setup.py); the same numerics, no per-call overhead
+    from . import _whittle_kernel
+except ImportError:  # pragma: no cover - depends on the install
+    _whittle_kernel = None
+
 __all__ = ["TINY", "BandProblem", "band_design", "designs", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
-           "null_neg_log_likelihood", "whittle_linear_many"]
+           "null_neg_log_likelihood", "whittle_linear_many", "whittle_linear_many_numpy"]
 
 TINY = np.finfo(float).tiny
 
@@ -133,8 +140,19 @@ def _whittle_linear(
     the band's edges that sum to a constant) and halves each step until the mean stays positive
     and the likelihood does not fall, so it never ends worse than the flat
     background. Coefficients that are powers stay ≥ 0: a neighbour's tail
-    taken negative would carve a bump out of a constant and mimic a mode.
+    taken negative would carve a bump out of a constant and mimic a mode. By the compiled kernel where it is
+    built (:func:`whittle_linear_many` of one basis: the same steps), else :func:`_whittle_linear_numpy`.
     """
+    if _whittle_kernel is None or FORCE_NUMPY:
+        return _whittle_linear_numpy(basis, periodogram, nonnegative, iterations)
+    lin, nll = whittle_linear_many(basis[None], periodogram, nonnegative, iterations)
+    return lin[0], float(nll[0])
+
+
+def _whittle_linear_numpy(
+    basis: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray, iterations: int = 8
+) -> tuple[np.ndarray, float]:
+    """:func:`_whittle_linear` in numpy (the reference of the compiled kernel)."""
     lin = np.zeros(basis.shape[1])
     lin[-2] = np.mean(periodogram)
     if nonnegative[-1]:  # the background as two nonnegative edge ramps: both at the mean make it flat
@@ -223,9 +241,23 @@ def whittle_linear_many(bases: np.ndarray, periodogram: np.ndarray, nonnegative:
     """:func:`_whittle_linear` of many bases (c, m, q) at once: coefficients (c, q) and -log-likelihoods (c,).
 
     The same steps candidate by candidate (the flat start, the weighted least squares with the active set,
-    the step halved until the likelihood does not fall, a candidate whose step cannot be made to stops), in
-    a few array operations for all: the start grid of every band's fit, a third of an ambient record's
-    picking, was numpy's per-call overhead on 6 × 6 systems."""
+    the step halved until the likelihood does not fall, a candidate whose step cannot be made to stops). By
+    the compiled kernel where it is built (``_whittle_kernel.c``: each candidate's arithmetic in a fixed
+    order, whatever the batch), else in a few array operations for all (:func:`whittle_linear_many_numpy`,
+    the reference): the start grids of the bands' fits and the profiles' grids were half of a bridge record's
+    analysis, numpy's per-call overhead and temporaries on 6 × 6 systems."""
+    if _whittle_kernel is None or FORCE_NUMPY:
+        return whittle_linear_many_numpy(bases, periodogram, nonnegative, iterations)
+    c, _, q = bases.shape
+    lin, nll = _whittle_kernel.linear_many(np.ascontiguousarray(bases, dtype=np.float64),
+                                           np.ascontiguousarray(periodogram, dtype=np.float64),
+                                           np.ascontiguousarray(nonnegative, dtype=np.uint8), int(iterations))
+    return np.frombuffer(lin, dtype=np.float64).reshape(c, q).copy(), np.frombuffer(nll, dtype=np.float64).copy()
+
+
+def whittle_linear_many_numpy(bases: np.ndarray, periodogram: np.ndarray, nonnegative: np.ndarray,
+                              iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`whittle_linear_many` in numpy, all candidates in a few array operations (the kernel's reference)."""
     c, _, q = bases.shape
     lin = np.zeros((c, q))
     lin[:, -2] = np.mean(periodogram)

@@ -1,0 +1,212 @@
+/*
+ * Compiled kernel of the Whittle fit's linear terms (optional): whittle.py's whittle_linear_many, one
+ * candidate at a time. For each candidate's real basis (bins × q columns) and the band's periodogram, the
+ * linear coefficients by damped Fisher scoring (iteratively reweighted least squares) from the flat mean, the
+ * powers held >= 0 by dropping the most negative column in turn, each step halved until the likelihood does
+ * not fall (at most 20 times; a candidate whose step cannot be made to stops), and the -log-likelihood
+ * sum(log E + I / E), infinite where a mean is not positive.
+ *
+ * It exists because the profile likelihood's grids and the fits' start grids are hundreds of candidates of
+ * a few hundred bins and five to eight columns: numpy's per-call overhead and its temporaries over the
+ * candidates' stacked arrays cost more than the arithmetic. whittle.py stays the reference (STCS_IDENT_NUMPY=1
+ * runs it) and the tests compare the two. Each candidate's arithmetic is its own, in a fixed order: the result
+ * does not depend on how many candidates are evaluated together, nor on threads (a BLAS product's last bits
+ * do, which made a Dask run's tensions differ from a local run's by 1e-9).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_COLUMNS 32
+#define HALVINGS 20
+#define RIDGE 1e-12
+
+/* -log-likelihood of the mean e against the periodogram I over m bins: +inf where a mean is <= 0, NaN
+ * propagated (as whittle.py's _neg_log_likelihood_many). */
+static double neg_log_likelihood(const double *e, const double *I, Py_ssize_t m) {
+    double total = 0.0;
+    for (Py_ssize_t k = 0; k < m; k++) {
+        if (e[k] <= 0.0) return INFINITY;
+        total += log(e[k]) + I[k] / e[k];
+    }
+    return total;
+}
+
+static void mean_of(const double *B, const double *lin, Py_ssize_t m, int q, double *e) {
+    for (Py_ssize_t k = 0; k < m; k++) {
+        const double *row = B + k * q;
+        double s = 0.0;
+        for (int j = 0; j < q; j++) s += row[j] * lin[j];
+        e[k] = s;
+    }
+}
+
+/* x = A⁻¹ b for a q × q matrix (row-major, overwritten) by LU with partial pivoting; NaN where a pivot is 0. */
+static void solve(double *A, double *b, int q, double *x) {
+    for (int c = 0; c < q; c++) {
+        int p = c;
+        for (int r = c + 1; r < q; r++)
+            if (fabs(A[r * q + c]) > fabs(A[p * q + c])) p = r;
+        if (p != c) {
+            for (int j = 0; j < q; j++) {
+                double t = A[c * q + j]; A[c * q + j] = A[p * q + j]; A[p * q + j] = t;
+            }
+            double t = b[c]; b[c] = b[p]; b[p] = t;
+        }
+        double pivot = A[c * q + c];
+        if (pivot == 0.0) {
+            for (int j = 0; j < q; j++) x[j] = NAN;
+            return;
+        }
+        for (int r = c + 1; r < q; r++) {
+            double f = A[r * q + c] / pivot;
+            if (f == 0.0) continue;
+            for (int j = c; j < q; j++) A[r * q + j] -= f * A[c * q + j];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int r = q - 1; r >= 0; r--) {
+        double s = b[r];
+        for (int j = r + 1; j < q; j++) s -= A[r * q + j] * x[j];
+        x[r] = s / A[r * q + r];
+    }
+}
+
+/* min ||w (B c − I)|| with c >= 0 where `nonnegative`, by dropping the most negative bounded column in turn
+ * (whittle.py's _weighted_least_squares_many for one candidate: a dropped column's row and column of the
+ * scaled normal matrix zero but for the ridge, its coefficient 0). */
+static void weighted_least_squares(const double *B, const double *I, const double *w, const unsigned char *nonneg,
+                                   Py_ssize_t m, int q, double *coef) {
+    double full[MAX_COLUMNS * MAX_COLUMNS] = {0}, rhs[MAX_COLUMNS] = {0}, a[MAX_COLUMNS];
+    for (Py_ssize_t k = 0; k < m; k++) {
+        const double *row = B + k * q;
+        double wk = w[k], bk = I[k] * wk;
+        for (int i = 0; i < q; i++) a[i] = row[i] * wk;
+        for (int i = 0; i < q; i++) {
+            double ai = a[i];
+            for (int j = i; j < q; j++) full[i * q + j] += ai * a[j];
+            rhs[i] += ai * bk;
+        }
+    }
+    for (int i = 0; i < q; i++)
+        for (int j = 0; j < i; j++) full[i * q + j] = full[j * q + i];
+    unsigned char free_[MAX_COLUMNS], bounded[MAX_COLUMNS];
+    for (int j = 0; j < q; j++) { free_[j] = 1; bounded[j] = nonneg[j]; coef[j] = 0.0; }
+    double normal[MAX_COLUMNS * MAX_COLUMNS], scale[MAX_COLUMNS], r[MAX_COLUMNS], x[MAX_COLUMNS];
+    for (int pass = 0; pass < q; pass++) {
+        for (int i = 0; i < q; i++) {
+            double d = free_[i] ? full[i * q + i] : 0.0;
+            scale[i] = sqrt(d > DBL_MIN ? d : DBL_MIN);
+        }
+        for (int i = 0; i < q; i++) {
+            for (int j = 0; j < q; j++)
+                normal[i * q + j] = (free_[i] && free_[j] ? full[i * q + j] : 0.0) / (scale[i] * scale[j]);
+            normal[i * q + i] += RIDGE;
+            r[i] = (free_[i] ? rhs[i] : 0.0) / scale[i];
+        }
+        solve(normal, r, q, x);
+        int worst = -1;
+        double lowest = 0.0;
+        for (int j = 0; j < q; j++) {
+            coef[j] = x[j] / scale[j] * (double)free_[j];
+            double candidate = bounded[j] ? coef[j] : 0.0;
+            if (isnan(candidate)) { worst = -2; break; } /* numpy's argmin stops at a NaN: no column dropped */
+            if (worst == -1 || candidate < lowest) { worst = j; lowest = candidate; }
+        }
+        if (worst == -2) {
+            for (int j = 0; j < q; j++) coef[j] = x[j] / scale[j] * (double)free_[j];
+            break;
+        }
+        if (!(lowest < 0.0)) break;
+        free_[worst] = bounded[worst] = 0;
+    }
+}
+
+/* One candidate: its coefficients (q) and -log-likelihood; work holds 3 m doubles. */
+static double fit_candidate(const double *B, const double *I, const unsigned char *nonneg, Py_ssize_t m, int q,
+                            int iterations, double level, double *lin, double *work) {
+    double *e = work, *trial_e = work + m, *w = work + 2 * m;
+    double target[MAX_COLUMNS], step[MAX_COLUMNS], trial[MAX_COLUMNS];
+    for (int j = 0; j < q; j++) lin[j] = 0.0;
+    lin[q - 2] = level;
+    if (nonneg[q - 1]) lin[q - 1] = level; /* the background as two nonnegative edge ramps: both at the mean */
+    mean_of(B, lin, m, q, e);
+    double nll = neg_log_likelihood(e, I, m);
+    for (int it = 0; it < iterations; it++) {
+        for (Py_ssize_t k = 0; k < m; k++) w[k] = 1.0 / e[k];
+        weighted_least_squares(B, I, w, nonneg, m, q, target);
+        for (int j = 0; j < q; j++) step[j] = target[j] - lin[j];
+        int accepted = 0;
+        for (int h = 0; h < HALVINGS; h++) {
+            for (int j = 0; j < q; j++) trial[j] = lin[j] + step[j];
+            mean_of(B, trial, m, q, trial_e);
+            double trial_nll = neg_log_likelihood(trial_e, I, m);
+            if (trial_nll <= nll) {
+                memcpy(lin, trial, q * sizeof(double));
+                double *t = e; e = trial_e; trial_e = t;
+                nll = trial_nll;
+                accepted = 1;
+                break;
+            }
+            for (int j = 0; j < q; j++) step[j] /= 2;
+        }
+        if (!accepted) break;
+    }
+    return nll;
+}
+
+/* linear_many(bases (c × m × q float64), periodogram (m float64), nonnegative (q uint8), iterations)
+ *   -> (bytes of float64 coefficients, c × q; bytes of float64 -log-likelihoods, c) */
+static PyObject *py_linear_many(PyObject *self, PyObject *args) {
+    PyObject *objs[3];
+    int iterations;
+    if (!PyArg_ParseTuple(args, "OOOi", &objs[0], &objs[1], &objs[2], &iterations)) return NULL;
+    Py_buffer views[3];
+    int got = 0;
+    PyObject *result = NULL;
+    for (; got < 3; got++)
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
+    int q = (int)views[2].len;
+    if (q < 2 || q > MAX_COLUMNS || m < 1 || views[0].len % (m * q * (Py_ssize_t)sizeof(double)) != 0) {
+        PyErr_SetString(PyExc_ValueError, "linear_many: bases must be candidates x bins x 2..32 columns");
+        goto done;
+    }
+    Py_ssize_t c = views[0].len / (m * q * (Py_ssize_t)sizeof(double));
+    const double *B = views[0].buf, *I = views[1].buf;
+    const unsigned char *nonneg = views[2].buf;
+    PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
+    PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
+    double *work = malloc(3 * m * sizeof(double));
+    if (!lin || !nll || !work) {
+        Py_XDECREF(lin); Py_XDECREF(nll); free(work);
+        PyErr_NoMemory();
+        goto done;
+    }
+    double *L = (double *)PyBytes_AS_STRING(lin), *N = (double *)PyBytes_AS_STRING(nll);
+    Py_BEGIN_ALLOW_THREADS
+    double level = 0.0;
+    for (Py_ssize_t k = 0; k < m; k++) level += I[k];
+    level /= (double)m;
+    for (Py_ssize_t i = 0; i < c; i++)
+        N[i] = fit_candidate(B + i * m * q, I, nonneg, m, q, iterations, level, L + i * q, work);
+    Py_END_ALLOW_THREADS
+    free(work);
+    result = Py_BuildValue("NN", lin, nll);
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"linear_many", py_linear_many, METH_VARARGS,
+     "Whittle fits of the linear terms of many candidate bases: coefficients and -log-likelihoods."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_whittle_kernel", NULL, -1, methods};
+
+PyMODINIT_FUNC PyInit__whittle_kernel(void) { return PyModule_Create(&module); }
