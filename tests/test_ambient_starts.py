@@ -82,3 +82,20 @@ def test_the_compiled_kernel_gives_the_numpy_reference_s_fits(seed):
         ref = A._whittle_linear_numpy(problem.fixed, problem.periodogram, problem.nonnegative[2:], iterations=12)
         assert null[1] == pytest.approx(ref[1], rel=1e-12)
         assert np.max(np.abs(null[0] - ref[0])) <= 1e-8 * np.max(np.abs(ref[0]))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_kernel_s_grid_forms_the_bases_designs_forms(seed):
+    """linear_grid (the kernel forms each row's Fejér columns as it fits them) against the numpy reference of
+    designs + whittle_linear_many, on rows in frequency-major order (the rotations reused) and in a shuffled one."""
+    if A._whittle_kernel is None:
+        pytest.skip("the compiled kernel is not built in this install (no C compiler)")
+    problem, f0 = _problem(seed, 2)
+    sigma = 0.01 * 2 * np.pi * f0
+    grid = np.array([[f, s] for f in np.linspace(f0 - 0.1, f0 + 0.1, 9) for s in sigma * np.logspace(-0.6, 0.6, 5)])
+    for rows in (grid, grid[np.random.default_rng(seed).permutation(len(grid))]):
+        lin, nll = A.linear_grid(rows, problem, 4)
+        ref_lin, ref_nll = A.whittle_linear_many_numpy(A.designs(rows, problem), problem.periodogram,
+                                                        problem.nonnegative, 4)
+        assert np.allclose(nll, ref_nll, rtol=1e-12, atol=0)  # rounding (sums and the Fejér sums in another order)
+        assert np.max(np.abs(lin - ref_lin) / np.max(np.abs(ref_lin), axis=1, keepdims=True)) <= 1e-6

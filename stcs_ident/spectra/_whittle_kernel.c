@@ -4,7 +4,7 @@
  * linear coefficients by damped Fisher scoring (iteratively reweighted least squares) from the flat mean, the
  * powers held >= 0 by dropping the most negative column in turn, each step halved until the likelihood does
  * not fall (at most 20 times; a candidate whose step cannot be made to stops), and the -log-likelihood
- * sum(log E + I / E), infinite where a mean is not positive.
+ * sum(log E + P / E) (P the periodogram), infinite where a mean is not positive.
  *
  * It exists because the profile likelihood's grids and the fits' start grids are hundreds of candidates of
  * a few hundred bins and five to eight columns: numpy's per-call overhead and its temporaries over the
@@ -15,6 +15,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -24,13 +25,13 @@
 #define HALVINGS 20
 #define RIDGE 1e-12
 
-/* -log-likelihood of the mean e against the periodogram I over m bins: +inf where a mean is <= 0, NaN
+/* -log-likelihood of the mean e against the periodogram P over m bins: +inf where a mean is <= 0, NaN
  * propagated (as whittle.py's _neg_log_likelihood_many). */
-static double neg_log_likelihood(const double *e, const double *I, Py_ssize_t m) {
+static double neg_log_likelihood(const double *e, const double *P, Py_ssize_t m) {
     double total = 0.0;
     for (Py_ssize_t k = 0; k < m; k++) {
         if (e[k] <= 0.0) return INFINITY;
-        total += log(e[k]) + I[k] / e[k];
+        total += log(e[k]) + P[k] / e[k];
     }
     return total;
 }
@@ -75,15 +76,15 @@ static void solve(double *A, double *b, int q, double *x) {
     }
 }
 
-/* min ||w (B c − I)|| with c >= 0 where `nonnegative`, by dropping the most negative bounded column in turn
+/* min ||w (B c − P)|| with c >= 0 where `nonnegative`, by dropping the most negative bounded column in turn
  * (whittle.py's _weighted_least_squares_many for one candidate: a dropped column's row and column of the
  * scaled normal matrix zero but for the ridge, its coefficient 0). */
-static void weighted_least_squares(const double *B, const double *I, const double *w, const unsigned char *nonneg,
+static void weighted_least_squares(const double *B, const double *P, const double *w, const unsigned char *nonneg,
                                    Py_ssize_t m, int q, double *coef) {
     double full[MAX_COLUMNS * MAX_COLUMNS] = {0}, rhs[MAX_COLUMNS] = {0}, a[MAX_COLUMNS];
     for (Py_ssize_t k = 0; k < m; k++) {
         const double *row = B + k * q;
-        double wk = w[k], bk = I[k] * wk;
+        double wk = w[k], bk = P[k] * wk;
         for (int i = 0; i < q; i++) a[i] = row[i] * wk;
         for (int i = 0; i < q; i++) {
             double ai = a[i];
@@ -126,7 +127,7 @@ static void weighted_least_squares(const double *B, const double *I, const doubl
 }
 
 /* One candidate: its coefficients (q) and -log-likelihood; work holds 3 m doubles. */
-static double fit_candidate(const double *B, const double *I, const unsigned char *nonneg, Py_ssize_t m, int q,
+static double fit_candidate(const double *B, const double *P, const unsigned char *nonneg, Py_ssize_t m, int q,
                             int iterations, double level, double *lin, double *work) {
     double *e = work, *trial_e = work + m, *w = work + 2 * m;
     double target[MAX_COLUMNS], step[MAX_COLUMNS], trial[MAX_COLUMNS];
@@ -134,16 +135,16 @@ static double fit_candidate(const double *B, const double *I, const unsigned cha
     lin[q - 2] = level;
     if (nonneg[q - 1]) lin[q - 1] = level; /* the background as two nonnegative edge ramps: both at the mean */
     mean_of(B, lin, m, q, e);
-    double nll = neg_log_likelihood(e, I, m);
+    double nll = neg_log_likelihood(e, P, m);
     for (int it = 0; it < iterations; it++) {
         for (Py_ssize_t k = 0; k < m; k++) w[k] = 1.0 / e[k];
-        weighted_least_squares(B, I, w, nonneg, m, q, target);
+        weighted_least_squares(B, P, w, nonneg, m, q, target);
         for (int j = 0; j < q; j++) step[j] = target[j] - lin[j];
         int accepted = 0;
         for (int h = 0; h < HALVINGS; h++) {
             for (int j = 0; j < q; j++) trial[j] = lin[j] + step[j];
             mean_of(B, trial, m, q, trial_e);
-            double trial_nll = neg_log_likelihood(trial_e, I, m);
+            double trial_nll = neg_log_likelihood(trial_e, P, m);
             if (trial_nll <= nll) {
                 memcpy(lin, trial, q * sizeof(double));
                 double *t = e; e = trial_e; trial_e = t;
@@ -156,6 +157,91 @@ static double fit_candidate(const double *B, const double *I, const unsigned cha
         if (!accepted) break;
     }
     return nll;
+}
+
+/* The mode's two columns of one pole z = a + iω (a = −σΔt, ω = 2π f Δt) over the bins' phases φ_k: H(u) =
+ * 2G(u) − 1 at u = exp(z − iφ), G(u) = 1/(1 − u) − u (1 − uᴺ) / (N (1 − u)²) (whittle.py's fejer_lorentzian,
+ * written as its _fejer: exp and expm1 of x + iy from the sines and cosines of y and N y, free of cancellation
+ * near u = 1), as Re H + Im H and Re H − Im H, into the first two columns of the rows of `basis` (m × q). The
+ * rotations (cos, sin, 2 sin²(·/2) of y = ω − φ and of N y) depend on ω alone: `turns` (6 m doubles) holds them
+ * for `omega_done` and is recomputed only for another ω. */
+static void mode_columns(double a, double omega, const double *phase, Py_ssize_t m, double n, double *turns,
+                         double *omega_done, int q, double *basis) {
+    if (!(omega == *omega_done)) {
+        for (Py_ssize_t k = 0; k < m; k++) {
+            double y = omega - phase[k], yn = n * y, h = sin(0.5 * y), hn = sin(0.5 * yn);
+            double *t = turns + 6 * k;
+            t[0] = cos(y); t[1] = sin(y); t[2] = 2.0 * h * h;
+            t[3] = cos(yn); t[4] = sin(yn); t[5] = 2.0 * hn * hn;
+        }
+        *omega_done = omega;
+    }
+    double grow = exp(a), grow_n = exp(n * a), em1 = expm1(a), em1_n = expm1(n * a);
+    for (Py_ssize_t k = 0; k < m; k++) {
+        const double *t = turns + 6 * k;
+        double complex one_minus = (t[2] - em1 * t[0]) - I * (grow * t[1]);
+        double complex u = grow * t[0] + I * (grow * t[1]);
+        double complex trunc = (t[5] - em1_n * t[3]) - I * (grow_n * t[4]);
+        double complex g = 1.0 / one_minus - u * trunc / (n * (one_minus * one_minus));
+        double complex h = 2.0 * g - 1.0;
+        basis[k * q] = creal(h) + cimag(h);
+        basis[k * q + 1] = creal(h) - cimag(h);
+    }
+}
+
+/* grid(thetas (c × 2: f Hz, σ 1/s), phase (m), n_samples, dt, fixed (m × (q − 2)), periodogram (m),
+ *      nonnegative (q uint8), iterations) -> as linear_many, of the bases [mode columns of θ, fixed]: whittle.py's
+ *      whittle_linear_many(designs(thetas, problem), ...) without the bases stacked in memory. */
+static PyObject *py_grid(PyObject *self, PyObject *args) {
+    PyObject *objs[5];
+    Py_ssize_t n_samples;
+    double dt;
+    int iterations;
+    if (!PyArg_ParseTuple(args, "OOndOOOi", &objs[0], &objs[1], &n_samples, &dt, &objs[2], &objs[3], &objs[4],
+                          &iterations))
+        return NULL;
+    Py_buffer views[5];
+    int got = 0;
+    PyObject *result = NULL;
+    for (; got < 5; got++)
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    Py_ssize_t c = views[0].len / (2 * (Py_ssize_t)sizeof(double));
+    Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
+    int q = (int)views[4].len;
+    if (q < 2 || q > MAX_COLUMNS || m < 1 || views[3].len != m * (Py_ssize_t)sizeof(double)
+        || views[2].len != m * (q - 2) * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "grid: phase, fixed (bins x q-2) and periodogram must agree, q 2..32");
+        goto done;
+    }
+    const double *theta = views[0].buf, *phase = views[1].buf, *fixed = views[2].buf, *Iv = views[3].buf;
+    const unsigned char *nonneg = views[4].buf;
+    PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
+    PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
+    double *work = malloc((3 * m + 6 * m + m * q) * sizeof(double));
+    if (!lin || !nll || !work) {
+        Py_XDECREF(lin); Py_XDECREF(nll); free(work);
+        PyErr_NoMemory();
+        goto done;
+    }
+    double *L = (double *)PyBytes_AS_STRING(lin), *N = (double *)PyBytes_AS_STRING(nll);
+    double *turns = work + 3 * m, *basis = work + 9 * m;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t k = 0; k < m; k++)
+        for (int j = 2; j < q; j++) basis[k * q + j] = fixed[k * (q - 2) + j - 2];
+    double level = 0.0, omega_done = NAN;
+    for (Py_ssize_t k = 0; k < m; k++) level += Iv[k];
+    level /= (double)m;
+    for (Py_ssize_t i = 0; i < c; i++) {
+        mode_columns(-theta[2 * i + 1] * dt, 2.0 * M_PI * theta[2 * i] * dt, phase, m, (double)n_samples, turns,
+                     &omega_done, q, basis);
+        N[i] = fit_candidate(basis, Iv, nonneg, m, q, iterations, level, L + i * q, work);
+    }
+    Py_END_ALLOW_THREADS
+    free(work);
+    result = Py_BuildValue("NN", lin, nll);
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    return result;
 }
 
 /* linear_many(bases (c × m × q float64), periodogram (m float64), nonnegative (q uint8), iterations)
@@ -176,7 +262,7 @@ static PyObject *py_linear_many(PyObject *self, PyObject *args) {
         goto done;
     }
     Py_ssize_t c = views[0].len / (m * q * (Py_ssize_t)sizeof(double));
-    const double *B = views[0].buf, *I = views[1].buf;
+    const double *B = views[0].buf, *P = views[1].buf;
     const unsigned char *nonneg = views[2].buf;
     PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
     PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
@@ -189,10 +275,10 @@ static PyObject *py_linear_many(PyObject *self, PyObject *args) {
     double *L = (double *)PyBytes_AS_STRING(lin), *N = (double *)PyBytes_AS_STRING(nll);
     Py_BEGIN_ALLOW_THREADS
     double level = 0.0;
-    for (Py_ssize_t k = 0; k < m; k++) level += I[k];
+    for (Py_ssize_t k = 0; k < m; k++) level += P[k];
     level /= (double)m;
     for (Py_ssize_t i = 0; i < c; i++)
-        N[i] = fit_candidate(B + i * m * q, I, nonneg, m, q, iterations, level, L + i * q, work);
+        N[i] = fit_candidate(B + i * m * q, P, nonneg, m, q, iterations, level, L + i * q, work);
     Py_END_ALLOW_THREADS
     free(work);
     result = Py_BuildValue("NN", lin, nll);
@@ -204,6 +290,8 @@ done:
 static PyMethodDef methods[] = {
     {"linear_many", py_linear_many, METH_VARARGS,
      "Whittle fits of the linear terms of many candidate bases: coefficients and -log-likelihoods."},
+    {"grid", py_grid, METH_VARARGS,
+     "Whittle fits of the linear terms of a mode's pole at many (f, decay rate) beside fixed columns."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .whittle import BandProblem, band_design, designs, whittle_linear_many
+from .whittle import BandProblem, band_design, linear_grid
 
 __all__ = ["spreads"]
 
@@ -195,8 +195,7 @@ def _values(sub: BandProblem, freqs: np.ndarray, decays: np.ndarray) -> np.ndarr
     block = max(decays.size, (MAX_ELEMENTS // max(1, sub.periodogram.size * (2 + sub.fixed.shape[1]))) // decays.size
                 * decays.size)
     values = np.concatenate([
-        whittle_linear_many(designs(grid[i:i + block], sub), sub.periodogram, sub.nonnegative,
-                            iterations=LINEAR_ITERATIONS)[1]
+        linear_grid(grid[i:i + block], sub, iterations=LINEAR_ITERATIONS)[1]
         for i in range(0, grid.shape[0], block)])
     return np.where(np.isfinite(values), values, np.inf).reshape(freqs.size, decays.size)
 

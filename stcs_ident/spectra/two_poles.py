@@ -39,7 +39,7 @@ import numpy as np
 
 from .ambient_fit import AmbientFit, fisher_scoring, robust_covariance
 from .decay_fit import pole_statistics
-from .whittle import BandProblem, designs, fejer_lorentzian, neg_log_likelihood, whittle_linear_many
+from .whittle import BandProblem, designs, fejer_lorentzian, linear_grid, neg_log_likelihood
 
 __all__ = ["MISFIT_GATE", "RESOLVED_CELLS", "THRESHOLD", "TwoPoles", "second_resonance", "two_poles"]
 
@@ -129,7 +129,7 @@ def two_poles(problem: BandProblem, theta: np.ndarray, limits, max_iterations: i
                      if limits[1][0] < z * 2 * np.pi * f < limits[1][1]])
     if grid.size == 0:
         return None
-    lin, nll = whittle_linear_many(designs(grid, held), periodogram, held.nonnegative, iterations=3)
+    lin, nll = linear_grid(grid, held, iterations=3)
     best = int(np.argmin(np.where(np.isfinite(nll), nll, np.inf)))
     if not np.isfinite(nll[best]):
         return None

@@ -19,7 +19,7 @@ except ImportError:  # pragma: no cover - depends on the install
     _whittle_kernel = None
 
 __all__ = ["TINY", "BandProblem", "band_design", "designs", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
-           "null_neg_log_likelihood", "whittle_linear_many", "whittle_linear_many_numpy"]
+           "linear_grid", "null_neg_log_likelihood", "whittle_linear_many", "whittle_linear_many_numpy"]
 
 TINY = np.finfo(float).tiny
 
@@ -207,17 +207,32 @@ def _weighted_least_squares(basis, target, weight, nonnegative) -> np.ndarray:
 
 def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) -> np.ndarray:
     """The best (least -log-likelihood) of the starting frequencies × `damping_grid` (ζ), linear terms fitted
-    (all of them at once: :func:`whittle_linear_many`; the first of equal ones)."""
+    (all of them at once: :func:`linear_grid`; the first of equal ones)."""
     grid = [np.array([f_start, zeta * 2 * np.pi * f_start]) for f_start in starts for zeta in damping_grid]
     grid = [theta_nl for theta_nl in grid if limits[1][0] < theta_nl[1] < limits[1][1]]
     if grid:
-        bases = designs(np.array(grid), problem)
-        lin, nll = whittle_linear_many(bases, problem.periodogram, problem.nonnegative, iterations=3)  # starts only
+        lin, nll = linear_grid(np.array(grid), problem, iterations=3)  # starts only
         best = int(np.argmin(np.where(np.isnan(nll), np.inf, nll)))
         if nll[best] < np.inf:
             return np.concatenate([grid[best], lin[best]])
     theta_nl = np.array([starts[0], limits[1][1] / 2])
     return np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
+
+
+def linear_grid(thetas: np.ndarray, problem: BandProblem, iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`whittle_linear_many` of :func:`designs` (``thetas``, ``problem``): the linear terms fitted at each
+    (f, σ) row, coefficients (c, 2 + q) and -log-likelihoods (c,). By the compiled kernel where it is built,
+    which forms each row's basis as it fits it (the same formulas as :func:`_fejer`; the rotations once per
+    distinct frequency, for consecutive rows): the grids never stacked in memory."""
+    if _whittle_kernel is None or FORCE_NUMPY:
+        return whittle_linear_many(designs(thetas, problem), problem.periodogram, problem.nonnegative, iterations)
+    c, q = thetas.shape[0], 2 + problem.fixed.shape[1]
+    lin, nll = _whittle_kernel.grid(np.ascontiguousarray(thetas, dtype=np.float64),
+                                    np.ascontiguousarray(problem.phase, dtype=np.float64), int(problem.n_samples),
+                                    float(problem.dt), np.ascontiguousarray(problem.fixed, dtype=np.float64),
+                                    np.ascontiguousarray(problem.periodogram, dtype=np.float64),
+                                    np.ascontiguousarray(problem.nonnegative, dtype=np.uint8), int(iterations))
+    return np.frombuffer(lin, dtype=np.float64).reshape(c, q).copy(), np.frombuffer(nll, dtype=np.float64).copy()
 
 
 def designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
