@@ -18,8 +18,19 @@ try:  # the optional compiled kernel of whittle_linear_many (setup.py); the same
 except ImportError:  # pragma: no cover - depends on the install
     _whittle_kernel = None
 
-__all__ = ["TINY", "BandProblem", "band_design", "designs", "fejer_lorentzian", "grid_start", "neg_log_likelihood",
-           "linear_grid", "null_neg_log_likelihood", "whittle_linear_many", "whittle_linear_many_numpy"]
+__all__ = [
+    "TINY",
+    "BandProblem",
+    "band_design",
+    "designs",
+    "fejer_lorentzian",
+    "grid_start",
+    "linear_grid",
+    "neg_log_likelihood",
+    "null_neg_log_likelihood",
+    "whittle_linear_many",
+    "whittle_linear_many_numpy",
+]
 
 TINY = np.finfo(float).tiny
 
