@@ -15,7 +15,6 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
-#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -26,14 +25,19 @@
 #define RIDGE 1e-12
 
 /* -log-likelihood of the mean e against the periodogram P over m bins: +inf where a mean is <= 0, NaN
- * propagated (as whittle.py's _neg_log_likelihood_many). */
-static double neg_log_likelihood(const double *e, const double *P, Py_ssize_t m) {
+ * propagated (as whittle.py's _neg_log_likelihood_many); `inv` gets 1 / e (the next step's weights). */
+static double neg_log_likelihood(const double *e, const double *P, Py_ssize_t m, double *inv) {
     double total = 0.0;
+    int bad = 0;
     for (Py_ssize_t k = 0; k < m; k++) {
-        if (e[k] <= 0.0) return INFINITY;
-        total += log(e[k]) + P[k] / e[k];
+        double r = 1.0 / e[k];
+        inv[k] = r;
+        if (e[k] <= 0.0)
+            bad = 1;
+        else
+            total += log(e[k]) + P[k] * r;
     }
-    return total;
+    return bad ? INFINITY : total;
 }
 
 static void mean_of(const double *B, const double *lin, Py_ssize_t m, int q, double *e) {
@@ -126,28 +130,28 @@ static void weighted_least_squares(const double *B, const double *P, const doubl
     }
 }
 
-/* One candidate: its coefficients (q) and -log-likelihood; work holds 3 m doubles. */
+/* One candidate: its coefficients (q) and -log-likelihood; work holds 4 m doubles. */
 static double fit_candidate(const double *B, const double *P, const unsigned char *nonneg, Py_ssize_t m, int q,
                             int iterations, double level, double *lin, double *work) {
-    double *e = work, *trial_e = work + m, *w = work + 2 * m;
+    double *e = work, *trial_e = work + m, *w = work + 2 * m, *trial_w = work + 3 * m;
     double target[MAX_COLUMNS], step[MAX_COLUMNS], trial[MAX_COLUMNS];
     for (int j = 0; j < q; j++) lin[j] = 0.0;
     lin[q - 2] = level;
     if (nonneg[q - 1]) lin[q - 1] = level; /* the background as two nonnegative edge ramps: both at the mean */
     mean_of(B, lin, m, q, e);
-    double nll = neg_log_likelihood(e, P, m);
+    double nll = neg_log_likelihood(e, P, m, w);
     for (int it = 0; it < iterations; it++) {
-        for (Py_ssize_t k = 0; k < m; k++) w[k] = 1.0 / e[k];
-        weighted_least_squares(B, P, w, nonneg, m, q, target);
+        weighted_least_squares(B, P, w, nonneg, m, q, target); /* w = 1 / e of the accepted mean */
         for (int j = 0; j < q; j++) step[j] = target[j] - lin[j];
         int accepted = 0;
         for (int h = 0; h < HALVINGS; h++) {
             for (int j = 0; j < q; j++) trial[j] = lin[j] + step[j];
             mean_of(B, trial, m, q, trial_e);
-            double trial_nll = neg_log_likelihood(trial_e, P, m);
+            double trial_nll = neg_log_likelihood(trial_e, P, m, trial_w);
             if (trial_nll <= nll) {
                 memcpy(lin, trial, q * sizeof(double));
                 double *t = e; e = trial_e; trial_e = t;
+                t = w; w = trial_w; trial_w = t;
                 nll = trial_nll;
                 accepted = 1;
                 break;
@@ -179,13 +183,17 @@ static void mode_columns(double a, double omega, const double *phase, Py_ssize_t
     double grow = exp(a), grow_n = exp(n * a), em1 = expm1(a), em1_n = expm1(n * a);
     for (Py_ssize_t k = 0; k < m; k++) {
         const double *t = turns + 6 * k;
-        double complex one_minus = (t[2] - em1 * t[0]) - I * (grow * t[1]);
-        double complex u = grow * t[0] + I * (grow * t[1]);
-        double complex trunc = (t[5] - em1_n * t[3]) - I * (grow_n * t[4]);
-        double complex g = 1.0 / one_minus - u * trunc / (n * (one_minus * one_minus));
-        double complex h = 2.0 * g - 1.0;
-        basis[k * q] = creal(h) + cimag(h);
-        basis[k * q + 1] = creal(h) - cimag(h);
+        /* 1 − u = x + iy, its reciprocal r = (x − iy) / |1 − u|², then g = r − u (1 − uᴺ) r² / N */
+        double x = t[2] - em1 * t[0], y = -grow * t[1], d = 1.0 / (x * x + y * y);
+        double rr = x * d, ri = -y * d;
+        double ur = grow * t[0], ui = grow * t[1];
+        double tr = t[5] - em1_n * t[3], ti = -grow_n * t[4];
+        double pr = ur * tr - ui * ti, pi = ur * ti + ui * tr; /* u (1 − uᴺ) */
+        double r2r = rr * rr - ri * ri, r2i = 2.0 * rr * ri;   /* r² */
+        double gr = rr - (pr * r2r - pi * r2i) / n, gi = ri - (pr * r2i + pi * r2r) / n;
+        double hr = 2.0 * gr - 1.0, hi = 2.0 * gi;
+        basis[k * q] = hr + hi;
+        basis[k * q + 1] = hr - hi;
     }
 }
 
@@ -217,14 +225,14 @@ static PyObject *py_grid(PyObject *self, PyObject *args) {
     const unsigned char *nonneg = views[4].buf;
     PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
     PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
-    double *work = malloc((3 * m + 6 * m + m * q) * sizeof(double));
+    double *work = malloc((4 * m + 6 * m + m * q) * sizeof(double));
     if (!lin || !nll || !work) {
         Py_XDECREF(lin); Py_XDECREF(nll); free(work);
         PyErr_NoMemory();
         goto done;
     }
     double *L = (double *)PyBytes_AS_STRING(lin), *N = (double *)PyBytes_AS_STRING(nll);
-    double *turns = work + 3 * m, *basis = work + 9 * m;
+    double *turns = work + 4 * m, *basis = work + 10 * m;
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t k = 0; k < m; k++)
         for (int j = 2; j < q; j++) basis[k * q + j] = fixed[k * (q - 2) + j - 2];
@@ -266,7 +274,7 @@ static PyObject *py_linear_many(PyObject *self, PyObject *args) {
     const unsigned char *nonneg = views[2].buf;
     PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
     PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
-    double *work = malloc(3 * m * sizeof(double));
+    double *work = malloc(4 * m * sizeof(double));
     if (!lin || !nll || !work) {
         Py_XDECREF(lin); Py_XDECREF(nll); free(work);
         PyErr_NoMemory();
