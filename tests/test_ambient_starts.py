@@ -99,3 +99,31 @@ def test_the_kernel_s_grid_forms_the_bases_designs_forms(seed):
                                                         problem.nonnegative, 4)
         assert np.allclose(nll, ref_nll, rtol=1e-12, atol=0)  # rounding (sums and the Fejér sums in another order)
         assert np.max(np.abs(lin - ref_lin) / np.max(np.abs(ref_lin), axis=1, keepdims=True)) <= 1e-6
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("neighbours", [0, 2])
+def test_the_kernel_s_fisher_scoring_is_the_numpy_reference_s(seed, neighbours):
+    """The one-pole fit by the compiled kernel (its expected periodogram, gradient, scoring step with the held
+    powers and its least squares from an eigen-decomposition) and by ambient_fit's numpy steps, from the start
+    grid's best: the same pole, the same convergence, the same mean and gradient where it ended."""
+    from stcs_ident.spectra import ambient_fit as F
+
+    if A._whittle_kernel is None:
+        pytest.skip("the compiled kernel is not built in this install (no C compiler)")
+    problem, f0 = _problem(seed, neighbours)
+    limits = ((f0 - 0.2, f0 + 0.2), (0.0, 0.2 * 2 * np.pi * f0))
+    start = A.grid_start([f0, f0 + 0.01], problem, limits, tuple(np.logspace(-4, -1, 7)))
+    theta, ok, mean, grad = F.fisher_scoring(start, problem, limits, 60)
+    ref_theta, ref_ok, ref_mean, ref_grad = F._fisher_scoring_numpy(start, problem, limits, 60)
+    assert ok == ref_ok
+    # the converged pole to 1e-9 of its frequency and decay rate (the scoring stops within 1e-4 of a Fisher
+    # σ, which the two paths' rounding moves by far less)
+    assert theta[0] == pytest.approx(ref_theta[0], rel=1e-9)
+    assert theta[1] == pytest.approx(ref_theta[1], rel=1e-6)
+    assert np.allclose(mean, ref_mean, rtol=1e-8, atol=0)
+    assert np.allclose(grad, ref_grad, rtol=1e-6, atol=1e-9 * np.max(np.abs(ref_grad), axis=0))
+    # at θ itself the kernel's mean and gradient are the reference's formulas (rounding only)
+    same_mean, same_grad = F._expected(theta, problem)
+    assert np.allclose(mean, same_mean, rtol=1e-12, atol=0)
+    assert np.allclose(grad, same_grad, rtol=1e-9, atol=1e-12 * np.max(np.abs(same_grad), axis=0))

@@ -402,7 +402,7 @@ def _command(*args) -> list[str]:
     rightly keeps an ignored SIGINT ignored; these tests are about what a pressed Ctrl-C does."""
     start = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
              "from stcs_ident.cli.main import main; sys.exit(main())")
-    return [sys.executable, "-c", start, *args]
+    return [sys.executable, "-P", "-c", start, *args]  # -P: the installed package, not a checkout's source tree
 
 
 @pytest.fixture

@@ -111,7 +111,9 @@ def test_a_run_killed_midway_and_restarted_ends_with_the_same_table(small, tmp_p
     whole = tmp_path / "whole"
     track(small, whole, batch=2, workers=2)  # the reference table (local processes give the same rows)
     out = tmp_path / "killed"
-    command = [sys.executable, "-c", ("import sys; from stcs_ident.track.api import track; "
+    # -P: the child imports the installed package, as this process does (from a checkout's root, the current
+    # directory first on its path would give it the source tree, without the compiled kernels: rows 1e-13 apart)
+    command = [sys.executable, "-P", "-c", ("import sys; from stcs_ident.track.api import track; "
                f"track({str(small)!r}, {str(out)!r}, batch=2)")]
     child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     while child.poll() is None and len(list((out / "parts").glob("*.parquet"))) < 3:

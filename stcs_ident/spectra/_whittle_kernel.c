@@ -252,6 +252,281 @@ done:
     return result;
 }
 
+/* ---- The one-pole fit: Fisher scoring over (f, σ) and the linear terms (ambient_fit.py's fisher_scoring with its
+ * _expected and _scoring_step, whose reference they stay). ---- */
+
+#define MAX_PARAMETERS (MAX_COLUMNS + 2)
+#define STEP_HALVINGS 30
+#define CONVERGED 1e-4
+
+/* Eigen-decomposition of a symmetric p × p matrix (row-major, destroyed) by cyclic Jacobi rotations:
+ * eigenvalues in `value`, eigenvectors in the columns of `vector`. */
+static void symmetric_eigen(double *A, int p, double *value, double *vector) {
+    for (int i = 0; i < p; i++)
+        for (int j = 0; j < p; j++) vector[i * p + j] = i == j ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 60; sweep++) {
+        double off = 0.0, diag = 0.0;
+        for (int i = 0; i < p; i++) {
+            diag += A[i * p + i] * A[i * p + i];
+            for (int j = i + 1; j < p; j++) off += A[i * p + j] * A[i * p + j];
+        }
+        if (!(off > 1e-32 * diag)) break;
+        for (int i = 0; i < p; i++)
+            for (int j = i + 1; j < p; j++) {
+                double aij = A[i * p + j];
+                if (aij == 0.0) continue;
+                double theta = (A[j * p + j] - A[i * p + i]) / (2.0 * aij);
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
+                for (int k = 0; k < p; k++) { /* columns i, j */
+                    double x = A[k * p + i], y = A[k * p + j];
+                    A[k * p + i] = c * x - sn * y;
+                    A[k * p + j] = sn * x + c * y;
+                }
+                for (int k = 0; k < p; k++) { /* rows i, j */
+                    double x = A[i * p + k], y = A[j * p + k];
+                    A[i * p + k] = c * x - sn * y;
+                    A[j * p + k] = sn * x + c * y;
+                }
+                for (int k = 0; k < p; k++) {
+                    double x = vector[k * p + i], y = vector[k * p + j];
+                    vector[k * p + i] = c * x - sn * y;
+                    vector[k * p + j] = sn * x + c * y;
+                }
+            }
+    }
+    for (int i = 0; i < p; i++) value[i] = A[i * p + i];
+}
+
+/* The least-squares solution of the symmetric system A x = b (numpy's lstsq with rcond: singular values below
+ * rcond times the largest left out), from its eigen-decomposition (|λ| are its singular values). */
+static void symmetric_lstsq(double *A, const double *b, int p, double rcond, double *x) {
+    double value[MAX_PARAMETERS], vector[MAX_PARAMETERS * MAX_PARAMETERS];
+    symmetric_eigen(A, p, value, vector);
+    double largest = 0.0;
+    for (int i = 0; i < p; i++) largest = fabs(value[i]) > largest ? fabs(value[i]) : largest;
+    for (int k = 0; k < p; k++) x[k] = 0.0;
+    for (int i = 0; i < p; i++) {
+        if (!(fabs(value[i]) > rcond * largest)) continue;
+        double proj = 0.0;
+        for (int k = 0; k < p; k++) proj += vector[k * p + i] * b[k];
+        proj /= value[i];
+        for (int k = 0; k < p; k++) x[k] += proj * vector[k * p + i];
+    }
+}
+
+/* The band: its bins, fixed columns and bounds. */
+typedef struct {
+    const double *phase, *fixed, *P;
+    const unsigned char *nonneg; /* of the q linear terms */
+    Py_ssize_t m;
+    int q; /* linear terms: the mode's two, then the fixed columns */
+    double n, dt;
+} Band;
+
+/* The expected periodogram at θ = (f, σ, linear terms) and its gradient (m × (2 + q), row-major). */
+static void expected(const Band *b, const double *theta, double *mean, double *grad) {
+    int q = b->q, p = q + 2;
+    double a = -theta[1] * b->dt, omega = 2.0 * M_PI * theta[0] * b->dt, n = b->n;
+    double grow = exp(a), grow_n = exp(n * a), em1 = expm1(a), em1_n = expm1(n * a);
+    double c0 = theta[2], c1 = theta[3];
+    for (Py_ssize_t k = 0; k < b->m; k++) {
+        double y = omega - b->phase[k], yn = n * y, h = sin(0.5 * y), hn = sin(0.5 * yn);
+        double cs = cos(y), sn = sin(y), cs_n = cos(yn), sn_n = sin(yn);
+        double x = 2.0 * h * h - em1 * cs, yy = -grow * sn, d = 1.0 / (x * x + yy * yy);
+        double rr = x * d, ri = -yy * d;                          /* r = 1 / (1 − u) */
+        double ur = grow * cs, ui = grow * sn;                    /* u */
+        double tr = 2.0 * hn * hn - em1_n * cs_n, ti = -grow_n * sn_n; /* 1 − uᴺ */
+        double unr = grow_n * cs_n, uni = grow_n * sn_n;          /* uᴺ */
+        double pr = ur * tr - ui * ti, pi = ur * ti + ui * tr;     /* u (1 − uᴺ) */
+        double r2r = rr * rr - ri * ri, r2i = 2.0 * rr * ri;       /* r² */
+        double r3r = r2r * rr - r2i * ri, r3i = r2r * ri + r2i * rr; /* r³ */
+        double gr = rr - (pr * r2r - pi * r2i) / n, gi = ri - (pr * r2i + pi * r2r) / n;
+        double Hr = 2.0 * gr - 1.0, Hi = 2.0 * gi;
+        /* dG/du = r² − (1 − uᴺ − N uᴺ) r² / N − 2 u (1 − uᴺ) r³ / N; dH/dz = 2 dG/du · u */
+        double sr = tr - n * unr, si = ti - n * uni;
+        double dgr = r2r - (sr * r2r - si * r2i) / n - 2.0 * (pr * r3r - pi * r3i) / n;
+        double dgi = r2i - (sr * r2i + si * r2r) / n - 2.0 * (pr * r3i + pi * r3r) / n;
+        double dHr = 2.0 * (dgr * ur - dgi * ui), dHi = 2.0 * (dgr * ui + dgi * ur);
+        /* d/df = dH · 2πiΔt, d/dσ = dH · (−Δt) */
+        double wdt = 2.0 * M_PI * b->dt;
+        double dfr = -dHi * wdt, dfi = dHr * wdt, dsr = -dHr * b->dt, dsi = -dHi * b->dt;
+        double *g = grad + k * p;
+        double col0 = Hr + Hi, col1 = Hr - Hi;
+        g[0] = (dfr + dfi) * c0 + (dfr - dfi) * c1;
+        g[1] = (dsr + dsi) * c0 + (dsr - dsi) * c1;
+        g[2] = col0;
+        g[3] = col1;
+        double e = col0 * c0 + col1 * c1;
+        const double *f = b->fixed + k * (q - 2);
+        for (int j = 0; j < q - 2; j++) {
+            g[4 + j] = f[j];
+            e += f[j] * theta[4 + j];
+        }
+        mean[k] = e;
+    }
+}
+
+static double likelihood(const Band *b, const double *mean) {
+    double total = 0.0;
+    int bad = 0;
+    for (Py_ssize_t k = 0; k < b->m; k++) {
+        if (mean[k] <= 0.0)
+            bad = 1;
+        else
+            total += log(mean[k]) + b->P[k] / mean[k];
+    }
+    return bad ? INFINITY : total;
+}
+
+/* The scoring step with the powers at zero held where the quadratic model wants them lower, released when its
+ * gradient says the likelihood would fall with them (ambient_fit.py's _scoring_step). */
+static void scoring_step(const double *theta, const double *score, const double *fisher, const unsigned char *nonneg,
+                         int p, double *step) {
+    unsigned char at_zero[MAX_PARAMETERS], held[MAX_PARAMETERS] = {0};
+    double largest = 0.0;
+    for (int i = 0; i < p; i++) largest = fabs(theta[i]) > largest ? fabs(theta[i]) : largest;
+    for (int i = 0; i < p; i++) at_zero[i] = i >= 2 && nonneg[i - 2] && theta[i] <= 1e-12 * largest;
+    for (int round = 0; round < 2 * p; round++) {
+        int idx[MAX_PARAMETERS], nf = 0;
+        for (int i = 0; i < p; i++)
+            if (!held[i]) idx[nf++] = i;
+        double sub[MAX_PARAMETERS * MAX_PARAMETERS], scale[MAX_PARAMETERS], rhs[MAX_PARAMETERS], x[MAX_PARAMETERS];
+        for (int a = 0; a < nf; a++) {
+            double dg = fisher[idx[a] * p + idx[a]];
+            scale[a] = sqrt(dg > DBL_MIN ? dg : DBL_MIN);
+        }
+        for (int a = 0; a < nf; a++) {
+            for (int c = 0; c < nf; c++) sub[a * nf + c] = fisher[idx[a] * p + idx[c]] / (scale[a] * scale[c]);
+            rhs[a] = score[idx[a]] / scale[a];
+        }
+        symmetric_lstsq(sub, rhs, nf, 1e-12, x);
+        for (int i = 0; i < p; i++) step[i] = 0.0;
+        for (int a = 0; a < nf; a++) step[idx[a]] = x[a] / scale[a];
+        int blocked = 0;
+        for (int a = 0; a < nf; a++)
+            if (at_zero[idx[a]] && step[idx[a]] < 0) { held[idx[a]] = 1; blocked = 1; }
+        if (blocked) continue;
+        int release = -1;
+        double lowest = 0.0;
+        for (int i = 0; i < p; i++) {
+            if (!held[i]) continue;
+            double gradient = -score[i];
+            for (int j = 0; j < p; j++) gradient += fisher[i * p + j] * step[j];
+            if (gradient < 0 && (release < 0 || gradient < lowest)) { release = i; lowest = gradient; }
+        }
+        if (release < 0) break;
+        held[release] = 0;
+    }
+}
+
+/* Fisher scoring from θ; returns 1 when converged (θ, its mean and gradient where it ended). */
+static int scoring(const Band *b, double *theta, const double *limits, int max_iterations, double *mean, double *grad,
+                   double *work) {
+    int q = b->q, p = q + 2;
+    Py_ssize_t m = b->m;
+    double *trial_mean = work, *trial_grad = work + m;
+    expected(b, theta, mean, grad);
+    double nll = likelihood(b, mean);
+    for (int it = 0; it < max_iterations; it++) {
+        double score[MAX_PARAMETERS] = {0}, fisher[MAX_PARAMETERS * MAX_PARAMETERS] = {0}, step[MAX_PARAMETERS];
+        for (Py_ssize_t k = 0; k < m; k++) {
+            const double *g = grad + k * p;
+            double r = 1.0 / mean[k], res = (b->P[k] - mean[k]) * r * r, gk[MAX_PARAMETERS];
+            for (int i = 0; i < p; i++) {
+                score[i] += g[i] * res;
+                gk[i] = g[i] * r;
+            }
+            for (int i = 0; i < p; i++)
+                for (int j = i; j < p; j++) fisher[i * p + j] += gk[i] * gk[j];
+        }
+        int finite = 1;
+        for (int i = 0; i < p; i++) {
+            for (int j = 0; j < i; j++) fisher[i * p + j] = fisher[j * p + i];
+            finite &= isfinite(score[i]);
+            for (int j = 0; j < p; j++) finite &= isfinite(fisher[i * p + j]);
+        }
+        if (!finite) return 0;
+        scoring_step(theta, score, fisher, b->nonneg, p, step);
+        int small = 1;
+        for (int i = 0; i < p; i++) finite &= isfinite(step[i]);
+        if (!finite) return 0;
+        for (int i = 0; i < 2; i++) {
+            double dg = fisher[i * p + i];
+            small &= fabs(step[i]) * sqrt(dg > DBL_MIN ? dg : DBL_MIN) < CONVERGED;
+        }
+        if (small) return 1;
+        int accepted = 0;
+        for (int h = 0; h < STEP_HALVINGS; h++) {
+            double trial[MAX_PARAMETERS];
+            for (int i = 0; i < p; i++) trial[i] = theta[i] + step[i];
+            for (int i = 2; i < p; i++)
+                if (b->nonneg[i - 2] && trial[i] < 0.0) trial[i] = 0.0;
+            if (limits[0] < trial[0] && trial[0] < limits[1] && limits[2] < trial[1] && trial[1] < limits[3]) {
+                expected(b, trial, trial_mean, trial_grad);
+                double trial_nll = likelihood(b, trial_mean);
+                if (trial_nll <= nll) {
+                    memcpy(theta, trial, p * sizeof(double));
+                    memcpy(mean, trial_mean, m * sizeof(double));
+                    memcpy(grad, trial_grad, m * p * sizeof(double));
+                    nll = trial_nll;
+                    accepted = 1;
+                    break;
+                }
+            }
+            for (int i = 0; i < p; i++) step[i] /= 2;
+        }
+        if (!accepted) return 1; /* no decrease along the scoring direction: at the optimum within rounding */
+    }
+    return 0;
+}
+
+/* fisher_scoring(theta (2 + q), phase (m), n_samples, dt, fixed (m × (q − 2)), periodogram (m), nonnegative (q uint8),
+ *                limits (4: f low, f high, σ low, σ high), max_iterations)
+ *   -> (bytes of θ, converged (bool), bytes of the mean (m), bytes of the gradient (m × (2 + q))) */
+static PyObject *py_fisher_scoring(PyObject *self, PyObject *args) {
+    PyObject *objs[6];
+    Py_ssize_t n_samples;
+    double dt;
+    int max_iterations;
+    if (!PyArg_ParseTuple(args, "OOndOOOOi", &objs[0], &objs[1], &n_samples, &dt, &objs[2], &objs[3], &objs[4],
+                          &objs[5], &max_iterations))
+        return NULL;
+    Py_buffer views[6];
+    int got = 0;
+    PyObject *result = NULL;
+    for (; got < 6; got++)
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
+    int q = (int)views[4].len, p = q + 2;
+    if (q < 2 || q > MAX_COLUMNS || m < 1 || views[0].len != p * (Py_ssize_t)sizeof(double)
+        || views[3].len != m * (Py_ssize_t)sizeof(double) || views[2].len != m * (q - 2) * (Py_ssize_t)sizeof(double)
+        || views[5].len != 4 * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "fisher_scoring: theta, phase, fixed, periodogram and limits must agree");
+        goto done;
+    }
+    Band b = {views[1].buf, views[2].buf, views[3].buf, views[4].buf, m, q, (double)n_samples, dt};
+    PyObject *theta = PyBytes_FromStringAndSize(views[0].buf, p * (Py_ssize_t)sizeof(double));
+    PyObject *mean = PyBytes_FromStringAndSize(NULL, m * (Py_ssize_t)sizeof(double));
+    PyObject *grad = PyBytes_FromStringAndSize(NULL, m * p * (Py_ssize_t)sizeof(double));
+    double *work = malloc((m + m * p) * sizeof(double));
+    if (!theta || !mean || !grad || !work) {
+        Py_XDECREF(theta); Py_XDECREF(mean); Py_XDECREF(grad); free(work);
+        PyErr_NoMemory();
+        goto done;
+    }
+    int ok;
+    Py_BEGIN_ALLOW_THREADS
+    ok = scoring(&b, (double *)PyBytes_AS_STRING(theta), views[5].buf, max_iterations,
+                 (double *)PyBytes_AS_STRING(mean), (double *)PyBytes_AS_STRING(grad), work);
+    Py_END_ALLOW_THREADS
+    free(work);
+    result = Py_BuildValue("NONN", theta, ok ? Py_True : Py_False, mean, grad);
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    return result;
+}
+
 /* linear_many(bases (c × m × q float64), periodogram (m float64), nonnegative (q uint8), iterations)
  *   -> (bytes of float64 coefficients, c × q; bytes of float64 -log-likelihoods, c) */
 static PyObject *py_linear_many(PyObject *self, PyObject *args) {
@@ -298,6 +573,8 @@ done:
 static PyMethodDef methods[] = {
     {"linear_many", py_linear_many, METH_VARARGS,
      "Whittle fits of the linear terms of many candidate bases: coefficients and -log-likelihoods."},
+    {"fisher_scoring", py_fisher_scoring, METH_VARARGS,
+     "Fisher scoring of one pole and its linear terms in a band: theta, converged, mean, gradient."},
     {"grid", py_grid, METH_VARARGS,
      "Whittle fits of the linear terms of a mode's pole at many (f, decay rate) beside fixed columns."},
     {NULL, NULL, 0, NULL},

@@ -68,6 +68,7 @@ from .whittle import (
     TINY,
     BandProblem,
     band_design,
+    compiled_scoring,
     fejer_lorentzian,
     grid_start,
     neg_log_likelihood,
@@ -187,8 +188,19 @@ def fisher_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iteratio
     ``limits`` holds (low, high) of each nonlinear parameter, the first ``len(limits)`` of θ (f and σ of each
     pole); ``expected(θ, problem)`` gives the expected periodogram and its gradient (one pole: :func:`_expected`;
     several: :mod:`.two_poles`). Returns θ, whether it converged, and the expected periodogram and its gradient
-    at θ.
+    at θ. One pole is scored by the compiled kernel where it is built (``_whittle_kernel.c``: these steps, its
+    least squares from the eigen-decomposition of the symmetric system), else by the steps below, its reference.
     """
+    if expected is _expected and len(limits) == 1 + 1:
+        compiled = compiled_scoring(theta, problem, limits, max_iterations)
+        if compiled is not None:
+            return compiled
+    return _fisher_scoring_numpy(theta, problem, limits, max_iterations, expected)
+
+
+def _fisher_scoring_numpy(theta: np.ndarray, problem: BandProblem, limits, max_iterations: int,
+                          expected=_expected) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+    """:func:`fisher_scoring` in numpy (the kernel's reference)."""
     poles = len(limits)
     mean, grad = expected(theta, problem)
     nll = neg_log_likelihood(mean, problem.periodogram)

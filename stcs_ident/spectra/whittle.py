@@ -246,6 +246,23 @@ def linear_grid(thetas: np.ndarray, problem: BandProblem, iterations: int) -> tu
     return np.frombuffer(lin, dtype=np.float64).reshape(c, q).copy(), np.frombuffer(nll, dtype=np.float64).copy()
 
 
+def compiled_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iterations: int):
+    """The one-pole Fisher scoring (:func:`.ambient_fit.fisher_scoring` with its own expected periodogram) by the
+    compiled kernel: θ, whether it converged, the expected periodogram and its gradient at θ; None where the
+    kernel is not built (or STCS_IDENT_NUMPY=1): the caller then runs the numpy reference."""
+    if _whittle_kernel is None or FORCE_NUMPY:
+        return None
+    m, p = problem.phase.size, theta.size
+    out, ok, mean, grad = _whittle_kernel.fisher_scoring(
+        np.ascontiguousarray(theta, dtype=np.float64), np.ascontiguousarray(problem.phase, dtype=np.float64),
+        int(problem.n_samples), float(problem.dt), np.ascontiguousarray(problem.fixed, dtype=np.float64),
+        np.ascontiguousarray(problem.periodogram, dtype=np.float64),
+        np.ascontiguousarray(problem.nonnegative, dtype=np.uint8), np.array(limits, dtype=np.float64).ravel(),
+        int(max_iterations))
+    return (np.frombuffer(out, dtype=np.float64).copy(), bool(ok), np.frombuffer(mean, dtype=np.float64).copy(),
+            np.frombuffer(grad, dtype=np.float64).reshape(m, p).copy())
+
+
 def designs(thetas: np.ndarray, problem: BandProblem) -> np.ndarray:
     """:func:`band_design`'s basis (no derivative) of many (f, σ) rows at once, (c, m, 2 + q); the sines and
     cosines once per distinct frequency, for all its damping ratios (:func:`_turns`)."""
