@@ -127,3 +127,17 @@ def test_the_kernel_s_fisher_scoring_is_the_numpy_reference_s(seed, neighbours):
     same_mean, same_grad = F._expected(theta, problem)
     assert np.allclose(mean, same_mean, rtol=1e-12, atol=0)
     assert np.allclose(grad, same_grad, rtol=1e-9, atol=1e-12 * np.max(np.abs(same_grad), axis=0))
+
+
+def test_the_kernel_s_threads_give_each_row_its_own_result():
+    """A grid's rows split over threads: the same bits as on one thread (each row's arithmetic its own)."""
+    if A._whittle_kernel is None:
+        pytest.skip("the compiled kernel is not built in this install (no C compiler)")
+    problem, f0 = _problem(7, 2)
+    sigma = 0.01 * 2 * np.pi * f0
+    grid = np.array([[f, s] for f in np.linspace(f0 - 0.1, f0 + 0.1, 13) for s in sigma * np.logspace(-0.6, 0.6, 5)])
+    args = (grid, problem.phase, problem.n_samples, problem.dt, np.ascontiguousarray(problem.fixed),
+            problem.periodogram, problem.nonnegative.astype(np.uint8), 6)
+    one = A._whittle_kernel.grid(*args, 1)
+    for threads in (2, 3, 7):
+        assert A._whittle_kernel.grid(*args, threads) == one

@@ -19,6 +19,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifndef _WIN32
+#include <pthread.h>
+#endif
 
 #define MAX_COLUMNS 32
 #define HALVINGS 20
@@ -197,16 +200,51 @@ static void mode_columns(double a, double omega, const double *phase, Py_ssize_t
     }
 }
 
+/* A run of consecutive rows of a grid, fitted by one thread with its own buffers. */
+typedef struct {
+    const double *theta, *phase, *fixed, *P;
+    const unsigned char *nonneg;
+    Py_ssize_t m, begin, end;
+    int q, iterations, failed;
+    double n, dt, level;
+    double *L, *N;
+} Rows;
+
+static void *fit_rows(void *arg) {
+    Rows *r = arg;
+    Py_ssize_t m = r->m;
+    int q = r->q;
+    double *work = malloc((4 * m + 6 * m + m * q) * sizeof(double));
+    if (!work) {
+        r->failed = 1;
+        return NULL;
+    }
+    double *turns = work + 4 * m, *basis = work + 10 * m, omega_done = NAN;
+    for (Py_ssize_t k = 0; k < m; k++)
+        for (int j = 2; j < q; j++) basis[k * q + j] = r->fixed[k * (q - 2) + j - 2];
+    for (Py_ssize_t i = r->begin; i < r->end; i++) {
+        mode_columns(-r->theta[2 * i + 1] * r->dt, 2.0 * M_PI * r->theta[2 * i] * r->dt, r->phase, m, r->n, turns,
+                     &omega_done, q, basis);
+        r->N[i] = fit_candidate(basis, r->P, r->nonneg, m, q, r->iterations, r->level, r->L + i * q, work);
+    }
+    free(work);
+    return NULL;
+}
+
+#define MAX_THREADS 16
+
 /* grid(thetas (c × 2: f Hz, σ 1/s), phase (m), n_samples, dt, fixed (m × (q − 2)), periodogram (m),
- *      nonnegative (q uint8), iterations) -> as linear_many, of the bases [mode columns of θ, fixed]: whittle.py's
- *      whittle_linear_many(designs(thetas, problem), ...) without the bases stacked in memory. */
+ *      nonnegative (q uint8), iterations, threads) -> as linear_many, of the bases [mode columns of θ, fixed]:
+ *      whittle.py's whittle_linear_many(designs(thetas, problem), ...) without the bases stacked in memory. The
+ *      rows are split into `threads` runs of consecutive rows (POSIX threads; one where there are none): a row's
+ *      result is its own arithmetic's, whichever thread fits it. */
 static PyObject *py_grid(PyObject *self, PyObject *args) {
     PyObject *objs[5];
     Py_ssize_t n_samples;
     double dt;
-    int iterations;
-    if (!PyArg_ParseTuple(args, "OOndOOOi", &objs[0], &objs[1], &n_samples, &dt, &objs[2], &objs[3], &objs[4],
-                          &iterations))
+    int iterations, threads;
+    if (!PyArg_ParseTuple(args, "OOndOOOii", &objs[0], &objs[1], &n_samples, &dt, &objs[2], &objs[3], &objs[4],
+                          &iterations, &threads))
         return NULL;
     Py_buffer views[5];
     int got = 0;
@@ -221,31 +259,52 @@ static PyObject *py_grid(PyObject *self, PyObject *args) {
         PyErr_SetString(PyExc_ValueError, "grid: phase, fixed (bins x q-2) and periodogram must agree, q 2..32");
         goto done;
     }
-    const double *theta = views[0].buf, *phase = views[1].buf, *fixed = views[2].buf, *Iv = views[3].buf;
-    const unsigned char *nonneg = views[4].buf;
+    const double *Iv = views[3].buf;
     PyObject *lin = PyBytes_FromStringAndSize(NULL, c * q * (Py_ssize_t)sizeof(double));
     PyObject *nll = PyBytes_FromStringAndSize(NULL, c * (Py_ssize_t)sizeof(double));
-    double *work = malloc((4 * m + 6 * m + m * q) * sizeof(double));
-    if (!lin || !nll || !work) {
-        Py_XDECREF(lin); Py_XDECREF(nll); free(work);
+    if (!lin || !nll) {
+        Py_XDECREF(lin); Py_XDECREF(nll);
+        goto done;
+    }
+    double level = 0.0;
+    for (Py_ssize_t k = 0; k < m; k++) level += Iv[k];
+    level /= (double)m;
+#ifdef _WIN32
+    threads = 1;
+#endif
+    if (threads > MAX_THREADS) threads = MAX_THREADS;
+    if (threads > c) threads = (int)c;
+    if (threads < 1) threads = 1;
+    Rows rows[MAX_THREADS];
+    for (int t = 0; t < threads; t++) {
+        Rows r = {views[0].buf, views[1].buf, views[2].buf, Iv, views[4].buf, m, c * t / threads,
+                  c * (t + 1) / threads, q, iterations, 0, (double)n_samples, dt, level,
+                  (double *)PyBytes_AS_STRING(lin), (double *)PyBytes_AS_STRING(nll)};
+        rows[t] = r;
+    }
+    int failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+#ifndef _WIN32
+    pthread_t handles[MAX_THREADS];
+    int started[MAX_THREADS] = {0};
+    for (int t = 1; t < threads; t++) started[t] = pthread_create(&handles[t], NULL, fit_rows, &rows[t]) == 0;
+    fit_rows(&rows[0]);
+    for (int t = 1; t < threads; t++) {
+        if (started[t])
+            pthread_join(handles[t], NULL);
+        else
+            fit_rows(&rows[t]); /* a thread that could not start: its rows here */
+    }
+#else
+    fit_rows(&rows[0]);
+#endif
+    Py_END_ALLOW_THREADS
+    for (int t = 0; t < threads; t++) failed |= rows[t].failed;
+    if (failed) {
+        Py_DECREF(lin); Py_DECREF(nll);
         PyErr_NoMemory();
         goto done;
     }
-    double *L = (double *)PyBytes_AS_STRING(lin), *N = (double *)PyBytes_AS_STRING(nll);
-    double *turns = work + 4 * m, *basis = work + 10 * m;
-    Py_BEGIN_ALLOW_THREADS
-    for (Py_ssize_t k = 0; k < m; k++)
-        for (int j = 2; j < q; j++) basis[k * q + j] = fixed[k * (q - 2) + j - 2];
-    double level = 0.0, omega_done = NAN;
-    for (Py_ssize_t k = 0; k < m; k++) level += Iv[k];
-    level /= (double)m;
-    for (Py_ssize_t i = 0; i < c; i++) {
-        mode_columns(-theta[2 * i + 1] * dt, 2.0 * M_PI * theta[2 * i] * dt, phase, m, (double)n_samples, turns,
-                     &omega_done, q, basis);
-        N[i] = fit_candidate(basis, Iv, nonneg, m, q, iterations, level, L + i * q, work);
-    }
-    Py_END_ALLOW_THREADS
-    free(work);
     result = Py_BuildValue("NN", lin, nll);
 done:
     for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);

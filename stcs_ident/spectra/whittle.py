@@ -7,6 +7,7 @@ candidate of which is evaluated at once (:func:`grid_start`). The model and its 
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,9 +23,11 @@ __all__ = [
     "TINY",
     "BandProblem",
     "band_design",
+    "compiled_scoring",
     "designs",
     "fejer_lorentzian",
     "grid_start",
+    "kernel_threads",
     "linear_grid",
     "neg_log_likelihood",
     "null_neg_log_likelihood",
@@ -230,19 +233,43 @@ def grid_start(starts: list[float], problem: BandProblem, limits, damping_grid) 
     return np.concatenate([theta_nl, _linear_start(theta_nl, problem)[0]])
 
 
+# A grid of this many rows × bins or more is split over the kernel's threads (:func:`kernel_threads`): a
+# profile's grid (hundreds of rows of a few hundred bins), not a fit's start grid (15 rows), whose threads'
+# start (about 50 µs) would cost more than they save.
+THREADED_ROW_BINS = 50_000
+MAX_KERNEL_THREADS = 4
+
+
+def kernel_threads() -> int:
+    """Threads for a large grid: the CPUs this process may use (at most :data:`MAX_KERNEL_THREADS`), or one in
+    a worker process of a pool (track's, diagnose's, a Dask worker's), whose siblings use the others."""
+    import multiprocessing
+
+    if multiprocessing.parent_process() is not None:
+        return 1
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_KERNEL_THREADS))
+
+
 def linear_grid(thetas: np.ndarray, problem: BandProblem, iterations: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`whittle_linear_many` of :func:`designs` (``thetas``, ``problem``): the linear terms fitted at each
     (f, σ) row, coefficients (c, 2 + q) and -log-likelihoods (c,). By the compiled kernel where it is built,
     which forms each row's basis as it fits it (the same formulas as :func:`_fejer`; the rotations once per
-    distinct frequency, for consecutive rows): the grids never stacked in memory."""
+    distinct frequency, for consecutive rows): the grids never stacked in memory; a large grid's rows split
+    over :func:`kernel_threads` threads (each row's result its own arithmetic's, whichever thread fits it)."""
     if _whittle_kernel is None or FORCE_NUMPY:
         return whittle_linear_many(designs(thetas, problem), problem.periodogram, problem.nonnegative, iterations)
     c, q = thetas.shape[0], 2 + problem.fixed.shape[1]
+    threads = kernel_threads() if c * problem.phase.size >= THREADED_ROW_BINS else 1
     lin, nll = _whittle_kernel.grid(np.ascontiguousarray(thetas, dtype=np.float64),
                                     np.ascontiguousarray(problem.phase, dtype=np.float64), int(problem.n_samples),
                                     float(problem.dt), np.ascontiguousarray(problem.fixed, dtype=np.float64),
                                     np.ascontiguousarray(problem.periodogram, dtype=np.float64),
-                                    np.ascontiguousarray(problem.nonnegative, dtype=np.uint8), int(iterations))
+                                    np.ascontiguousarray(problem.nonnegative, dtype=np.uint8), int(iterations),
+                                    threads)
     return np.frombuffer(lin, dtype=np.float64).reshape(c, q).copy(), np.frombuffer(nll, dtype=np.float64).copy()
 
 
