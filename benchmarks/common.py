@@ -103,6 +103,17 @@ def code_path() -> tuple[str, str | None]:
     return f"numpy fallback ({why})", warning
 
 
+def spectra_path() -> str:
+    """Which code fits the spectra's bands: the compiled kernel (spectra/_whittle_kernel.c) or the numpy path."""
+    from stcs_ident.spectra import whittle
+
+    if getattr(whittle, "_whittle_kernel", None) is None:
+        return "numpy (no compiled kernel in this install)" if hasattr(whittle, "_whittle_kernel") else "numpy"
+    if whittle.FORCE_NUMPY:
+        return "numpy (STCS_IDENT_NUMPY set; kernel available)"
+    return f"compiled kernel ({os.path.basename(whittle._whittle_kernel.__file__)})"
+
+
 def print_header() -> None:
     """What is being timed: package version and origin, Python, forward-solver code path."""
     pkg, where = package_location()
@@ -111,6 +122,7 @@ def print_header() -> None:
     print(f"  location: {where}")
     print(f"  python: {sys.executable} ({platform.python_version()})")
     print(f"  forward solver: {path}")
+    print(f"  spectra fits: {spectra_path()}")
     if warning:
         print(warning)
     print(flush=True)
