@@ -166,38 +166,77 @@ static double fit_candidate(const double *B, const double *P, const unsigned cha
     return nll;
 }
 
-/* The mode's two columns of one pole z = a + iω (a = −σΔt, ω = 2π f Δt) over the bins' phases φ_k: H(u) =
- * 2G(u) − 1 at u = exp(z − iφ), G(u) = 1/(1 − u) − u (1 − uᴺ) / (N (1 − u)²) (whittle.py's fejer_lorentzian,
- * written as its _fejer: exp and expm1 of x + iy from the sines and cosines of y and N y, free of cancellation
- * near u = 1), as Re H + Im H and Re H − Im H, into the first two columns of the rows of `basis` (m × q). The
- * rotations (cos, sin, 2 sin²(·/2) of y = ω − φ and of N y) depend on ω alone: `turns` (6 m doubles) holds them
- * for `omega_done` and is recomputed only for another ω. */
+/* The rotations of y = ω − φ and of N y: cos, sin, 2 sin²(·/2) of each (whittle.py's _turns). */
+static void rotations(double y, double n, double *t) {
+    double yn = n * y, h = sin(0.5 * y), hn = sin(0.5 * yn);
+    t[0] = cos(y); t[1] = sin(y); t[2] = 2.0 * h * h;
+    t[3] = cos(yn); t[4] = sin(yn); t[5] = 2.0 * hn * hn;
+}
+
+/* The pole's constants: exp and expm1 of a and of N a (a = Re z = −σΔt). */
+typedef struct {
+    double grow, grow_n, em1, em1_n, n;
+} Pole;
+
+static Pole pole_of(double a, double n) {
+    Pole z = {exp(a), exp(n * a), expm1(a), expm1(n * a), n};
+    return z;
+}
+
+/* H(u) = 2G(u) − 1 at one bin, G(u) = 1/(1 − u) − u (1 − uᴺ) / (N (1 − u)²), u = exp(z − iφ), from the bin's
+ * rotations `t` (whittle.py's _fejer: exp and expm1 of x + iy written out, free of cancellation near u = 1),
+ * into H[0] + i H[1]; and, where `dH` is given, dH/dz = 2 dG/du · u into dH[0] + i dH[1]. */
+static void fejer_bin(const double *t, const Pole *z, double *H, double *dH) {
+    double n = z->n;
+    /* 1 − u = x + iy, its reciprocal r = (x − iy) / |1 − u|², then g = r − u (1 − uᴺ) r² / N */
+    double x = t[2] - z->em1 * t[0], y = -z->grow * t[1], d = 1.0 / (x * x + y * y);
+    double rr = x * d, ri = -y * d;
+    double ur = z->grow * t[0], ui = z->grow * t[1];                    /* u */
+    double tr = t[5] - z->em1_n * t[3], ti = -z->grow_n * t[4];         /* 1 − uᴺ */
+    double pr = ur * tr - ui * ti, pi = ur * ti + ui * tr;              /* u (1 − uᴺ) */
+    double r2r = rr * rr - ri * ri, r2i = 2.0 * rr * ri;                /* r² */
+    double gr = rr - (pr * r2r - pi * r2i) / n, gi = ri - (pr * r2i + pi * r2r) / n;
+    H[0] = 2.0 * gr - 1.0;
+    H[1] = 2.0 * gi;
+    if (!dH) return;
+    /* dG/du = r² − (1 − uᴺ − N uᴺ) r² / N − 2 u (1 − uᴺ) r³ / N */
+    double unr = z->grow_n * t[3], uni = z->grow_n * t[4];              /* uᴺ */
+    double r3r = r2r * rr - r2i * ri, r3i = r2r * ri + r2i * rr;        /* r³ */
+    double sr = tr - n * unr, si = ti - n * uni;
+    double dgr = r2r - (sr * r2r - si * r2i) / n - 2.0 * (pr * r3r - pi * r3i) / n;
+    double dgi = r2i - (sr * r2i + si * r2r) / n - 2.0 * (pr * r3i + pi * r3r) / n;
+    dH[0] = 2.0 * (dgr * ur - dgi * ui);
+    dH[1] = 2.0 * (dgr * ui + dgi * ur);
+}
+
+/* The mode's two columns of one pole z = a + iω (a = −σΔt, ω = 2π f Δt) over the bins' phases φ_k: Re H + Im H
+ * and Re H − Im H (:c:func:`fejer_bin`), into the first two columns of the rows of `basis` (m × q). The
+ * rotations depend on ω alone: `turns` (6 m doubles) holds them for `omega_done` and is recomputed only for
+ * another ω. */
 static void mode_columns(double a, double omega, const double *phase, Py_ssize_t m, double n, double *turns,
                          double *omega_done, int q, double *basis) {
     if (!(omega == *omega_done)) {
-        for (Py_ssize_t k = 0; k < m; k++) {
-            double y = omega - phase[k], yn = n * y, h = sin(0.5 * y), hn = sin(0.5 * yn);
-            double *t = turns + 6 * k;
-            t[0] = cos(y); t[1] = sin(y); t[2] = 2.0 * h * h;
-            t[3] = cos(yn); t[4] = sin(yn); t[5] = 2.0 * hn * hn;
-        }
+        for (Py_ssize_t k = 0; k < m; k++) rotations(omega - phase[k], n, turns + 6 * k);
         *omega_done = omega;
     }
-    double grow = exp(a), grow_n = exp(n * a), em1 = expm1(a), em1_n = expm1(n * a);
+    Pole z = pole_of(a, n);
     for (Py_ssize_t k = 0; k < m; k++) {
-        const double *t = turns + 6 * k;
-        /* 1 − u = x + iy, its reciprocal r = (x − iy) / |1 − u|², then g = r − u (1 − uᴺ) r² / N */
-        double x = t[2] - em1 * t[0], y = -grow * t[1], d = 1.0 / (x * x + y * y);
-        double rr = x * d, ri = -y * d;
-        double ur = grow * t[0], ui = grow * t[1];
-        double tr = t[5] - em1_n * t[3], ti = -grow_n * t[4];
-        double pr = ur * tr - ui * ti, pi = ur * ti + ui * tr; /* u (1 − uᴺ) */
-        double r2r = rr * rr - ri * ri, r2i = 2.0 * rr * ri;   /* r² */
-        double gr = rr - (pr * r2r - pi * r2i) / n, gi = ri - (pr * r2i + pi * r2r) / n;
-        double hr = 2.0 * gr - 1.0, hi = 2.0 * gi;
-        basis[k * q] = hr + hi;
-        basis[k * q + 1] = hr - hi;
+        double H[2];
+        fejer_bin(turns + 6 * k, &z, H, NULL);
+        basis[k * q] = H[0] + H[1];
+        basis[k * q + 1] = H[0] - H[1];
     }
+}
+
+/* The first n objects' buffers (C-contiguous) into views; how many were opened (n, or fewer with an error set). */
+static int open_views(PyObject *const *objs, int n, Py_buffer *views) {
+    for (int k = 0; k < n; k++)
+        if (PyObject_GetBuffer(objs[k], &views[k], PyBUF_C_CONTIGUOUS) < 0) return k;
+    return n;
+}
+
+static void close_views(Py_buffer *views, int n) {
+    for (int k = 0; k < n; k++) PyBuffer_Release(&views[k]);
 }
 
 /* A run of consecutive rows of a grid, fitted by one thread with its own buffers. */
@@ -247,10 +286,9 @@ static PyObject *py_grid(PyObject *self, PyObject *args) {
                           &iterations, &threads))
         return NULL;
     Py_buffer views[5];
-    int got = 0;
     PyObject *result = NULL;
-    for (; got < 5; got++)
-        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    int got = open_views(objs, 5, views);
+    if (got < 5) goto done;
     Py_ssize_t c = views[0].len / (2 * (Py_ssize_t)sizeof(double));
     Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
     int q = (int)views[4].len;
@@ -307,7 +345,7 @@ static PyObject *py_grid(PyObject *self, PyObject *args) {
     }
     result = Py_BuildValue("NN", lin, nll);
 done:
-    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    close_views(views, got);
     return result;
 }
 
@@ -386,32 +424,17 @@ typedef struct {
 /* The expected periodogram at θ = (f, σ, linear terms) and its gradient (m × (2 + q), row-major). */
 static void expected(const Band *b, const double *theta, double *mean, double *grad) {
     int q = b->q, p = q + 2;
-    double a = -theta[1] * b->dt, omega = 2.0 * M_PI * theta[0] * b->dt, n = b->n;
-    double grow = exp(a), grow_n = exp(n * a), em1 = expm1(a), em1_n = expm1(n * a);
+    double omega = 2.0 * M_PI * theta[0] * b->dt, wdt = 2.0 * M_PI * b->dt;
+    Pole z = pole_of(-theta[1] * b->dt, b->n);
     double c0 = theta[2], c1 = theta[3];
     for (Py_ssize_t k = 0; k < b->m; k++) {
-        double y = omega - b->phase[k], yn = n * y, h = sin(0.5 * y), hn = sin(0.5 * yn);
-        double cs = cos(y), sn = sin(y), cs_n = cos(yn), sn_n = sin(yn);
-        double x = 2.0 * h * h - em1 * cs, yy = -grow * sn, d = 1.0 / (x * x + yy * yy);
-        double rr = x * d, ri = -yy * d;                          /* r = 1 / (1 − u) */
-        double ur = grow * cs, ui = grow * sn;                    /* u */
-        double tr = 2.0 * hn * hn - em1_n * cs_n, ti = -grow_n * sn_n; /* 1 − uᴺ */
-        double unr = grow_n * cs_n, uni = grow_n * sn_n;          /* uᴺ */
-        double pr = ur * tr - ui * ti, pi = ur * ti + ui * tr;     /* u (1 − uᴺ) */
-        double r2r = rr * rr - ri * ri, r2i = 2.0 * rr * ri;       /* r² */
-        double r3r = r2r * rr - r2i * ri, r3i = r2r * ri + r2i * rr; /* r³ */
-        double gr = rr - (pr * r2r - pi * r2i) / n, gi = ri - (pr * r2i + pi * r2r) / n;
-        double Hr = 2.0 * gr - 1.0, Hi = 2.0 * gi;
-        /* dG/du = r² − (1 − uᴺ − N uᴺ) r² / N − 2 u (1 − uᴺ) r³ / N; dH/dz = 2 dG/du · u */
-        double sr = tr - n * unr, si = ti - n * uni;
-        double dgr = r2r - (sr * r2r - si * r2i) / n - 2.0 * (pr * r3r - pi * r3i) / n;
-        double dgi = r2i - (sr * r2i + si * r2r) / n - 2.0 * (pr * r3i + pi * r3r) / n;
-        double dHr = 2.0 * (dgr * ur - dgi * ui), dHi = 2.0 * (dgr * ui + dgi * ur);
+        double t[6], H[2], dH[2];
+        rotations(omega - b->phase[k], b->n, t);
+        fejer_bin(t, &z, H, dH);
         /* d/df = dH · 2πiΔt, d/dσ = dH · (−Δt) */
-        double wdt = 2.0 * M_PI * b->dt;
-        double dfr = -dHi * wdt, dfi = dHr * wdt, dsr = -dHr * b->dt, dsi = -dHi * b->dt;
+        double dfr = -dH[1] * wdt, dfi = dH[0] * wdt, dsr = -dH[0] * b->dt, dsi = -dH[1] * b->dt;
         double *g = grad + k * p;
-        double col0 = Hr + Hi, col1 = Hr - Hi;
+        double col0 = H[0] + H[1], col1 = H[0] - H[1];
         g[0] = (dfr + dfi) * c0 + (dfr - dfi) * c1;
         g[1] = (dsr + dsi) * c0 + (dsr - dsi) * c1;
         g[2] = col0;
@@ -424,18 +447,6 @@ static void expected(const Band *b, const double *theta, double *mean, double *g
         }
         mean[k] = e;
     }
-}
-
-static double likelihood(const Band *b, const double *mean) {
-    double total = 0.0;
-    int bad = 0;
-    for (Py_ssize_t k = 0; k < b->m; k++) {
-        if (mean[k] <= 0.0)
-            bad = 1;
-        else
-            total += log(mean[k]) + b->P[k] / mean[k];
-    }
-    return bad ? INFINITY : total;
 }
 
 /* The scoring step with the powers at zero held where the quadratic model wants them lower, released when its
@@ -484,9 +495,9 @@ static int scoring(const Band *b, double *theta, const double *limits, int max_i
                    double *work) {
     int q = b->q, p = q + 2;
     Py_ssize_t m = b->m;
-    double *trial_mean = work, *trial_grad = work + m;
+    double *trial_mean = work, *trial_grad = work + m, *inv = work + m + m * p; /* 1/E: not needed here */
     expected(b, theta, mean, grad);
-    double nll = likelihood(b, mean);
+    double nll = neg_log_likelihood(mean, b->P, m, inv);
     for (int it = 0; it < max_iterations; it++) {
         double score[MAX_PARAMETERS] = {0}, fisher[MAX_PARAMETERS * MAX_PARAMETERS] = {0}, step[MAX_PARAMETERS];
         for (Py_ssize_t k = 0; k < m; k++) {
@@ -523,7 +534,7 @@ static int scoring(const Band *b, double *theta, const double *limits, int max_i
                 if (b->nonneg[i - 2] && trial[i] < 0.0) trial[i] = 0.0;
             if (limits[0] < trial[0] && trial[0] < limits[1] && limits[2] < trial[1] && trial[1] < limits[3]) {
                 expected(b, trial, trial_mean, trial_grad);
-                double trial_nll = likelihood(b, trial_mean);
+                double trial_nll = neg_log_likelihood(trial_mean, b->P, m, inv);
                 if (trial_nll <= nll) {
                     memcpy(theta, trial, p * sizeof(double));
                     memcpy(mean, trial_mean, m * sizeof(double));
@@ -552,10 +563,9 @@ static PyObject *py_fisher_scoring(PyObject *self, PyObject *args) {
                           &objs[5], &max_iterations))
         return NULL;
     Py_buffer views[6];
-    int got = 0;
     PyObject *result = NULL;
-    for (; got < 6; got++)
-        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    int got = open_views(objs, 6, views);
+    if (got < 6) goto done;
     Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
     int q = (int)views[4].len, p = q + 2;
     if (q < 2 || q > MAX_COLUMNS || m < 1 || views[0].len != p * (Py_ssize_t)sizeof(double)
@@ -568,7 +578,7 @@ static PyObject *py_fisher_scoring(PyObject *self, PyObject *args) {
     PyObject *theta = PyBytes_FromStringAndSize(views[0].buf, p * (Py_ssize_t)sizeof(double));
     PyObject *mean = PyBytes_FromStringAndSize(NULL, m * (Py_ssize_t)sizeof(double));
     PyObject *grad = PyBytes_FromStringAndSize(NULL, m * p * (Py_ssize_t)sizeof(double));
-    double *work = malloc((m + m * p) * sizeof(double));
+    double *work = malloc((2 * m + m * p) * sizeof(double));
     if (!theta || !mean || !grad || !work) {
         Py_XDECREF(theta); Py_XDECREF(mean); Py_XDECREF(grad); free(work);
         PyErr_NoMemory();
@@ -582,7 +592,7 @@ static PyObject *py_fisher_scoring(PyObject *self, PyObject *args) {
     free(work);
     result = Py_BuildValue("NONN", theta, ok ? Py_True : Py_False, mean, grad);
 done:
-    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    close_views(views, got);
     return result;
 }
 
@@ -593,10 +603,9 @@ static PyObject *py_linear_many(PyObject *self, PyObject *args) {
     int iterations;
     if (!PyArg_ParseTuple(args, "OOOi", &objs[0], &objs[1], &objs[2], &iterations)) return NULL;
     Py_buffer views[3];
-    int got = 0;
     PyObject *result = NULL;
-    for (; got < 3; got++)
-        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    int got = open_views(objs, 3, views);
+    if (got < 3) goto done;
     Py_ssize_t m = views[1].len / (Py_ssize_t)sizeof(double);
     int q = (int)views[2].len;
     if (q < 2 || q > MAX_COLUMNS || m < 1 || views[0].len % (m * q * (Py_ssize_t)sizeof(double)) != 0) {
@@ -625,7 +634,7 @@ static PyObject *py_linear_many(PyObject *self, PyObject *args) {
     free(work);
     result = Py_BuildValue("NN", lin, nll);
 done:
-    for (int k = 0; k < got; k++) PyBuffer_Release(&views[k]);
+    close_views(views, got);
     return result;
 }
 

@@ -191,7 +191,7 @@ def fisher_scoring(theta: np.ndarray, problem: BandProblem, limits, max_iteratio
     at θ. One pole is scored by the compiled kernel where it is built (``_whittle_kernel.c``: these steps, its
     least squares from the eigen-decomposition of the symmetric system), else by the steps below, its reference.
     """
-    if expected is _expected and len(limits) == 1 + 1:
+    if expected is _expected and len(limits) == 2:  # one pole: its (f, σ) limits
         compiled = compiled_scoring(theta, problem, limits, max_iterations)
         if compiled is not None:
             return compiled
