@@ -50,3 +50,8 @@ def test_the_walk_through_runs_and_finds_the_hidden_mass(tmp_path, monkeypatch, 
         assert (tmp_path / name).is_file(), name
     assert all(_is_png(tmp_path / name) for name in ("spectra.png", "errors.png", "residuals.png", "profile.png"))
     assert any((tmp_path / "report").glob("spectra_*.png"))  # the diagnosis carried its spectra to the report
+    # The page's profile figure: the named cause's star on its own curve (the figure the page saved).
+    from stcs_ident.report.diagnose_figures import plot_profiles
+    from tests.profile_marks import assert_marks_on_curves
+
+    assert_marks_on_curves(diagnosis, plot_profiles(diagnosis))

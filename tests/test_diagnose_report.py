@@ -14,10 +14,12 @@ from stcs_ident.core.errors import InputError
 from stcs_ident.core.files import umask
 from stcs_ident.core.model import Cable, Campaign, Setup, Test
 from stcs_ident.diagnose import diagnose
+from stcs_ident.diagnose.profile import cause_profile
 from stcs_ident.forward import natural_frequencies
 from stcs_ident.io.campaign import load_campaign
 from stcs_ident.report import diagnose_figures as diagnosis_figures
 from stcs_ident.report.diagnose import CSV_FILES, write_report
+from tests.profile_marks import assert_marks_on_curves
 
 ROOT = Path(__file__).resolve().parents[1]
 HAN = ROOT / "campaigns" / "han2020"
@@ -82,7 +84,8 @@ def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis)
     assert {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()} == dict.fromkeys(files, mode)
 
     text = (out / "report.md").read_text(encoding="utf-8")
-    assert d.cause_text() in text and d.selection.statement in text
+    assert text.count(d.cause_text()) == 1  # said once: the named cause's section does not repeat it
+    assert "The nominal χ² is 2.462e+05: rejected." in text  # the selection's gate, said in the ranking's key
     assert d.settings.max_effects == 2 and d.summary()["settings"]["tension_model"] == "uniform"
     g = d.summary()["gain"]
     for key in ("rms_error_nominal", "rms_error_baseline", "rms_error_corrected", "cv_rms_error_corrected"):
@@ -98,11 +101,15 @@ def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis)
     fitted = ranking["effects"] != "unmodeled_mass"  # the failed hypothesis has no ε
     assert d.selection.model_error and (ranking.loc[fitted, "epsilon"] > 1e-3).all()
     assert ranking["epsilon"].iloc[0] < ranking.loc[ranking["effects"] == "nominal", "epsilon"].iloc[0]
-    assert ranking["delta_aicc"].iloc[0] == 0.0 and ranking["delta_aicc"].is_monotonic_increasing
+    assert ranking["delta_aicc"].iloc[0] == 0.0 and ranking["delta_aicc"].dropna().is_monotonic_increasing
+    failed = ranking["failure"].fillna("") != ""  # a failed fit: its reason, no figures (not χ² inf, ε 0)
+    assert ranking.loc[failed, "effects"].tolist() == ["unmodeled_mass"]
+    assert ranking.loc[failed, ["chi2", "epsilon", "delta_aicc"]].isna().all(axis=None)
+    assert "stopped at a bound" in ranking.loc[failed, "failure"].iloc[0]
+    assert "| inf |" not in text and "- unmodeled_mass: the fit stopped at a bound" in text
     assert ranking.loc[ranking["cause"], "effects"].tolist() == ["unmodeled_mass + unmodeled_support"]
     failed = ranking.loc[~fitted]
     assert len(failed) == 1 and not failed["cause"].iloc[0]  # at its bound: failed, never the cause
-    assert "failed: the fit stopped at a bound" in text
 
     freq = pd.read_csv(out / "frequencies.csv")
     assert len(freq) == 36 and freq["test"].unique().tolist() == HAN_TESTS
@@ -231,13 +238,11 @@ def test_figures_return_what_they_drew(han_diagnosis):
     first = drawn["lines"]["nominal"][0].get_ydata()
     m = d.measurements[0]
     np.testing.assert_allclose(first, (d.per_test(d.nominal)[0] - m.frequencies) / m.frequencies * 100, rtol=1e-12)
-    profile = diagnosis_figures.plot_profile(d)
-    scan = d.fits[("unmodeled_mass",)]  # the pair is fitted from the singles' scans: the mass's own is drawn
-    assert profile["scan"] is scan and len(profile["profile"].get_xdata()) == len(scan.profile) > 0
-    position = d.parameters(d.corrected)[0]["unmodeled_mass"]["position"]
-    assert profile["estimate"].get_xdata()[0] == position
-    with pytest.raises(ValueError, match="no profile scan"):
-        diagnosis_figures.plot_profile(d, "end_restraint")  # not in the cause
+    drawn = diagnosis_figures.plot_profiles(d)
+    assert set(drawn["panels"]) == {"unmodeled_mass", "unmodeled_support"} and drawn["unscanned"] == []
+    assert_marks_on_curves(d, drawn)
+    with pytest.raises(ValueError, match="not an unmodeled attachment"):
+        cause_profile(d, "end_restraint")  # not in the cause
 
 
 def test_cli_writes_the_report(tmp_path, capsys):

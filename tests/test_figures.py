@@ -44,22 +44,22 @@ def test_residuals_legend_is_inside_the_figure_for_one_test():
     assert len(legend.get_texts()) == 4 and _inside(legend, fig)
 
 
-def test_a_flat_profile_scan_is_left_out_and_said(monkeypatch):
-    """The support's scan moves χ² by 0.015 along the span (as han2020's does): no panel, a sentence instead."""
-    monkeypatch.setattr(diagnose_figures.registry, "get",
-                        lambda name: SimpleNamespace(unmodeled=name.startswith("unmodeled"), noun=name.split("_")[-1]))
-    x = np.linspace(0.6, 8.7, 8)
-    mass = SimpleNamespace(effects=("unmodeled_mass",), profile=list(zip(x, 7e4 + 2e4 * (x - 5.2) ** 2)))
-    support = SimpleNamespace(effects=("unmodeled_support",), profile=list(zip(x, 246178.64 + 0.002 * x)))
-    d = SimpleNamespace(selection=SimpleNamespace(effects=("unmodeled_mass", "unmodeled_support")),
-                        corrected=SimpleNamespace(effects=("unmodeled_mass", "unmodeled_support"),
-                                                  profile=mass.profile),
-                        fits={("unmodeled_support",): support})
-    assert list(diagnose_figures.profile_scans(d)) == ["unmodeled_mass"]
-    assert diagnose_figures.unscanned(d) == ["unmodeled_support"]
-    assert "support" in diagnose_figures.unscanned_sentence(["unmodeled_support"])
-    support.profile = list(zip(x, 246178.64 + 0.5 * x))  # a change of 4 in χ² along the span is information
-    assert list(diagnose_figures.profile_scans(d)) == ["unmodeled_mass", "unmodeled_support"]
+def test_a_flat_profile_is_left_out_and_said(monkeypatch):
+    """The support's profile moves χ² by 0.015 along the span: no panel, a sentence instead."""
+    import importlib
+
+    profile_module = importlib.import_module("stcs_ident.diagnose.profile")  # stcs_ident.diagnose is also a function
+    PositionProfile = profile_module.PositionProfile
+
+    x = np.linspace(0.6, 8.7, 25)
+    profiles = {"unmodeled_mass": PositionProfile("unmodeled_mass", x, 7e4 + 2e4 * (x - 5.2) ** 2, 5.2, 7e4),
+                "unmodeled_support": PositionProfile("unmodeled_support", x, 246178.64 + 0.002 * x, 3.0,
+                                                     246178.646)}
+    monkeypatch.setattr(profile_module, "cause_profiles", lambda d, points=None: dict(profiles))
+    assert list(diagnose_figures.cause_profiles(None)) == ["unmodeled_mass"]
+    assert "support" in diagnose_figures.flat_sentence(["unmodeled_support"])
+    profiles["unmodeled_support"] = PositionProfile("unmodeled_support", x, 246178.64 + 0.5 * x, 3.0, 246180.1)
+    assert list(diagnose_figures.cause_profiles(None)) == ["unmodeled_mass", "unmodeled_support"]  # Δχ² 4: information
 
 
 def _spectra():

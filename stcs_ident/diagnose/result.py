@@ -243,25 +243,45 @@ class Diagnosis(Result):
                            f"{'; '.join(said)}.")
         if not sel.effects:
             return sel.statement + corrections
+        # The principal effect first: the sentence leads with what the removal costs say matters most.
+        ordered = sorted(sel.effects, key=lambda e: e != sel.principal)
         parts = [registry.get(e).describe(values.get(e, {}), sigmas.get(e, {}), self.campaign.cable)
-                 for e in sel.effects]
+                 for e in ordered]
         delta = self.nominal.aicc - self.corrected.aicc
         text = f"{'; '.join(parts)} explain{'s' if len(parts) == 1 else ''} the residual pattern"
         text = text[0].upper() + text[1:]
-        text += f" (ΔAICc = {delta:.1f} against the nominal model; principal effect: {sel.principal})."
+        text += f" (ΔAICc = {delta:.1f} against the nominal model"
+        if len(sel.effects) > 1:
+            text += f"; principal effect: {sel.principal}"
+        text += ")."
         ranks = self.cv_ranks()
         chosen = self.corrected
+        said: tuple = ()
         if ranks.get(chosen.effects, 1) > 1:
             top = next(f for f in self.fits.values() if ranks.get(f.effects) == 1)
-            text += (f" By leave-one-mode-out prediction error it ranks {ranks[chosen.effects]}; "
-                     f"{' + '.join(top.effects) or 'the nominal model'} predicts left-out modes best "
-                     f"({top.cv_rms_error:.3g} % against {chosen.cv_rms_error:.3g} %).")
-        if sel.ambiguous_with:
-            text += (" Not told apart from: " + "; ".join(" + ".join(a) for a in sel.ambiguous_with)
-                     + " (ΔAICc < 2).")
-        if sel.implausible:
+            name = " + ".join(top.effects) or "the nominal model"
+            text += (f" Leave-one-mode-out prediction prefers {name} ({top.cv_rms_error:.3g} % against "
+                     f"{chosen.cv_rms_error:.3g} %); the diagnosis follows AICc (each frequency weighed by its "
+                     f"uncertainty, parameters and implausible departures charged), which ")
+            if top.effects in sel.ambiguous_with:
+                text += "does not tell the two apart (ΔAICc < 2): the simpler is named."
+            else:
+                more = (f" and {top.n_parameters} parameters against {chosen.n_parameters}"
+                        if top.n_parameters > chosen.n_parameters else "")
+                text += f"ranks {name} {top.aicc - chosen.aicc:.1f} higher"
+                if top.effects in sel.implausible:
+                    text += (f": it needs less plausible departures from the nominal values (prior cost "
+                             f"{top.penalty:.1f} against {chosen.penalty:.1f}){more}.")
+                else:
+                    text += f" (χ² {top.chi2:.4g} against {chosen.chi2:.4g}{more})."
+            said = (top.effects,)
+        ambiguous = [a for a in sel.ambiguous_with if a not in said]
+        implausible = [a for a in sel.implausible if a not in said]
+        if ambiguous:
+            text += " Not told apart from: " + "; ".join(" + ".join(a) for a in ambiguous) + " (ΔAICc < 2)."
+        if implausible:
             text += (" The frequencies alone do not separate it from "
-                     + "; ".join(" + ".join(a) for a in sel.implausible)
+                     + "; ".join(" + ".join(a) for a in implausible)
                      + ", which need less plausible departures from the nominal values.")
         if chosen.epsilon > 0:
             text += (f" No hypothesis reaches the measurement uncertainty: the ranking includes a model error of "

@@ -45,7 +45,11 @@
    damper's own mass explains the data with 3 (χ² 28.4, AICc 3.1 above;
    validate_diagnosis stay seed 9503).
 4. **Principal effect**: of the chosen effects, the one whose removal
-   raises AICc most.
+   raises AICc most, of those whose removal cost is known. A cost is not
+   known when the hypothesis without the effect was not fitted or its fit
+   failed (it stopped at a bound: no estimate, so no AICc); such an effect
+   is principal only when no cost is known, and ``removal_unknown`` says
+   why (an unknown cost is never read as an infinite one).
 5. **Ambiguity**: every other hypothesis within :data:`AMBIGUITY` of the
    chosen one's AICc and not merely the chosen effects plus another is
    reported as ambiguous, never hidden; so are those that explain the
@@ -73,7 +77,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import optimize
@@ -111,7 +115,8 @@ class Selection:
         Probability of a χ² at least the nominal's if the nominal model
         were right.
     removal_cost : dict
-        ΔAICc when each effect of the cause is removed.
+        ΔAICc when each effect of the chosen hypothesis is removed (NaN where
+        not known: see ``removal_unknown``).
     statement : str
         One sentence on what was decided and why.
     fitted : tuple of str
@@ -126,6 +131,9 @@ class Selection:
     model_error : bool
         Whether no hypothesis reaches the measurement uncertainty, so that
         AICc includes a model error ε.
+    removal_unknown : dict
+        {effect: why its removal cost is not known} (the hypothesis without
+        it was not fitted, or its fit failed, with the failure's reason).
     """
 
     effects: tuple[str, ...]
@@ -139,6 +147,7 @@ class Selection:
     corrections: tuple[str, ...] = ()
     implausible: tuple[tuple[str, ...], ...] = ()
     model_error: bool = False
+    removal_unknown: dict[str, str] = field(default_factory=dict)
 
 
 def explains(nominal: HypothesisFit, n: int) -> bool:
@@ -223,12 +232,9 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
             beyond = beyond_tolerance(best)
     corrections = tuple(e for e in best.effects if beyond.get(e) is False)
     cause = tuple(e for e in best.effects if e not in corrections)
-    cost = {}
-    for e in best.effects:
-        rest = tuple(x for x in best.effects if x != e)
-        other = fits.get(rest)
-        cost[e] = (other.aicc - best.aicc) if other is not None and math.isfinite(other.aicc) else math.inf
-    principal = max(cause, key=lambda e: cost[e]) if cause else None
+    cost, unknown = removal_costs(best, fits)
+    known = [e for e in cause if e not in unknown]
+    principal = max(known, key=lambda e: cost[e]) if known else (cause[0] if cause else None)
     ambiguous = tuple(f.effects for f in ranked if f is not best and f.aicc - best.aicc < AMBIGUITY
                       and not set(f.effects) > set(best.effects))
     implausible = tuple(f.effects for f in ranked if f is not best and f.effects not in ambiguous
@@ -248,7 +254,26 @@ def select(fits: dict[tuple[str, ...], HypothesisFit], n: int, max_effects: int 
     if ambiguous:
         statement += f", but {'; '.join(' + '.join(a) for a in ambiguous)} explain them about as well (ΔAICc < 2)"
     return Selection(cause, principal, ambiguous, False, p_value, cost, statement + ".", best.effects, corrections,
-                     implausible, model_error)
+                     implausible, model_error, unknown)
+
+
+def removal_costs(best: HypothesisFit, fits: dict) -> tuple[dict[str, float], dict[str, str]]:
+    """The AICc rise when each effect of ``best`` is dropped ({effect: ΔAICc}, NaN where not known) and why a
+    cost is not known ({effect: reason}): the hypothesis without the effect was not fitted, or failed."""
+    cost: dict[str, float] = {}
+    unknown: dict[str, str] = {}
+    for e in best.effects:
+        rest = tuple(x for x in best.effects if x != e)
+        other = fits.get(rest)
+        label = " + ".join(rest) or "the nominal model"
+        if other is None:
+            cost[e], unknown[e] = math.nan, f"{label} was not fitted"
+        elif other.failure is not None or not math.isfinite(other.aicc):
+            reason = (other.failure or "its AICc is not finite").split(":", 1)[0].split(", so ")[0]
+            cost[e], unknown[e] = math.nan, f"{label} failed ({reason})"
+        else:
+            cost[e] = other.aicc - best.aicc
+    return cost, unknown
 
 
 def insignificant(fit: HypothesisFit) -> tuple[str, ...]:

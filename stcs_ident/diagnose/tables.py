@@ -80,20 +80,27 @@ def _reduced_chi2(fit, n: int) -> float:
 
 
 def ranking_table(diagnosis) -> pd.DataFrame:
-    """Every hypothesis, best AICc first: effects, k, χ², reduced χ², AICc, ΔAICc, rms and CV rms (%)."""
+    """Every hypothesis, best AICc first: effects, k, χ², reduced χ², AICc, ΔAICc, rms and CV rms (%); a failed
+    fit last, its figures empty and its reason in ``failure``."""
     d = diagnosis
     n = d.measured.size
     ranked = d.ranked
     best = ranked[0].aicc
     rows = []
     for rank, f in enumerate(ranked, start=1):
-        rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters, "chi2": f.chi2,
-                     "reduced_chi2": _reduced_chi2(f, n), "prior_penalty": f.penalty, "epsilon": f.epsilon,
-                     "aicc": f.aicc, "delta_aicc": f.aicc - best,
+        # A failed fit has no estimate: its figures are empty (not χ² inf, ε 0), its reason in ``failure``.
+        failed = f.failure is not None
+        rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters,
+                     "chi2": math.nan if failed else f.chi2,
+                     "reduced_chi2": math.nan if failed else _reduced_chi2(f, n),
+                     "prior_penalty": math.nan if failed else f.penalty,
+                     "epsilon": math.nan if failed else f.epsilon,
+                     "aicc": math.nan if failed else f.aicc, "delta_aicc": math.nan if failed else f.aicc - best,
                      "rms_error_%": f.rms_error,
                      "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
                      "cause": f.effects == d.selection.fitted,
-                     "parameters": f"failed: {f.failure}" if f.failure else _short(parameter_rows(*d.parameters(f))),
+                     "parameters": "" if failed else _short(parameter_rows(*d.parameters(f))),
+                     "failure": f.failure or "",
                      "seconds": d.timings.get(f.effects, math.nan)})
     return pd.DataFrame(rows)
 

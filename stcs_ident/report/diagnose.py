@@ -80,6 +80,22 @@ def skipped_lines(skipped) -> list[str]:
             for reason, names in by_reason.items()]
 
 
+def removal_sentence(selection) -> str:
+    """The removal costs behind the principal effect, one sentence: ``Removal cost (AICc rise when an effect is
+    dropped): a 48.6; b not known (a alone failed (…)); principal: a, the largest known.``"""
+    sel = selection
+    costs = [f"{e} " + (f"not known: {sel.removal_unknown[e]}" if e in sel.removal_unknown
+                        else number(v, "{:.1f}", finite_only=True)) for e, v in sel.removal_cost.items()]
+    text = "Removal cost (AICc rise when an effect is dropped): " + "; ".join(costs) + "."
+    if not sel.effects:
+        return text + " No cause: corrections only."
+    if len(sel.effects) == 1:
+        return text
+    known = [e for e in sel.effects if e not in sel.removal_unknown]
+    why = "the largest known" if known else "no removal cost known: the first of the cause"
+    return text + f" Principal effect: {sel.principal} ({why})."
+
+
 def baseline_label(diagnosis) -> str:
     """What the baseline re-estimated: ``tension, EI`` (the source paper's correction), ``tension, EI absolute``
     on a bare cable, or the part of it that was fitted (``tension``); ``none`` when nothing was."""
@@ -163,8 +179,11 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
         del columns["epsilon"]
     fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "prior_penalty": "{:.2f}", "epsilon": "{:.2e}",
            "delta_aicc": "{:.1f}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
-    return ["## Hypotheses ranked by AICc", "", markdown_table(ranking, fmt, columns),
-            "How to read this:", "",
+    failed = ranking["failure"] != ""
+    listed = ["Failed fits (no estimate, not ranked):", ""] if failed.any() else []
+    listed += [f"- {row.effects}: {row.failure}" for row in ranking[failed].itertuples()]
+    return ["## Hypotheses ranked by AICc", "", markdown_table(ranking[~failed], fmt, columns), *listed,
+            *([""] if listed else []), "How to read this:", "",
             (f"- χ² sums the squared misfits in units of the frequency uncertainties; k is the number of fitted "
             f"parameters, n = {n} the number of measured frequencies."),
             ("- AICc = χ² + prior + 2k + 2k(k + 1)/(n − k − 1) trades misfit against parameters; lower is better "
@@ -195,18 +214,12 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
 
     sel = d.selection
     n = d.measured.size
-    out = ["## Named cause", "", d.cause_text(), "", sel.statement, ""]
-    if sel.fitted:
-        out.append(f"Principal effect: {sel.principal or 'none (corrections only)'}. Removal cost (AICc rise when "
-                   f"an effect is dropped): "
-                   + "; ".join(f"{e} {number(v, '{:.1f}', finite_only=True)}" for e, v in sel.removal_cost.items())
-                   + ".")
-        out.append("Ambiguous alternatives (ΔAICc < 2): "
-                   + ("; ".join(effects_label(a) for a in sel.ambiguous_with) if sel.ambiguous_with else "none") + ".")
-        out.append("Alternatives the frequencies alone do not separate, set aside for implausible departures from "
-                   "the nominal values: "
-                   + ("; ".join(effects_label(a) for a in sel.implausible) if sel.implausible else "none") + ".")
-        out += ["", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
+    # The cause's sentence (with its alternatives) heads the report: here only what it does not say.
+    out = ["## Named cause", ""]
+    if not sel.fitted:
+        out += [sel.statement, ""]
+    else:
+        out += [removal_sentence(sel), "", markdown_table(cause, {"value": "{:.5g}", "uncertainty": "{:.2g}"})]
     best = d.ranked[0]
     if best is not d.corrected and best.effects == BASELINE and not allowed(BASELINE, d.settings.max_effects):
         out += [(f"The first-ranked {effects_label(best.effects)} is the baseline (the source paper's correction), fitted "
@@ -224,8 +237,11 @@ def _cause_section(d, cause: pd.DataFrame, figures: dict) -> list[str]:
         out.append("")
     if "profile" in figures:
         out += ["![Profile of the position](profile.png)", "",
-                ("χ² with the unmodeled attachment held at each position of a grid (every other parameter "
-                 "refitted), the scan that started the fit; the red line is the named cause's estimate."
+                (f"χ² of the named cause with each unmodeled attachment held at {figures['profile_points']} or more "
+                 "positions along the span (every other parameter of the cause refitted); the red star is the "
+                 "named cause's estimate, a point of the curve."
+                 + (" The setup is symmetric about midspan: the curve is too, and the estimate's mirror image is "
+                    "starred as well." if d.symmetric else "")
                  + (f" {figures['unscanned']}" if figures.get("unscanned") else "")), ""]
     return out
 
@@ -405,12 +421,14 @@ def write_report(diagnosis, out_dir, spectra=None) -> Path:
         if "damping" in tables:
             write_figure(diagnosis_figures.plot_damping(damping)["figure"], tmp / DAMPING_PNG)
             figures["damping"] = DAMPING_PNG
-        if diagnosis_figures.profile_scans(d):
-            drawn = diagnosis_figures.plot_profiles(d)
+        profiles = diagnosis_figures.cause_profiles(d)
+        if profiles:
+            drawn = diagnosis_figures.plot_profiles(d, profiles=profiles)
             write_figure(drawn["figure"], tmp / "profile.png")
             figures["profile"] = "profile.png"
+            figures["profile_points"] = min(p.positions.size for p in profiles.values())
             if drawn["unscanned"]:
-                figures["unscanned"] = diagnosis_figures.unscanned_sentence(drawn["unscanned"])
+                figures["unscanned"] = diagnosis_figures.flat_sentence(drawn["unscanned"])
         text = report_markdown(d, tables, figures, spectra)
         write_atomic(tmp / "report.md", text)
     return out

@@ -95,123 +95,106 @@ def plot_residuals(diagnosis, fig=None) -> Drawn:
 FLAT_PROFILE = 1.0
 
 
-def profile_scans(diagnosis) -> dict:
-    """{effect: fit} of the profile scan of each unmodeled attachment of the named cause.
+def cause_profiles(diagnosis) -> dict:
+    """{effect: PositionProfile} of each unmodeled attachment of the named cause whose profile is informative
+    (χ² varies by at least :data:`FLAT_PROFILE` along the span): :func:`stcs_ident.diagnose.profile.cause_profile`,
+    every other parameter of the cause refitted at each position."""
+    from ..diagnose.profile import cause_profiles as profiles
 
-    The fit that scanned the position: the cause's own when it scanned it,
-    else the single-effect hypothesis (pairs start from the single effects'
-    profile minima and are not scanned again). An effect without a scan, or
-    whose scan is flat (χ² varies by less than :data:`FLAT_PROFILE` along
-    the span: the effect alone changes nothing there), is left out.
-    """
-    d = diagnosis
-    out = {}
-    for e in d.selection.effects:
-        if not registry.get(e).unmodeled:
-            continue
-        own = [x for x in d.corrected.effects if registry.get(x).unmodeled]
-        if d.corrected.profile and own and own[0] == e:
-            scan = d.corrected
-        elif (e,) in d.fits and d.fits[(e,)].profile:
-            scan = d.fits[(e,)]
-        else:
-            continue
-        chi2 = [c for _, c in scan.profile]
-        if max(chi2) - min(chi2) >= FLAT_PROFILE:
-            out[e] = scan
-    return out
+    return {e: p for e, p in profiles(diagnosis).items() if np.ptp(p.chi2) >= FLAT_PROFILE}
 
 
-def unscanned(diagnosis) -> list[str]:
-    """The unmodeled attachments of the named cause that :func:`profile_scans` has no (informative) scan of."""
-    scans = profile_scans(diagnosis)
-    return [e for e in diagnosis.selection.effects if registry.get(e).unmodeled and e not in scans]
-
-
-def unscanned_sentence(effects) -> str:
-    """Why the profile figure has no panel for ``effects`` (see :func:`unscanned`)."""
+def flat_sentence(effects) -> str:
+    """Why the profile figure has no panel for ``effects`` (their profiles are flat)."""
     nouns = " and ".join(registry.get(e).noun for e in effects)
-    return (f"No profile of the {nouns} position: not scanned within the named cause, and alone it leaves χ² "
-            "flat along the span.")
+    return f"No profile of the {nouns} position: χ² varies by less than {FLAT_PROFILE:g} along the span."
 
 
-def plot_profile(diagnosis, effect: str | None = None, ax=None) -> Drawn:
-    """χ² against the position of an unmodeled mass or support of the named cause (the profile scan).
+def plot_profile(diagnosis, effect: str | None = None, ax=None, profile=None) -> Drawn:
+    """χ² of the named cause against the position of one of its unmodeled masses or supports.
 
-    Every other parameter is refitted at each position of the grid; the
-    cause's estimate (and its standard uncertainty) is marked. On a
-    configuration symmetric about midspan only [0, l/2] is scanned.
+    The position is held at each point of a grid over the span and every
+    other parameter of the cause is refitted
+    (:func:`stcs_ident.diagnose.profile.cause_profile`); the cause's
+    estimate is a point of the curve (its χ², by construction), marked with
+    its standard uncertainty. On a configuration symmetric about midspan the
+    curve is symmetric and the mirror of the estimate is marked too.
 
     Parameters
     ----------
     diagnosis : Diagnosis
     effect : str, optional
-        An unmodeled effect (mass or support) of the cause.
-        Default: the first one of the cause.
+        An unmodeled effect (mass or support) of the cause. Default: the first one.
     ax : matplotlib Axes, optional
+    profile : PositionProfile, optional
+        The profile of ``effect`` when already computed.
 
     Returns
     -------
-    dict with the figure, the axes, the profile line, the estimate line and
-    the fit whose scan is drawn (``scan``).
+    dict with the figure, the axes, the profile line, the estimate's marks (``estimate``: the star at the
+    estimate, on the curve) and the profile drawn (``scan``).
 
     Raises
     ------
     ValueError
-        When the cause has no such effect or its position was not scanned.
+        When the cause has no such effect or its profile is flat.
     """
     d = diagnosis
-    scans = profile_scans(d)
-    effect = effect if effect is not None else next(iter(scans), None)
-    if effect not in scans:
-        raise ValueError(f"no profile scan of {effect!r} in the named cause {d.selection.effects}")
-    scan = scans[effect]
+    if profile is None:
+        scans = cause_profiles(d)
+        effect = effect if effect is not None else next(iter(scans), None)
+        if effect not in scans:
+            raise ValueError(f"no informative profile of {effect!r} in the named cause {d.selection.effects}")
+        profile = scans[effect]
+    effect = profile.effect
     if ax is None:
         fig = new_figure(figsize=(9.5, 3.8), layout="constrained")
         ax = fig.subplots()
     fig = ax.figure
-    x, chi2 = np.array(sorted(scan.profile)).T
-    whose = "" if scan is d.corrected else f" of '{' + '.join(scan.effects)}' alone"
-    line = ax.semilogy(x, chi2, "o-", color="k", lw=0.9, ms=4,
-                       label=f"profile scan{whose}: χ² with\nthe other parameters refitted")[0]
-    values, sigmas = d.parameters(d.corrected)
-    position, sigma = values[effect]["position"], sigmas[effect].get("position")
-    if sigma is not None and math.isfinite(sigma):
-        ax.axvspan(position - sigma, position + sigma, color="tab:red", alpha=0.15, lw=0, label="estimate ± 1σ")
-    estimate = ax.axvline(position, color="tab:red", lw=1.0, label=f"estimate {position:.3g} m")
-    ax.plot([position], [d.corrected.chi2], "*", color="tab:red", ms=11,
-            label=f"named cause (χ² = {d.corrected.chi2:.4g})")
-    ax.axhline(d.nominal.chi2, color="0.5", lw=0.8, ls="--", label=f"nominal model (χ² = {d.nominal.chi2:.4g})")
+    line = ax.semilogy(profile.positions, profile.chi2, "o-", color="k", lw=0.9, ms=4,
+                       label="χ² of the cause with this position held,\nevery other parameter refitted")[0]
+    sigma = d.parameters(d.corrected)[1].get(effect, {}).get("position")
     length = d.campaign.cable.length
-    ax.set_xlim(0.0, length / 2 if d.symmetric else length)
-    ax.set_xlabel("position from end A (m)" + (", mirrored into [0, l/2]: symmetric setup" if d.symmetric else ""))
+    marks = sorted([profile.estimate, length - profile.estimate]) if d.symmetric else [profile.estimate]
+    for k, x in enumerate(marks):
+        if sigma is not None and math.isfinite(sigma):
+            ax.axvspan(x - sigma, x + sigma, color="tab:red", alpha=0.15, lw=0,
+                       label="estimate ± 1σ" if k == 0 else None)
+    estimate = ax.plot(marks, [profile.estimate_chi2] * len(marks), "*", color="tab:red", ms=12, zorder=5,
+                       label=(f"named cause: {' / '.join(f'{x:.3g}' for x in marks)} m, χ² = {profile.estimate_chi2:.4g}"
+                              + (" (mirror images)" if len(marks) > 1 else "")))[0]
+    ax.axhline(d.nominal.chi2, color="0.5", lw=0.8, ls="--", label=f"nominal model (χ² = {d.nominal.chi2:.4g})")
+    ax.set_xlim(0.0, length)
+    ax.set_xlabel("position from end A (m)" + (": setup symmetric about midspan, x and l − x alike" if d.symmetric
+                                               else ""))
     ax.set_ylabel("χ²")
-    ax.set_title(f"{' + '.join(d.corrected.effects)}: where is the {registry.get(effect).noun}?", fontsize=9)
+    ax.set_title(f"{' + '.join(d.corrected.effects)}: χ² against the {registry.get(effect).noun}'s position "
+                 f"({profile.positions.size} positions)", fontsize=9)
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # never over the data
-    return Drawn({"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": scan})
+    return Drawn({"figure": fig, "axes": ax, "profile": line, "estimate": estimate, "scan": profile})
 
 
-def plot_profiles(diagnosis, fig=None) -> Drawn:
-    """:func:`plot_profile` of every scanned unmodeled attachment of the cause, one above the other.
+def plot_profiles(diagnosis, fig=None, profiles: dict | None = None) -> Drawn:
+    """:func:`plot_profile` of every unmodeled attachment of the cause, one above the other.
 
-    An unmodeled attachment of the cause without an informative scan
-    (:func:`unscanned`) gets no flat panel; the figure's title says so.
+    An unmodeled attachment of the cause whose profile is flat gets no panel; the figure's title says so.
+    ``profiles``: :func:`cause_profiles` when already computed.
 
     Returns
     -------
     dict with the figure, the :func:`plot_profile` results by effect (``panels``) and the effects left
     out (``unscanned``).
     """
-    effects = list(profile_scans(diagnosis))
-    if not effects:
-        raise ValueError("the named cause has no unmodeled attachment with a profile scan")
-    fig = fig or new_figure(figsize=(9.5, 3.6 * len(effects)), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(len(effects), 1))
-    panels = {e: plot_profile(diagnosis, e, ax) for e, ax in zip(effects, axes)}
-    missing = unscanned(diagnosis)
+    profiles = cause_profiles(diagnosis) if profiles is None else profiles
+    if not profiles:
+        raise ValueError("the named cause has no unmodeled attachment with an informative profile")
+    fig = fig or new_figure(figsize=(9.5, 3.6 * len(profiles)), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(profiles), 1))
+    panels = {e: plot_profile(diagnosis, e, ax, p) for (e, p), ax in zip(profiles.items(), axes)}
+    missing = [e for e in diagnosis.selection.effects if registry.get(e).unmodeled and e not in profiles]
     if missing:
-        fig.suptitle(unscanned_sentence(missing), fontsize=8, color="0.3")
+        fig.suptitle(flat_sentence(missing), fontsize=8, color="0.3")
     return Drawn({"figure": fig, "panels": panels, "unscanned": missing})
 
 
