@@ -24,11 +24,11 @@ import pandas as pd
 import pytest
 
 from stcs_ident.diagnose import diagnose
+from stcs_ident.diagnose.tables import damping_table
 from stcs_ident.forward.damped import complex_modes
 from stcs_ident.identify.problem import DAMPING_SPREAD
 from stcs_ident.report.diagnose import CSV_FILES, diagnosis_text, write_report
 from stcs_ident.report.diagnose_figures import plot_damping
-from stcs_ident.report.diagnose_tables import damping_table
 from stcs_ident.report.spectra_tables import damping_cell, modes_table, spectra_text, write_modes_csv
 from tests.test_diagnose_dampers import _campaign
 

@@ -18,10 +18,10 @@ from stcs_ident.core.errors import InputError
 from stcs_ident.core.kinds import Kind, Tolerance
 from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
 from stcs_ident.core.parameters import Parameter, parse_parameters
+from stcs_ident.diagnose.tables import parameter_rows
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.identify import Measurement, identify
 from stcs_ident.identify.corrected import corrected_campaign
-from stcs_ident.report.diagnose_tables import parameter_rows
 from stcs_ident.report.identify_figures import parameter_label
 from stcs_ident.report.identify_tables import parameters_table
 

@@ -15,12 +15,12 @@ from stcs_ident.core.errors import ComputationError
 from stcs_ident.core.model import Attachment, Cable, Campaign, Setup, Test
 from stcs_ident.core.parameters import parse_parameters
 from stcs_ident.diagnose import api, diagnose
+from stcs_ident.diagnose.tables import ranking_table
 from stcs_ident.forward import batch_frequencies
 from stcs_ident.forward.assembly import negative_pivots
 from stcs_ident.forward.elements import BeamSegment
 from stcs_ident.identify.problem import MIN_GAP, Measurement, Problem
 from stcs_ident.identify.uncertainty import covariance
-from stcs_ident.report.diagnose_tables import ranking_table
 
 EI, H, M = 2.0e6, 4.0e6, 60.0
 

@@ -8,6 +8,8 @@ that need it, when a command runs.
 from __future__ import annotations
 
 import argparse
+import json
+import math
 import os
 import re
 import sys
@@ -119,6 +121,30 @@ def check_output(path) -> None:
     parent = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(parent):
         raise InputError(f"directory {parent} does not exist", field="--json", file=str(path))
+
+
+def to_json(data) -> str:
+    """``data`` as standard JSON: a value that is not a finite number (a σ the data cannot give, an error
+    against a reference of 0) is written as null, never as NaN or Infinity, which JSON does not have."""
+    return json.dumps(_finite_or_null(data), indent=2, allow_nan=False, default=_json_default) + "\n"
+
+
+def _finite_or_null(value):
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite_or_null(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_null(v) for v in value]
+    if hasattr(value, "tolist") and not isinstance(value, str):
+        return _finite_or_null(value.tolist())
+    return value
+
+
+def _json_default(value):
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 def write_output(path, text: str) -> None:

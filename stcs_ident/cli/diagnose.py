@@ -17,6 +17,7 @@ from .common import (
     picked_spectra,
     prepare,
     step_progress,
+    to_json,
     worker_count,
     write_output,
 )
@@ -48,7 +49,6 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``diagnose``; returns the exit status."""
     from ..diagnose import diagnose
-    from ..report.forward import to_json
 
     campaign, file, tests = prepare(args)
     if args.out is not None:  # before any work: a report directory that would be refused after it

@@ -12,6 +12,7 @@ from .common import (
     command_parser,
     picked_spectra,
     prepare,
+    to_json,
     write_output,
 )
 
@@ -41,7 +42,7 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``forward``; returns the exit status."""
     from ..forward.compare import compare_forward
-    from ..report.forward import forward_text, to_json
+    from ..report.forward import forward_text
 
     campaign, file, tests = prepare(args)
     picked = {r.name: (r.modes, r.frequencies, r.mode_planes) for r in picked_spectra(campaign, tests, file)}

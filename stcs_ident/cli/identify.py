@@ -16,6 +16,7 @@ from .common import (
     picked_spectra,
     prepare,
     show_warning,
+    to_json,
     write_output,
 )
 
@@ -38,7 +39,6 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``identify``; returns the exit status."""
     from ..identify import identify
-    from ..report.forward import to_json
 
     campaign, file, tests = prepare(args)
     picked = {r.name: r for r in picked_spectra(campaign, tests, file)}
@@ -57,10 +57,7 @@ def run(args: argparse.Namespace) -> int:
             raise
     for w in caught:
         show_warning(w.message, w.category, w.filename, w.lineno)
-    from ..identify.published import published_comparison
-
     summary = result.summary()
-    summary["published"] = published_comparison(campaign, summary)
     if args.json:
         write_output(args.json, to_json(summary))
     if args.plot is not None:

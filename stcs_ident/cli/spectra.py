@@ -14,6 +14,7 @@ from .common import (
     picked_spectra,
     prepare,
     progress_line,
+    to_json,
     write_output,
 )
 from .reader_options import add_reader_options, as_options, reading_from_args
@@ -44,7 +45,6 @@ def _frequencies(text: str) -> tuple[float, ...]:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``spectra``; returns the exit status."""
-    from ..report.forward import to_json
     from ..report.spectra_tables import spectra_text
 
     reading = reading_from_args(args, _is_record(args.campaign), "a record file given instead of a campaign")
@@ -61,8 +61,9 @@ def run(args: argparse.Namespace) -> int:
         results = picked_spectra(campaign, tests, file)
     skipped = [t.name for t in campaign.tests if t.record is None and (not tests or t.name in tests)]
     if args.json:
-        write_output(args.json, to_json({"campaign": campaign.name, "tests": [r.summary() for r in results],
-                                         "skipped": skipped}))
+        from ..spectra.pipeline import campaign_summary
+
+        write_output(args.json, to_json(campaign_summary(campaign.name, results, skipped)))
     if args.plot is not None:
         from ..report.plots import plot_test_spectra, save_figure
         from ..report.spectra_tables import write_modes_csv
@@ -84,10 +85,9 @@ def _is_record(path: str) -> bool:
 def _run_record(args: argparse.Namespace, reading) -> int:
     """``spectra FILE``: the record's peaks, unnumbered (no campaign: no model to number them against)."""
     from ..core.errors import InputError
-    from ..identify.quick_record import pick_unnumbered
+    from ..identify.quick_record import pick_unnumbered, unnumbered_summary
     from ..io.records.validation import UnknownPositions
     from ..io.test_record import RecordReading, open_record
-    from ..report.forward import to_json
 
     for option, value in (("--test", args.test), ("--plot", args.plot), ("--structural", args.structural)):
         if value is not None:
@@ -98,17 +98,10 @@ def _run_record(args: argparse.Namespace, reading) -> int:
     except InputError as err:  # a reader's fix said as the option to type
         raise as_options(err) from None
     peaks = pick_unnumbered(record)
-    rows = [{"frequency": p.frequency, "uncertainty": p.uncertainty,
-             "damping": None if p.damping is None else float(p.damping), "channels": list(p.channels)}
-            for p in peaks.peaks]
-    hint = (f"stcs-ident tension --record {args.campaign} --length L --mass M numbers them from their own spacing "
-            "and gives the tension")
+    summary = unnumbered_summary(args.campaign, record, peaks)
+    rows, hint = summary["peaks"], summary["hint"]
     if args.json:
-        write_output(args.json, to_json({"record": args.campaign, "kind": peaks.kind,
-                                         "sampling_rate": record.sampling_rate, "duration": record.duration,
-                                         "channels": list(record.channel_names), "peaks": rows,
-                                         "notes": [str(n) for n in getattr(record, "notes", ())], "numbered": False,
-                                         "hint": hint}))
+        write_output(args.json, to_json(summary))
     if args.json != "-":
         lines = [(f"Record {args.campaign}: {peaks.kind}, {record.duration:.4g} s at {record.sampling_rate:.6g} Hz, "
                   f"channels {', '.join(record.channel_names)}; {len(rows)} peaks, unnumbered (no campaign)"), "",

@@ -7,7 +7,7 @@ import argparse
 import sys
 
 from ..core.errors import InputError
-from .common import add_json_option, command_parser, write_output
+from .common import add_json_option, command_parser, to_json, write_output
 from .reader_options import add_reader_options, as_options, reading_from_args
 
 
@@ -137,7 +137,6 @@ def run(args: argparse.Namespace) -> int:
                            length_tolerance=_number(args.length_tolerance, "--length-tolerance"),
                            mass_tolerance=_number(args.mass_tolerance, "--mass-tolerance"), plane=args.plane)
     if args.json:
-        from ..report.forward import to_json  # pandas with it: only when a JSON is asked for
 
         write_output(args.json, to_json(result.summary()))
     if args.json != "-":
@@ -148,7 +147,6 @@ def run(args: argparse.Namespace) -> int:
 def _run_record(args: argparse.Namespace, reading) -> int:
     """``tension --record``: the record's peaks, numbered from their spacing, then every method."""
     from ..identify.quick_record import tension_from_record
-    from ..report.forward import to_json
 
     for option in ("--modes", "--uncertainty"):
         if getattr(args, option[2:]) is not None:

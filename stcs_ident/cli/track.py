@@ -7,7 +7,7 @@ import sys
 
 from ..core.errors import InputError
 from .commands import ARCHIVE_EXAMPLE, COMMANDS
-from .common import add_plausibility_option, command_parser, worker_count, write_output
+from .common import add_plausibility_option, command_parser, to_json, worker_count, write_output
 
 TRACK_EXAMPLE = COMMANDS["track"].examples[0]
 
@@ -41,7 +41,6 @@ def run(args: argparse.Namespace) -> int:
 
     from ..core.files import check_outputs, check_path
     from ..core.formatting import counted
-    from ..report.forward import to_json
     from ..report.track import write_report
     from ..track.api import default_out, track
     from ..track.archive import discover, record_paths

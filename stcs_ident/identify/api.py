@@ -153,6 +153,10 @@ def identify(campaign: Campaign, tests: Sequence[str] | None = None, params: str
         result = replace(result, notes=result.notes + tuple(doubt))
     if result.failure is not None:
         raise BoundError(str(result.failure), result)
+    if campaign.published:  # the published results beside ours: part of the result, as the JSON has them
+        from .published import published_comparison
+
+        result = replace(result, published=tuple(published_comparison(campaign, result.summary())))
     return result
 
 

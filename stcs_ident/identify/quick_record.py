@@ -126,6 +126,19 @@ def pick_unnumbered(record: Record, *, f_min: float | None = None, f_max: float 
     return find_peaks(record, f_min=low, f_max=high, expected=expected)
 
 
+def unnumbered_summary(path: str, record: Record, peaks: PeakResult) -> dict:
+    """The ``spectra FILE`` JSON: a record's peaks as :func:`pick_unnumbered` picks them, unnumbered (no model
+    to number them against), with the record's rate, length, channels and notes, and how to get them numbered."""
+    rows = [{"frequency": p.frequency, "uncertainty": p.uncertainty,
+             "damping": None if p.damping is None else float(p.damping), "channels": list(p.channels)}
+            for p in peaks.peaks]
+    return {"record": str(path), "kind": peaks.kind, "sampling_rate": record.sampling_rate,
+            "duration": record.duration, "channels": list(record.channel_names), "peaks": rows,
+            "notes": [str(n) for n in getattr(record, "notes", ())], "numbered": False,
+            "hint": (f"stcs-ident tension --record {path} --length L --mass M numbers them from their own spacing "
+                     "and gives the tension")}
+
+
 def tension_from_record(path: str | os.PathLike, length: float, mass: float, *,
                         reading: RecordReading | Mapping[str, Any] | None = None, EI: float | None = None,
                         EA: float | None = None, inclination: float = 0.0, boundary: str = "clamped",

@@ -175,6 +175,7 @@ class IdentificationResult(Result):
     uncertainty_sources: dict = field(default_factory=dict)
     failure: Note | None = None
     failed_tests: tuple[tuple[str, str], ...] = ()
+    published: tuple[dict, ...] = ()
 
     main_table = "parameters"
 
@@ -301,7 +302,9 @@ class IdentificationResult(Result):
         ``uncertainty_sources`` (with tolerances propagated: each σ's share from the frequencies and from the
         tolerances of the values held fixed, in variable units, and those tolerances),
         and per test ``uncertainty``, ``uncertainty_source`` and ``reference``
-        (frequencies computed by others, e.g. the paper's corrected values).
+        (frequencies computed by others, e.g. the paper's corrected values); ``published``: the campaign's
+        published results beside ours (:func:`~stcs_ident.identify.published.published_comparison`, attached by
+        :func:`~stcs_ident.identify.identify`; empty when the campaign has none).
         """
         out = {
             "method": self.method,
@@ -338,6 +341,7 @@ class IdentificationResult(Result):
             "failed_tests": [{"test": n, "reason": r} for n, r in self.failed_tests],
             "alternatives": [_nest(self.parameters, a, by="key") for a in self.alternatives],
             "settings": self.settings.summary(),
+            "published": [dict(item) for item in self.published],
         }
         if self.uncertainty_sources:
             out["uncertainty_sources"] = {

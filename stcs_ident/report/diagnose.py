@@ -18,9 +18,7 @@ import pandas as pd
 from ..core.errors import InputError
 from ..core.files import whole_directory, write_atomic, write_csv, write_figure
 from ..core.formatting import counted, markdown_table, number, percent, rms
-from .diagnose_damping import DAMPING_CSV, DAMPING_PNG, damping_lines
-from .diagnose_tables import (
-    CSV_FILES,
+from ..diagnose.tables import (
     cause_table,
     damping_table,
     effects_label,
@@ -29,7 +27,11 @@ from .diagnose_tables import (
     nominal_comparison,
     ranking_table,
 )
+from .diagnose_damping import DAMPING_CSV, DAMPING_PNG, damping_lines
 from .plots import mode_axis
+
+#: Files of the report, besides the figures.
+CSV_FILES = ("ranking.csv", "frequencies.csv", "gain.csv", "nominal_comparison.csv", "cause.csv")
 
 
 def diagnosis_text(diagnosis) -> str:

@@ -1,4 +1,4 @@
-"""Human-readable tables and atomic output files.
+"""Human-readable tables of ``forward`` and the package's atomic output files.
 
 Tables are built from the result objects' data and formatted here; output
 files are written whole or not at all (a temporary file in the target
@@ -6,9 +6,6 @@ directory, then an atomic rename).
 """
 
 from __future__ import annotations
-
-import json
-import math
 
 from ..core.files import replace_directory, write_atomic  # noqa: F401  (re-exported: the writers of the package)
 from ..core.formatting import number, rms
@@ -57,27 +54,3 @@ def forward_text(result: ForwardResult) -> str:
             lines.append(f"- {check.sentence()}")
         lines.append("")
     return "\n".join(lines)
-
-
-def to_json(data) -> str:
-    """``data`` as standard JSON: a value that is not a finite number (a σ the data cannot give, an error
-    against a reference of 0) is written as null, never as NaN or Infinity, which JSON does not have."""
-    return json.dumps(_finite_or_null(data), indent=2, allow_nan=False, default=_json_default) + "\n"
-
-
-def _finite_or_null(value):
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite_or_null(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite_or_null(v) for v in value]
-    if hasattr(value, "tolist") and not isinstance(value, str):
-        return _finite_or_null(value.tolist())
-    return value
-
-
-def _json_default(value):
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

@@ -438,3 +438,9 @@ def analyse_campaign(campaign: Campaign, tests: list[str] | None = None, *, prog
         out.append(analyse_test(campaign, test, tension_model=tension_model, options=options,
                                 plane_options=plane_options))
     return out
+
+
+def campaign_summary(name: str, results, skipped=()) -> dict:
+    """The ``spectra CAMPAIGN`` JSON: the campaign's name, each analysed test's :meth:`TestSpectra.summary` and
+    the tests skipped (no record)."""
+    return {"campaign": name, "tests": [r.summary() for r in results], "skipped": list(skipped)}
