@@ -23,18 +23,28 @@ import pytest
 
 from stcs_ident.core.errors import InputError
 from stcs_ident.report.track import _normalised_label
-from stcs_ident.track.events import MONITORING, NOT_ENOUGH_HISTORY, analyse_history
+from stcs_ident.track.events import (
+    MIN_MONITORED,
+    MIN_TRAINING,
+    MONITORING,
+    MONITORING_RULE,
+    NOT_ENOUGH_HISTORY,
+    TRAINING,
+    analyse_history,
+    state_note,
+)
 
 STEP = -0.015
 REFERENCE = 4e5
 
 
-def _history(rng, *, days, interval, step_at=None, swing=None, scatter=None, lag=None):
-    """Tension (N), air temperature (°C), times (s) of one history; random conditions unless given."""
+def _history(rng, *, days, interval, step_at=None, swing=None, scatter=None, lag=None, step=STEP, coefficient=None):
+    """Tension (N), air temperature (°C), times (s) of one history; random conditions unless given (a thermal
+    ``coefficient`` per °C given sets the swing)."""
     n = int(days * 86400 // interval)
     swing = 10 ** rng.uniform(-3, -2) if swing is None else swing  # half the daily swing of the tension, relative
     amplitude = rng.uniform(2, 10)  # °C, half the daily swing of the air
-    coefficient = rng.choice([-1, 1]) * swing / amplitude  # per °C
+    coefficient = rng.choice([-1, 1]) * swing / amplitude if coefficient is None else coefficient  # per °C
     scatter = 10 ** rng.uniform(np.log10(3e-4), np.log10(3e-3)) if scatter is None else scatter
     lag = rng.uniform(0, 1) if lag is None else lag  # h, the cable's temperature behind the air's
     start = rng.uniform(0, 24)  # h of the day of the first record
@@ -44,7 +54,7 @@ def _history(rng, *, days, interval, step_at=None, swing=None, scatter=None, lag
     cable = 12 - amplitude * np.cos(2 * np.pi * (hours - 5 - lag) / 24) + weather
     tension = REFERENCE * (1 + coefficient * (cable - 12)) * (1 + scatter * rng.standard_normal(n))
     if step_at is not None:
-        tension[step_at:] *= 1 + STEP
+        tension[step_at:] *= 1 + step
     return tension, air, (hours - start) * 3600.0
 
 
@@ -112,6 +122,57 @@ def test_a_history_shorter_than_a_day_is_not_normalised_by_a_part_of_a_cycle():
     # the figure's legend says which (report.track)
     assert _normalised_label(history) == "not normalised yet (less than a day)"
     assert _normalised_label(whole) == f"normalised to {whole.mean_temperature:.1f} °C"
+
+
+def test_a_step_in_a_history_shorter_than_two_days_is_not_taken_for_a_thermal_effect():
+    """Issue 37: a day (or a day and a half) of records with a 2 % step and a daily cycle. One daily cycle
+    cannot tell a step from a thermal effect unless the step is in the model: the temperature terms are fitted
+    beside a possible step, and b is within 0.05 %/°C of the truth (the issue's bound). Before, fitted with one
+    level, b took the step: |b − truth| up to 0.44 %/°C, beyond 0.05 in 138 of 200 such 1-day histories
+    (the issue's archive: −0.271 %/°C against −0.05)."""
+    rng = np.random.default_rng(37)
+    truth = -5e-4  # per °C, the simulator's and the issue's
+    for k in range(60):
+        days, interval = (1.0, 1.5)[k % 2], (600.0, 1800.0, 3600.0)[k % 3]
+        n = int(days * 86400 // interval)
+        at = int(rng.integers(MIN_MONITORED, n - MIN_MONITORED))
+        step = (-0.02, 0.02)[k % 4 // 2]
+        tension, air, times = _history(rng, days=days, interval=interval, step_at=at, step=step, coefficient=truth)
+        history = analyse_history(tension, air, REFERENCE, times=times)
+        assert abs(history.thermal_coefficient - truth) <= 5e-4, (k, history.thermal_coefficient)  # the issue's
+        if days == 1.0:
+            assert history.state == NOT_ENOUGH_HISTORY and history.events == ()
+    # healthy: b as fitted with one level (no step kept where the records show none)
+    tension, air, times = _history(rng, days=1, interval=600.0, swing=5e-3, scatter=3e-4, lag=0.0)
+    alone = analyse_history(tension, air, REFERENCE, times=times)
+    hours = times / 3600.0
+    x = np.column_stack([np.ones(hours.size), air - air.mean(), np.gradient(air, hours)])
+    coefficients, *_ = np.linalg.lstsq(x, tension / REFERENCE - 1, rcond=None)
+    assert alone.thermal_coefficient == pytest.approx(coefficients[1], rel=1e-9)  # the same least squares
+
+
+def test_a_history_not_monitoring_yet_says_how_many_records_it_needs():
+    """The records still needed before change detection starts: a day of records (by their times; at least
+    MIN_TRAINING) and MIN_MONITORED more, counted from the history; projected at the records' interval while
+    the first day is not yet covered."""
+    rng = np.random.default_rng(5)
+    tension, air, times = _history(rng, days=2, interval=3600.0)
+    per_day = 24  # hourly records
+    for n in (per_day, per_day + 1, per_day + MIN_MONITORED - 1):  # the day covered: exact
+        history = analyse_history(tension[:n], air[:n], REFERENCE, times=times[:n])
+        assert (history.state, history.records_needed, history.projected) == (
+            NOT_ENOUGH_HISTORY, per_day + MIN_MONITORED - n, False)
+        assert state_note(history) == (f"not monitoring yet: {MONITORING_RULE}: "
+                                       f"{per_day + MIN_MONITORED - n} more record{'s' * (n != per_day + 2)}")
+    history = analyse_history(tension[:20], air[:20], REFERENCE, times=times[:20])  # 4 hours of the day to come
+    assert (history.records_needed, history.projected) == (per_day + MIN_MONITORED - 20, True)
+    assert state_note(history).endswith(f"about {per_day + MIN_MONITORED - 20} more records at the records' interval")
+    history = analyse_history(tension[:5], air[:5], REFERENCE, times=times[:5] * 4)  # 4-hourly: 6 a day, 12 needed
+    assert history.records_needed == MIN_TRAINING + MIN_MONITORED - 5
+    assert analyse_history(tension[:1], air[:1], REFERENCE, times=times[:1]).records_needed is None  # no interval
+    assert analyse_history(tension[:20], air[:20], REFERENCE).records_needed == TRAINING + MIN_MONITORED - 20
+    monitoring = analyse_history(tension, air, REFERENCE, times=times)
+    assert (monitoring.state, monitoring.records_needed, state_note(monitoring)) == (MONITORING, 0, MONITORING)
 
 
 def test_healthy_one_day_histories_of_ten_minute_records_report_nothing_even_without_times():

@@ -65,27 +65,22 @@ def run(args: argparse.Namespace) -> int:
     if args.json != "-":
         for name, cable in summary["cables"].items():
             events = "; ".join(f"{100 * e['change']:+.2f} ± {100 * e['uncertainty']:.2f} % from {e['start_time']}"
-                               for e in cable["events"]) or _quiet(cable["state"])
+                               for e in cable["events"]) or _quiet(cable)
             print(f"{name}: {cable['processed']} of {counted(cable['records'], 'record')} with a tension, "
                   f"{cable['failed']} failed; {events}")
             if "damper" in cable:
                 damper = cable["damper"]
                 changes = "; ".join(f"{100 * e['change']:+.1f} ± {100 * e['uncertainty']:.1f} % from "
-                                    f"{e['start_time']}" for e in damper["events"]) or _quiet(damper["state"])
+                                    f"{e['start_time']}" for e in damper["events"]) or _quiet(damper)
                 print(f"{name} damper: {damper['records']} records with a coefficient; {changes}")
         print(f"wrote {out}")
     return 0
 
 
-def _quiet(state: str) -> str:
-    """What a history without events says: no lasting change while monitoring; else that it is not monitoring
-    yet, and when it will be."""
-    from ..track.events import MIN_MONITORED, MONITORING
-
-    if state == MONITORING:
-        return "no lasting change"
-    return (f"not monitoring yet ({state}): change detection starts after a day of records (the training "
-            f"window) and {MIN_MONITORED} more")
+def _quiet(history: dict) -> str:
+    """What a history without events says: no lasting change while monitoring; else its state in words (the
+    summary's ``state_note``: not monitoring yet, the rule and the records still needed), as the report says it."""
+    return "no lasting change" if history["state"] == "monitoring" else history["state_note"]
 
 
 def add_archive_options(sim) -> None:

@@ -193,8 +193,9 @@ def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
     for _, c in cables.iterrows():
         thermal = "" if pd.isna(c["thermal_coefficient_per_C"]) else f"{100 * c['thermal_coefficient_per_C']:+.3f} %"
         scatter = "" if pd.isna(c["scatter"]) else f"{100 * c['scatter']:.2f} %"
+        state = summary["cables"][c["cable"]]["state_note"]  # the command's line says the same
         lines.append(f"| {c['cable']} | {c['records']} | {c['processed']} | {c['failed']} | "
-                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} | {c['state']} |")
+                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} | {state} |")
     lines += ["", "## Lasting changes", ""]
     if (events["kind"] != "damper").sum() == 0:
         lines.append("None found.")
@@ -227,7 +228,7 @@ def _damper_markdown(dampers: dict) -> list[str]:
     for name, d in dampers.items():
         thermal = "" if d["thermal_coefficient"] is None else f"{100 * d['thermal_coefficient']:+.2f} %"
         lines.append(f"| {name} | {d['reference_coefficient'] / 1e3:.1f} | {d['records']} | {len(d['failures'])} | "
-                     f"{thermal} | {d['state']} | {len(d['events'])} |")
+                     f"{thermal} | {d['state_note']} | {len(d['events'])} |")
     lines += ["", "### Damper events", ""]
     found = [(name, e) for name, d in dampers.items() for e in d["events"]]
     if not found:

@@ -53,7 +53,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.errors import InputError
-from .events import TRAINING, History, analyse_series
+from .events import TRAINING, History, analyse_series, records_needed
 
 __all__ = ["SIGMA_FLOOR", "analyse_coefficient", "coefficient_weights"]
 
@@ -110,4 +110,5 @@ def analyse_coefficient(coefficient: np.ndarray, sigma: np.ndarray | None, tempe
         np.log(c / reference), temperature, training=training, times=times, weights=weights, logarithmic=True)
     b = float(beta[0]) if beta.size else 0.0
     lag = float(-beta[1] / b) if beta.size and b != 0 else 0.0
-    return History(reference * np.exp(r), np.expm1(levels), b, mean_theta, scatter, events, state, monitored, lag)
+    return History(reference * np.exp(r), np.expm1(levels), b, mean_theta, scatter, events, state, monitored, lag,
+                   *records_needed(c.size, times, training=training))

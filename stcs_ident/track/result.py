@@ -19,7 +19,7 @@ from ..core.model import Damper
 from ..core.result import Result
 from ..core.settings import Settings
 from .archive import CableSpec
-from .events import History
+from .events import History, state_note
 
 __all__ = ["TrackResult"]
 
@@ -96,7 +96,7 @@ class TrackResult(Result):
             "reference_tension": spec.reference_tension, "EI": spec.campaign.cable.EI,
             "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
-            "state": history.state,
+            "state": history.state, "state_note": state_note(history), "records_needed": history.records_needed,
             "events": _events(history, times, "tension"),
             "failures": [{"record": r, "reason": why} for r, why in
                          zip(mine.loc[failed, "record"], mine.loc[failed, "reason"])],
@@ -112,7 +112,7 @@ class TrackResult(Result):
             "records": len(rows),
             "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
-            "state": history.state,
+            "state": history.state, "state_note": state_note(history), "records_needed": history.records_needed,
             "events": _events(history, self.table.loc[rows, "start_time"].to_numpy(), "damper"),
             "failures": [{"record": r, "reason": why} for r, why in
                          zip(missing["record"], missing["coefficient_reason"])],
@@ -120,7 +120,9 @@ class TrackResult(Result):
 
     def summary(self) -> dict:
         """The ``track`` JSON of the interface (plain data): the archive and, per cable, its counts,
-        reference tension, EI held, thermal coefficient, scatter, events and failed records; for a cable with
+        reference tension, EI held, thermal coefficient, scatter, state (``state``; ``state_note`` in words,
+        :func:`~stcs_ident.track.events.state_note`, the command's line and the report say the same;
+        ``records_needed`` before change detection starts), events and failed records; for a cable with
         one damper, ``damper``: its reference coefficient, the records with a coefficient, the coefficient's
         thermal coefficient (relative, per °C), scatter, state, events (``kind`` ``damper``) and the records
         with a tension but no coefficient (``failures``, the reason)."""
