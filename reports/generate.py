@@ -13,13 +13,21 @@ bed": the analyst's reading of whether the named cause is physically
 plausible on the source paper's test bed (a laboratory strand between two
 anchorages), written from the diagnosis's own numbers (:func:`assessment`).
 
+``reports/dampers/``: ``benchmarks/dampers.py --report`` (the complex
+modes, the tension bias of ignoring a damper; its forward cost line is a
+timing).
+
 Run from the repository root with the package installed:
-``python reports/generate.py``.
+``python reports/generate.py [--out DIR] [--only han2020,hanger-hidden-mass,dampers]``
+(``--out``: write the reports below DIR instead of ``reports/``, as the
+test that holds the shipped reports to a fresh run does).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
+import subprocess
 import sys
 from pathlib import Path
 
@@ -105,20 +113,35 @@ def assessment(summary: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run() -> int:
-    if not HIDDEN.exists():
+REPORTS = ("han2020", "hanger-hidden-mass", "dampers")
+
+
+def run(out_root: Path = ROOT / "reports", only=REPORTS) -> int:
+    """Regenerate the reports named in ``only`` below ``out_root``; returns the exit status."""
+    if "hanger-hidden-mass" in only and not HIDDEN.exists():
         simulate_hidden_mass()
-    for campaign, out in ((ROOT / "campaigns" / "han2020", ROOT / "reports" / "han2020"),
-                          (HIDDEN, ROOT / "reports" / "hanger-hidden-mass")):
-        code = main(["diagnose", str(campaign), "--out", str(out), "--json", str(out.with_suffix(".json"))])
+    diagnoses = {"han2020": ROOT / "campaigns" / "han2020", "hanger-hidden-mass": HIDDEN}
+    for name in (n for n in REPORTS if n in only and n in diagnoses):
+        out = out_root / name
+        code = main(["diagnose", str(diagnoses[name]), "--out", str(out), "--json", str(out.with_suffix(".json"))])
         if code:
             return code
-    han = ROOT / "reports" / "han2020"
-    summary = json.loads(han.with_suffix(".json").read_text(encoding="utf-8"))
-    report = han / "report.md"
-    report.write_text(report.read_text(encoding="utf-8").rstrip() + "\n\n" + assessment(summary), encoding="utf-8")
+        if name == "han2020":
+            summary = json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
+            report = out / "report.md"
+            report.write_text(report.read_text(encoding="utf-8").rstrip() + "\n\n" + assessment(summary),
+                              encoding="utf-8")
+    if "dampers" in only:
+        code = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "dampers.py"), "--report",
+                               str(out_root / "dampers")], check=False).returncode
+        if code:
+            return code
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(run())
+    parser = argparse.ArgumentParser(description="Regenerate the shipped reports.")
+    parser.add_argument("--out", type=Path, default=ROOT / "reports", help="where (default: reports/)")
+    parser.add_argument("--only", default=",".join(REPORTS), help=f"comma-separated, of {', '.join(REPORTS)}")
+    args = parser.parse_args()
+    sys.exit(run(args.out, tuple(args.only.split(","))))
