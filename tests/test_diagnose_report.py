@@ -255,3 +255,24 @@ def test_cli_writes_the_report(tmp_path, capsys):
     target.write_text("mine")
     assert main([*argv, "--out", str(target)]) == 2
     assert "--out" in capsys.readouterr().err and target.read_text() == "mine"
+
+
+def test_the_principal_effect_the_sentence_and_the_removal_costs_agree(han_diagnosis):
+    """han2020: the mass alone stops at its bound (its removal cost is not known), the support alone is fitted:
+    the principal is the effect whose removal cost is known and largest, the sentence leads with it, and the
+    unknown cost is said with its reason, never as infinite."""
+    d = han_diagnosis
+    sel = d.selection
+    known = {e: c for e, c in sel.removal_cost.items() if e not in sel.removal_unknown}
+    assert sel.principal == max(known, key=known.get) == "unmodeled_mass"
+    assert sel.removal_unknown == {"unmodeled_support": "unmodeled_mass failed (the fit stopped at a bound)"}
+    text = d.cause_text()
+    assert text.startswith("An unmodeled mass") and "principal effect: unmodeled_mass" in text
+    assert d.summary()["cause"]["removal_cost"]["unmodeled_support"] is None  # not known: null, not inf
+    from stcs_ident.report.diagnose import removal_sentence
+
+    sentence = removal_sentence(sel)
+    assert "unmodeled_support not known: unmodeled_mass failed" in sentence
+    assert sentence.endswith("Principal effect: unmodeled_mass (the largest known).")
+    # the ranking's first fitted hypothesis is the one named
+    assert d.ranked[0].effects == sel.fitted
