@@ -216,6 +216,7 @@ class Diagnosis(Result):
                       "epsilon": corrected.epsilon,
                       "explained_by_nominal": sel.explained, "p_value_nominal": sel.p_value,
                       "removal_cost": {k: _finite_or_none(v) for k, v in sel.removal_cost.items()},
+                      "removal_unknown": dict(sel.removal_unknown),
                       "statement": sel.statement, "description": self.cause_text()},
             "gain": gain,
             "symmetric": self.symmetric,
