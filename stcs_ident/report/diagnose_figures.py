@@ -256,7 +256,8 @@ def plot_damping(table, fig=None) -> Drawn:
     nrows = math.ceil(n / ncols)
     fig = fig or new_figure(figsize=(5.2 * ncols, 3.6 * nrows + 0.6), layout="constrained")
     panels = np.atleast_1d(fig.subfigures(nrows, ncols, squeeze=False).ravel())
-    same = np.array_equal(table["nominal_damping_ratio"].to_numpy(), table["corrected_damping_ratio"].to_numpy(), equal_nan=True)
+    same = np.array_equal(table["nominal_damping_ratio"].to_numpy(), table["corrected_damping_ratio"].to_numpy(),
+                          equal_nan=True)
     models = ["nominal"] if same else ["nominal", "corrected"]
     lines: dict[str, list] = {key: [] for key in models}
     measured, axes = [], []

@@ -78,8 +78,8 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     row = {"cable": spec.name, "record": relative, "record_id": record_id, "start_time": None,
            "temperature_degC": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
            "planes": [], "frequencies_Hz": [], "frequency_sigma_Hz": [], "doubtful": [], "tension_N": math.nan,
-           "tension_sigma_N": math.nan, "damping_ratio": [], "damping_ratio_sigma": [], "coefficient_Ns_per_m": math.nan,
-           "coefficient_sigma_Ns_per_m": math.nan,
+           "tension_sigma_N": math.nan, "damping_ratio": [], "damping_ratio_sigma": [],
+           "coefficient_Ns_per_m": math.nan, "coefficient_sigma_Ns_per_m": math.nan,
            "coefficient_reason": ""}
     try:
         # The record as a test of the cable's campaign: its setup, the reference tension, its path in the campaign.

@@ -22,7 +22,8 @@ again. A part written before the ``planes`` column reads with every mode
 in-plane (what it was processed as); one written before the damper's columns
 (``damping_ratio``, ``damping_ratio_sigma``, ``coefficient_Ns_per_m``,
 ``coefficient_sigma_Ns_per_m``, ``coefficient_reason``) reads with NaN damping
-ratios, one per mode, and no coefficient (nothing was fitted). The files are written and read by :mod:`~stcs_ident.io.tables`;
+ratios, one per mode, and no coefficient (nothing was fitted). The files are
+written and read by :mod:`~stcs_ident.io.tables`;
 this module keeps the rows' types, the parts' names and their order.
 """
 
@@ -51,8 +52,8 @@ TABLE = "records.parquet"
 #: processed, which spare hashing it again on a rerun.
 ROW_COLUMNS = (*COLUMNS, "version", "size_bytes", "mtime_ns")
 #: The columns of parts written before the names carried their units, and their names now.
-OLD_NAMES = {"temperature": "temperature_degC", "frequencies": "frequencies_Hz", "frequency_sigma": "frequency_sigma_Hz",
-             "tension": "tension_N", "tension_sigma": "tension_sigma_N", "damping": "damping_ratio",
+OLD_NAMES = {"temperature": "temperature_degC", "frequencies": "frequencies_Hz",
+             "frequency_sigma": "frequency_sigma_Hz", "tension": "tension_N", "tension_sigma": "tension_sigma_N", "damping": "damping_ratio",
              "damping_sigma": "damping_ratio_sigma", "coefficient": "coefficient_Ns_per_m",
              "coefficient_sigma": "coefficient_sigma_Ns_per_m", "size": "size_bytes"}
 #: The name of a part of ours.
