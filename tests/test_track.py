@@ -73,7 +73,7 @@ def test_the_hidden_tension_loss_is_found_on_its_cable_only(archive, tracked):
     # Each record's tension against the truth: its 1σ covers the identification's error, not the scatter.
     table = pd.read_parquet(out / "records.parquet")
     true_tension = {(n, r["record"]): r["tension"] for n, c in truth["cables"].items() for r in c["records"]}
-    z = np.array([(row.tension - true_tension[(row.cable, row.record)]) / row.tension_sigma
+    z = np.array([(row.tension_N - true_tension[(row.cable, row.record)]) / row.tension_sigma_N
                   for row in table.itertuples()])
     assert 0.55 <= np.mean(np.abs(z) <= 1) <= 0.85 and np.mean(np.abs(z) <= 3) >= 0.97, np.percentile(np.abs(z), 68)
 

@@ -53,8 +53,8 @@ TABLE = "records.parquet"
 ROW_COLUMNS = (*COLUMNS, "version", "size_bytes", "mtime_ns")
 #: The columns of parts written before the names carried their units, and their names now.
 OLD_NAMES = {"temperature": "temperature_degC", "frequencies": "frequencies_Hz",
-             "frequency_sigma": "frequency_sigma_Hz", "tension": "tension_N", "tension_sigma": "tension_sigma_N", "damping": "damping_ratio",
-             "damping_sigma": "damping_ratio_sigma", "coefficient": "coefficient_Ns_per_m",
+             "frequency_sigma": "frequency_sigma_Hz", "tension": "tension_N", "tension_sigma": "tension_sigma_N",
+             "damping": "damping_ratio", "damping_sigma": "damping_ratio_sigma", "coefficient": "coefficient_Ns_per_m",
              "coefficient_sigma": "coefficient_sigma_Ns_per_m", "size": "size_bytes"}
 #: The name of a part of ours.
 PART = re.compile(r"^(?P<cable>[0-9a-f]{12})-(?P<time>[0-9a-f]{16})-[0-9a-f]{8}-[0-9]+\.parquet$")
