@@ -89,11 +89,11 @@ def evaluate(archive: Path, tracked: Path, months: int, seed: int) -> int:
                     continue
                 first = after.iloc[0]
                 delay = (pd.Timestamp(first["alarm_time"]) - at).total_seconds() / 3600
-                z = (first["change"] - size) / first["uncertainty"]
+                z = (first["change_ratio"] - size) / first["uncertainty_ratio"]
                 ok = delay <= 24 and abs(z) <= 2
                 failed += not ok
-                print(f"  {name} {kind} change {100 * size:+.1f} % at {at}: found {100 * first['change']:+.2f} "
-                      f"± {100 * first['uncertainty']:.2f} % from {first['start_time']}, alarm after {delay:.1f} h "
+                print(f"  {name} {kind} change {100 * size:+.1f} % at {at}: found {100 * first['change_ratio']:+.2f} "
+                      f"± {100 * first['uncertainty_ratio']:.2f} % from {first['start_time']}, alarm after {delay:.1f} h "
                       f"(≤ 24), {abs(z):.2f}σ from the truth (≤ 2): {'met' if ok else 'NOT MET'}"
                       + (f"; {len(after) - 1} later event(s) of this kind" if len(after) > 1 else ""))
             else:
@@ -108,7 +108,7 @@ def evaluate(archive: Path, tracked: Path, months: int, seed: int) -> int:
     for name, cable in truth["cables"].items():
         true = {r["record"]: next(iter(r["coefficients"].values())) for r in cable["records"]}
         rows = table[table["cable"] == name].sort_values("start_time")
-        fitted, sigma = rows["coefficient"].to_numpy(float), rows["coefficient_sigma"].to_numpy(float)
+        fitted, sigma = rows["coefficient_Ns_per_m"].to_numpy(float), rows["coefficient_sigma_Ns_per_m"].to_numpy(float)
         c = np.array([true[r] for r in rows["record"]])
         ok = np.isfinite(fitted) & np.isfinite(sigma) & (sigma > 0)
         z = (fitted - c) / sigma

@@ -63,7 +63,7 @@ def main(argv=None) -> int:
         true = {r["record"]: r["coefficients"] for r in cable["records"]}
         for r in table[table["cable"] == name].itertuples():
             c = true[r.record]
-            rows.append((name, r.coefficient, r.coefficient_sigma, next(iter(c.values())), r.coefficient_reason))
+            rows.append((name, r.coefficient_Ns_per_m, r.coefficient_sigma_Ns_per_m, next(iter(c.values())), r.coefficient_reason))
     frame = pd.DataFrame(rows, columns=["cable", "fitted", "sigma", "true", "reason"])
     ok = frame[np.isfinite(frame["fitted"]) & np.isfinite(frame["sigma"])]
     z = np.abs(ok["fitted"] - ok["true"]) / ok["sigma"]

@@ -79,22 +79,23 @@ def bias_table(etas=ETAS) -> list[dict]:
                 [Attachment("D1", xd, 10.0)]
             truth = complex_modes(cable, atts, tension, 10) if eta > 0 else None
             f = truth.frequency if truth is not None else natural_frequencies(cable, atts, tension, 10)
-            row = {"length_m": length, "eta1": float(eta), "zeta1_%": 0.0 if truth is None else
-                   100 * float(truth.damping[0])}
+            # the CSV's columns carry their units (docs/formats.md): η₁ = c / c_opt,1 and ζ₁ are ratios
+            row = {"length_m": length, "eta1_ratio": float(eta), "mode1_damping_ratio": 0.0 if truth is None else
+                   float(truth.damping[0])}
             plain = Campaign("bias", cable, (Setup("S", (Attachment("D1", xd, 10.0),)),),
                              (Test("T", "S", tension),))
             meas = {"T": Measurement(plain.tests[0], modes, f, 1e-4 * f, "given")}
             for label, params in (("dsm_tension_EI", "tension,EI"), ("dsm_tension", "tension")):
                 r = identify(plain, params=params, picked=meas)
-                row[f"{label}_%"] = 100 * (r.value("tension")[0] / tension - 1)
-            row["string_mode1_%"] = 100 * (4 * m * length**2 * f[0] ** 2 / tension - 1)
+                row[f"{label}_error_percent"] = 100 * (r.value("tension")[0] / tension - 1)
+            row["string_mode1_error_percent"] = 100 * (4 * m * length**2 * f[0] ** 2 / tension - 1)
             if truth is not None:  # the model with the damper returns the truth
                 with_damper = Campaign("bias", cable, (Setup("S", tuple(atts)),), (Test("T", "S", tension),))
                 meas = {"T": Measurement(with_damper.tests[0], modes, f, 1e-4 * f, "given")}
                 r = identify(with_damper, params="tension,EI", picked=meas)
-                row["with_damper_%"] = 100 * (r.value("tension")[0] / tension - 1)
+                row["with_damper_error_percent"] = 100 * (r.value("tension")[0] / tension - 1)
             else:
-                row["with_damper_%"] = row["dsm_tension_EI_%"]
+                row["with_damper_error_percent"] = row["dsm_tension_EI_error_percent"]
             rows.append(row)
     return rows
 
@@ -200,13 +201,13 @@ def write_report(directory: Path, bias_rows, ident_rows, forward) -> None:
     write_figure(plot_universal_curve(universal_series())["figure"], directory / "universal_curve.png")
     shapes = complex_mode_shapes(STAY, [Damper("D1", XD, 10.0, coefficient=optimum(STAY, H, XD))], H, 4)
     write_figure(plot_complex_shapes(shapes, STAY.length, [XD])["figure"], directory / "complex_shapes.png")
-    eta = np.array([r["eta1"] for r in bias_rows if r["length_m"] == 200.0])
+    eta = np.array([r["eta1_ratio"] for r in bias_rows if r["length_m"] == 200.0])
     curves = {}
     for length in STAYS:
         sel = [r for r in bias_rows if r["length_m"] == length]
-        curves[f"{length:.0f} m, DSM fit of H and EI"] = np.array([r["dsm_tension_EI_%"] for r in sel])
+        curves[f"{length:.0f} m, DSM fit of H and EI"] = np.array([r["dsm_tension_EI_error_percent"] for r in sel])
     sel = [r for r in bias_rows if r["length_m"] == 200.0]
-    curves["200 m, string formula, mode 1"] = np.array([r["string_mode1_%"] for r in sel])
+    curves["200 m, string formula, mode 1"] = np.array([r["string_mode1_error_percent"] for r in sel])
     write_figure(plot_tension_bias(eta, curves)["figure"], directory / "tension_bias.png")
     with atomic_file(directory / "tension_bias.csv") as f:
         writer = csv.DictWriter(f, fieldnames=list(bias_rows[0]))
@@ -225,8 +226,9 @@ def write_report(directory: Path, bias_rows, ident_rows, forward) -> None:
              "| length (m) | η₁ | ζ₁ (%) | DSM, H and EI (%) | DSM, H only (%) | string, mode 1 (%) | with damper (%) |",
              "|---|---|---|---|---|---|---|"]
     for r in bias_rows:
-        lines.append(f"| {r['length_m']:.0f} | {r['eta1']:g} | {r['zeta1_%']:.2f} | {r['dsm_tension_EI_%']:+.2f} | "
-                     f"{r['dsm_tension_%']:+.2f} | {r['string_mode1_%']:+.2f} | {r['with_damper_%']:+.3f} |")
+        lines.append(f"| {r['length_m']:.0f} | {r['eta1_ratio']:g} | {100 * r['mode1_damping_ratio']:.2f} | "
+                     f"{r['dsm_tension_EI_error_percent']:+.2f} | {r['dsm_tension_error_percent']:+.2f} | "
+                     f"{r['string_mode1_error_percent']:+.2f} | {r['with_damper_error_percent']:+.3f} |")
     if ident_rows:
         lines += ["", "## Identification from simulated records (SNR 20 dB, 30 min)", "",
                   "| seed | tension error (%) | 1σ (%) | coefficient error (%) | 1σ (%) | damper ignored (%) |",
@@ -259,8 +261,9 @@ def main(argv=None):
     print(f"{'l (m)':>6} {'eta1':>6} {'zeta1%':>7} {'DSM H,EI %':>11} {'DSM H %':>8} {'string %':>9} "
           f"{'with damper %':>14}")
     for r in rows:
-        print(f"{r['length_m']:6.0f} {r['eta1']:6g} {r['zeta1_%']:7.2f} {r['dsm_tension_EI_%']:+11.2f} "
-              f"{r['dsm_tension_%']:+8.2f} {r['string_mode1_%']:+9.2f} {r['with_damper_%']:+14.4f}")
+        print(f"{r['length_m']:6.0f} {r['eta1_ratio']:6g} {100 * r['mode1_damping_ratio']:7.2f} "
+              f"{r['dsm_tension_EI_error_percent']:+11.2f} {r['dsm_tension_error_percent']:+8.2f} "
+              f"{r['string_mode1_error_percent']:+9.2f} {r['with_damper_error_percent']:+14.4f}")
     print("\n3. Identification from simulated records of the 200 m stay", file=sys.stderr)
     with tempfile.TemporaryDirectory() as tmp:
         ident = identification([1] if args.quick else [1, 2, 3, 4, 5], Path(tmp))

@@ -127,8 +127,8 @@ def evaluate(archive: Path, tracked: Path, campaign: Path) -> dict:
                     f_true = np.asarray(true["frequencies"], float)
                 else:  # the bare stay: its natural frequencies at the record's true tension
                     f_true = natural_frequencies(cable, attachments, true["tension"], int(modes.max()) + 1)
-                f = np.asarray(row.frequencies, float)
-                s = np.asarray(row.frequency_sigma, float)
+                f = np.asarray(row.frequencies_Hz, float)
+                s = np.asarray(row.frequency_sigma_Hz, float)
                 doubtful = np.asarray(row.doubtful, bool)
                 planes = np.asarray(row.planes, object)
                 out["out_of_plane"] += int(np.sum(planes != "in"))
@@ -148,15 +148,15 @@ def evaluate(archive: Path, tracked: Path, campaign: Path) -> dict:
                         out["misnumbered"].append(f"{name} {true['record']}: mode {n} at {fk:.3f} ± {sk:.3f} Hz, "
                                                   f"nearest true mode {nearest} ({f_true[nearest - 1]:.3f} Hz; "
                                                   f"mode {n} is {t:.3f})" + (" doubtful" if dk else ""))
-            ok = (row.status == "ok" and np.isfinite(row.tension) and np.isfinite(row.tension_sigma)
-                  and row.tension_sigma > 0)
+            ok = (row.status == "ok" and np.isfinite(row.tension_N) and np.isfinite(row.tension_sigma_N)
+                  and row.tension_sigma_N > 0)
             if ok:
                 out["with_tension"] += 1
-                out["z_tension"].append((row.tension - true["tension"]) / row.tension_sigma)
+                out["z_tension"].append((row.tension_N - true["tension"]) / row.tension_sigma_N)
             else:
                 out["no_tension"].append(f"{name} {true['record']}: status {row.status}"
                                          + (f" ({row.reason})" if row.reason else "")
-                                         + f", tension {row.tension:.0f} ± {row.tension_sigma:.3g} N, "
+                                         + f", tension {row.tension_N:.0f} ± {row.tension_sigma_N:.3g} N, "
                                          f"{modes.size} modes")
     return out
 

@@ -320,7 +320,7 @@ def test_spectra_writes_the_picked_modes_as_csv(simulated, tmp_path, capsys):
         assert rows["mode"].tolist() == t["modes"] and (rows["record_kind"] == t["kind"]).all()
         assert rows["frequency_Hz"].tolist() == t["frequencies"]  # the same numbers, at full precision
         assert rows["uncertainty_Hz"].tolist() == t["uncertainty"]
-        assert rows["channels"].tolist() == [" ".join(c) for c in t["channels"]]
+        assert rows["channels"].tolist() == [";".join(c) for c in t["channels"]]
 
 
 def test_identify_writes_its_tables_as_csv(tmp_path, capsys):
@@ -332,9 +332,10 @@ def test_identify_writes_its_tables_as_csv(tmp_path, capsys):
     assert {p.name for p in plots.iterdir()} >= {"errors.png", "parameters.csv", "frequencies.csv"}
     parameters = pd.read_csv(plots / "parameters.csv").set_index("parameter")
     # written with 6 significant digits ("%.6g", as the before/after table): agreement to 5e-6 relative
-    assert parameters.loc["EI_ratio", "estimate"] == pytest.approx(data["parameters"]["EI_ratio"], rel=5e-6)
-    assert parameters.loc["EI_ratio", "uncertainty"] == pytest.approx(data["uncertainty"]["EI_ratio"], rel=5e-6)
-    assert parameters.loc["tension_ratio[case1-L4]", "estimate"] == pytest.approx(
+    assert parameters.loc["EI_ratio", "variable"] == pytest.approx(data["parameters"]["EI_ratio"], rel=5e-6)
+    assert parameters.loc["EI_ratio", "variable_uncertainty"] == pytest.approx(data["uncertainty"]["EI_ratio"],
+                                                                               rel=5e-6)
+    assert parameters.loc["tension_ratio[case1-L4]", "variable"] == pytest.approx(
         data["parameters"]["tension_ratio"]["case1-L4"], rel=5e-6)
     frequencies = pd.read_csv(plots / "frequencies.csv")
     [t] = data["tests"]
@@ -352,10 +353,12 @@ def test_track_writes_its_records_as_csv_beside_the_parquet_table(tmp_path, caps
     assert code == 0, err
     parquet, csv = pd.read_parquet(out / "records.parquet"), pd.read_csv(out / "records.csv")
     assert list(csv.columns) == list(parquet.columns) and len(csv) == len(parquet) == 2  # 72 min every 30 min
-    assert csv["tension"].tolist() == parquet["tension"].tolist()  # floats written at full precision
-    assert csv["frequencies"].tolist() == [";".join(str(float(f)) for f in fs) for fs in parquet["frequencies"]]
-    # every list alike: the doubtful flags too (they were a numpy repr, "[False False ...]")
-    assert csv["doubtful"].tolist() == [";".join("true" if d else "false" for d in ds) for ds in parquet["doubtful"]]
+    assert csv["tension_N"].tolist() == parquet["tension_N"].tolist()  # floats written at full precision
+    assert csv["frequencies_Hz"].tolist() == [";".join(str(float(f)) for f in fs) for fs in parquet["frequencies_Hz"]]
+    # every list alike: the doubtful flags too (they were a numpy repr, "[False False ...]"), as pandas writes a bool
+    assert csv["doubtful"].tolist() == [";".join(str(bool(d)) for d in ds) for ds in parquet["doubtful"]]
+    assert [[float(f) for f in cell.split(";")] for cell in csv["frequencies_Hz"]] == \
+        [list(fs) for fs in parquet["frequencies_Hz"]]  # read back to the same doubles
     assert pd.to_datetime(csv["start_time"]).tolist() == parquet["start_time"].tolist()
     assert "of 2 records with a tension" in stdout
     # an hour of records is no monitoring yet: stdout says so, not "no lasting change" (issue 37)

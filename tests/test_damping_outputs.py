@@ -71,14 +71,14 @@ def test_spectra_damping_uncertainty_agrees_across_text_json_dataframe_and_csv(d
         frame = r.to_dataframe()
         sigma = np.asarray(r.damping_uncertainty, float)
         assert np.isfinite(sigma).all() and (sigma > 0).all()  # a damped impulse record: every ratio fitted
-        assert frame["damping_uncertainty"].tolist() == sigma.tolist()
+        assert frame["damping_ratio_uncertainty"].tolist() == sigma.tolist()
         summary = json.loads(json.dumps(r.summary()))
         assert summary["damping_uncertainty"] == sigma.tolist()  # aligned with modes, exact through JSON
         assert len(summary["damping_uncertainty"]) == len(summary["modes"])
         mine = csv[csv["test"] == r.name]
         # the CSV holds the shortest repr of each float, which reads back to the same double
-        assert mine["damping_uncertainty"].tolist() == sigma.tolist()
-        assert mine["damping"].tolist() == r.damping.tolist()
+        assert mine["damping_ratio_uncertainty"].tolist() == sigma.tolist()
+        assert mine["damping_ratio"].tolist() == r.damping.tolist()
         rows = _text_rows(text, r.name)
         assert len(rows) == len(r.modes)
         for row, z, s in zip(rows, r.damping, sigma):
@@ -98,7 +98,7 @@ def test_spectra_damping_nan_is_missing_everywhere_and_the_column_stays_aligned(
     summary = json.loads(json.dumps(r.summary()))
     assert summary["damping"][0] is None and summary["damping_uncertainty"][:2] == [None, None]
     assert summary["damping_uncertainty"][2:] == sigma[2:].tolist()
-    assert np.isnan(r.to_dataframe()["damping_uncertainty"].to_numpy()[:2]).all()
+    assert np.isnan(r.to_dataframe()["damping_ratio_uncertainty"].to_numpy()[:2]).all()
     rows = _text_rows(spectra_text("c", [r], []), r.name)
     assert rows[0].split()[3] == "-" and "±" not in rows[0]
     assert rows[1].split()[3] == f"{100 * zeta[1]:.3f}" and "±" not in rows[1]
@@ -109,7 +109,7 @@ def test_spectra_damping_nan_is_missing_everywhere_and_the_column_stays_aligned(
     assert len(damping_cell(0.005, math.nan)) == len(damping_cell(math.nan, math.nan)) == len(damping_cell(0.5, 0.1))
     none = replace(r, damping_uncertainty=None)  # spectra made before the 1σ was kept
     assert none.summary()["damping_uncertainty"] == [None] * len(r.modes)
-    assert np.isnan(modes_table([none])["damping_uncertainty"]).all()
+    assert np.isnan(modes_table([none])["damping_ratio_uncertainty"]).all()
 
 
 # --- diagnose ------------------------------------------------------------------------------------------------
@@ -146,18 +146,19 @@ def test_diagnose_damping_table_against_the_complex_modes(damped, tmp_path):
     assert np.sum(d.corrected.terms[n:]) == pytest.approx(np.sum(((measured - corrected) / sigma) ** 2), rel=1e-9)
 
     table = damping_table(d)
-    assert len(table) == measured.size and table["measured"].tolist() == measured.tolist()
+    assert len(table) == measured.size and table["measured_damping_ratio"].tolist() == measured.tolist()
     text = diagnosis_text(d)
     assert "Damping ratios (%)" in text
     for row in table.itertuples():
-        assert (f"{100 * row.measured:.3f} ± {100 * row.uncertainty:.3f}      {100 * row.nominal:.3f}  "
+        assert (f"{100 * row.measured_damping_ratio:.3f} ± {100 * row.damping_ratio_uncertainty:.3f}      "
+                f"{100 * row.nominal_damping_ratio:.3f}  "
                 f"{row.nominal_z:+.2f}") in text
     out = write_report(d, tmp_path / "report")
     csv = pd.read_csv(out / "damping.csv")
     assert csv["nominal_z"].tolist() == table["nominal_z"].tolist()  # shortest repr: the same doubles
     report = (out / "report.md").read_text()
     assert "## Damping ratios, measured and modelled" in report and "![Damping ratios per mode](damping.png)" in report
-    assert f"| {100 * table['measured'][0]:.3f} ± {100 * table['uncertainty'][0]:.3f} |" in report
+    assert f"| {100 * table['measured_damping_ratio'][0]:.3f} ± {100 * table['damping_ratio_uncertainty'][0]:.3f} |" in report
     assert (out / "damping.png").stat().st_size > 0
 
 
@@ -170,10 +171,12 @@ def test_the_damping_figure_draws_the_table(damped):
     for i, test in enumerate(tests):
         rows = table[table["test"] == test]
         points, _caps, (bars,) = drawn["measured"][i].lines
-        np.testing.assert_array_equal(points.get_ydata(), 100 * rows["measured"].to_numpy())
+        np.testing.assert_array_equal(points.get_ydata(), 100 * rows["measured_damping_ratio"].to_numpy())
         segments = bars.get_segments()  # one vertical bar per mode: ζ ± 1σ
-        np.testing.assert_allclose([s[1, 1] - s[0, 1] for s in segments], 200 * rows["uncertainty"].to_numpy())
-        np.testing.assert_array_equal(drawn["lines"]["nominal"][i].get_ydata(), 100 * rows["nominal"].to_numpy())
+        np.testing.assert_allclose([s[1, 1] - s[0, 1] for s in segments],
+                                   200 * rows["damping_ratio_uncertainty"].to_numpy())
+        np.testing.assert_array_equal(drawn["lines"]["nominal"][i].get_ydata(),
+                                      100 * rows["nominal_damping_ratio"].to_numpy())
 
 
 def test_an_undamped_cable_has_no_damping_table_nor_figure(bench_records, tmp_path):

@@ -99,12 +99,13 @@ def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis)
     assert len(ranking) == len(d.fits) and ranking["rank"].tolist() == list(range(1, len(d.fits) + 1))
     # table rounding against a model error of a few 0.1 %: every hypothesis carries its ε, the best the smallest
     fitted = ranking["effects"] != "unmodeled_mass"  # the failed hypothesis has no ε
-    assert d.selection.model_error and (ranking.loc[fitted, "epsilon"] > 1e-3).all()
-    assert ranking["epsilon"].iloc[0] < ranking.loc[ranking["effects"] == "nominal", "epsilon"].iloc[0]
+    assert d.selection.model_error and (ranking.loc[fitted, "relative_model_error"] > 1e-3).all()
+    assert ranking["relative_model_error"].iloc[0] < ranking.loc[ranking["effects"] == "nominal",
+                                                                   "relative_model_error"].iloc[0]
     assert ranking["delta_aicc"].iloc[0] == 0.0 and ranking["delta_aicc"].dropna().is_monotonic_increasing
     failed = ranking["failure"].fillna("") != ""  # a failed fit: its reason, no figures (not χ² inf, ε 0)
     assert ranking.loc[failed, "effects"].tolist() == ["unmodeled_mass"]
-    assert ranking.loc[failed, ["chi2", "epsilon", "delta_aicc"]].isna().all(axis=None)
+    assert ranking.loc[failed, ["chi2", "relative_model_error", "delta_aicc"]].isna().all(axis=None)
     assert "stopped at a bound" in ranking.loc[failed, "failure"].iloc[0]
     assert "| inf |" not in text and "- unmodeled_mass: the fit stopped at a bound" in text
     assert ranking.loc[ranking["cause"], "effects"].tolist() == ["unmodeled_mass + unmodeled_support"]
@@ -116,20 +117,20 @@ def test_report_holds_the_cause_the_gain_and_the_tables(tmp_path, han_diagnosis)
     np.testing.assert_allclose(freq["measured_Hz"], d.measured, **EXACT)
     np.testing.assert_allclose(freq["corrected_Hz"], d.corrected.predicted, **EXACT)
     np.testing.assert_allclose(freq["baseline_Hz"], d.baseline.predicted, **EXACT)
-    np.testing.assert_allclose(freq["nominal_error_%"],
+    np.testing.assert_allclose(freq["nominal_error_percent"],
                                (freq["nominal_Hz"] - freq["measured_Hz"]) / freq["measured_Hz"] * 100, rtol=1e-12)
     assert (freq["uncertainty_Hz"] > 0).all()
 
     gain = pd.read_csv(out / "gain.csv")
     assert gain["model"].tolist() == ["nominal", "baseline", "corrected"]
-    np.testing.assert_allclose(gain["rms_error_%"], [g["rms_error_nominal"], g["rms_error_baseline"],
+    np.testing.assert_allclose(gain["rms_error_percent"], [g["rms_error_nominal"], g["rms_error_baseline"],
                                                      g["rms_error_corrected"]], **EXACT)
 
     comparison = pd.read_csv(out / "nominal_comparison.csv")
     assert len(comparison) == 36
-    np.testing.assert_allclose(comparison["measured"], d.measured, **EXACT)
-    np.testing.assert_allclose(comparison["dsm"], d.nominal.predicted, rtol=1e-12)  # the same nominal model
-    assert {"taut_string_error_%", "beam_pinned_error_%", "dsm_error_%"} <= set(comparison.columns)
+    np.testing.assert_allclose(comparison["measured_Hz"], d.measured, **EXACT)
+    np.testing.assert_allclose(comparison["dsm_Hz"], d.nominal.predicted, rtol=1e-12)  # the same nominal model
+    assert {"taut_string_error_percent", "beam_pinned_error_percent", "dsm_error_percent"} <= set(comparison.columns)
 
     cause = pd.read_csv(out / "cause.csv")
     assert cause.columns.tolist() == ["effect", "role", "parameter", "value", "uncertainty", "unit"]
@@ -152,7 +153,7 @@ def test_report_shows_the_spectra_of_tests_with_records(tmp_path, simulated):
     freq = pd.read_csv(out / "frequencies.csv")
     np.testing.assert_allclose(freq["measured_Hz"], np.concatenate([s.frequencies for s in spectra]), **EXACT)
     comparison = pd.read_csv(out / "nominal_comparison.csv")  # measured = picked, the stated table absent
-    np.testing.assert_allclose(comparison["measured"].dropna(), d.measured, **EXACT)
+    np.testing.assert_allclose(comparison["measured_Hz"].dropna(), d.measured, **EXACT)
     cause = pd.read_csv(out / "cause.csv")
     assert cause["effect"].unique().tolist() == ["unmodeled_mass"]
     # the mass was put at 6 m: the profile figure marks it (on a symmetric setup, in [0, l/2])

@@ -52,25 +52,25 @@ def test_a_doubtful_number_is_flagged_and_left_out_of_the_tension(tmp_path, monk
     assert row["status"] == "ok", row["reason"]
     assert row["doubtful"] == [False, False, False, False, True] and row["modes"] == [1, 2, 3, 4, 13]
     # The four exact frequencies alone: the fit's tolerance (1e-14) and the solver's (1e-12), far below 1e-6.
-    assert row["tension"] == pytest.approx(TENSION, rel=1e-6)
+    assert row["tension_N"] == pytest.approx(TENSION, rel=1e-6)
     # With the doubtful mode fitted (its weight the others'), the fit gives 2.94 MN: (11/13)² ≈ 0.72 on that
     # mode, outweighing the four sure ones. The check that it did not:
-    assert abs(row["tension"] - TENSION) < row["tension_sigma"]
+    assert abs(row["tension_N"] - TENSION) < row["tension_sigma_N"]
 
 
 def test_a_record_with_no_sure_number_gives_no_tension_and_says_why(tmp_path, monkeypatch):
     f = natural_frequencies(STAY, (), TENSION, 12)
     row = _row(tmp_path, monkeypatch, (13,), [f[10]], (True,))
-    assert row["status"] == "failed" and math.isnan(row["tension"])
+    assert row["status"] == "failed" and math.isnan(row["tension_N"])
     assert "doubtful" in row["reason"] and f"{f[10]:.3f} Hz" in row["reason"]
-    assert row["doubtful"] == [True] and row["frequencies"] == [pytest.approx(f[10])]
+    assert row["doubtful"] == [True] and row["frequencies_Hz"] == [pytest.approx(f[10])]
 
 
 def test_spectra_without_flags_fit_every_mode(tmp_path, monkeypatch):
     f = natural_frequencies(STAY, (), TENSION, 4)
     row = _row(tmp_path, monkeypatch, (1, 2, 3, 4), f, (False,) * 4)
     assert row["status"] == "ok" and row["doubtful"] == [False] * 4
-    assert row["tension"] == pytest.approx(TENSION, rel=1e-6)
+    assert row["tension_N"] == pytest.approx(TENSION, rel=1e-6)
 
 
 def test_identify_leaves_doubtful_numbers_out_with_a_note_and_refuses_a_test_with_none_sure():

@@ -111,10 +111,10 @@ def test_a_record_picked_per_plane_draws_each_plane_with_its_own_modes_and_nomin
 def test_track_modes_past_ten_keep_distinct_colour_and_marker():
     n, modes = 24, tuple(range(1, 15))
     t = pd.date_range("2026-03-01", periods=n, freq="h", tz="UTC")
-    table = pd.DataFrame({"start_time": t, "tension": 1.3e6, "tension_sigma": 2e3, "level": 1.3e6,
-                          "temperature": 12.0, "modes": [modes] * n,
-                          "frequencies": [tuple(3.1 * k for k in modes)] * n})
-    history = SimpleNamespace(normalised=table["tension"].to_numpy(), mean_temperature=12.0, events=[],
+    table = pd.DataFrame({"start_time": t, "tension_N": 1.3e6, "tension_sigma_N": 2e3, "tension_level_N": 1.3e6,
+                          "temperature_degC": 12.0, "modes": [modes] * n,
+                          "frequencies_Hz": [tuple(3.1 * k for k in modes)] * n})
+    history = SimpleNamespace(normalised=table["tension_N"].to_numpy(), mean_temperature=12.0, events=[],
                               thermal_coefficient=-5e-4, thermal_lag=0.0)
     spec = SimpleNamespace(name="C1", reference_tension=1.3e6, campaign=SimpleNamespace(cable=SimpleNamespace(EI=5e5)))
     drawn = plot_cable_history(spec, table, table.index, history)

@@ -213,10 +213,10 @@ def test_tables_in_the_papers_form(tmp_path):
     campaign, picked = synthetic("bare", 1.02, 0.9, tensions=(1.0e6, 1.2e6), n_modes=6)
     result = identify(campaign, None, "tension,EI", picked=picked)
     df = result.to_dataframe()
-    assert list(df.columns[:7]) == ["test", "mode", "measured_Hz", "before_Hz", "before_error_abs_%",
-                                    "corrected_Hz", "corrected_error_abs_%"]
-    assert len(df) == 12 and (df["before_error_abs_%"] >= 0).all()
-    np.testing.assert_allclose(df["corrected_error_abs_%"], 0, atol=1e-8)
+    assert list(df.columns[:7]) == ["test", "mode", "measured_Hz", "before_Hz", "before_error_abs_percent",
+                                    "corrected_Hz", "corrected_error_abs_percent"]
+    assert len(df) == 12 and (df["before_error_abs_percent"] >= 0).all()
+    np.testing.assert_allclose(df["corrected_error_abs_percent"], 0, atol=1e-8)
     md = format_result(result, "markdown")
     assert "| mode | measured (Hz) | before (Hz) | \\|δ\\| (%) |" in md  # pipes escaped inside cells
     assert "#### T2" in md

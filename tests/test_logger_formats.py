@@ -355,7 +355,7 @@ def test_track_takes_an_archive_of_csv_records_with_their_start_times(tmp_path):
     assert list(after["start_time"]) == [pd.Timestamp(r.start_time) for r in records] == list(before["start_time"])
     assert all(name.endswith(".csv") for name in after["record"])
     # The same samples (to an ulp, text printed with repr): the same tension to far below its 1σ (~1e-4).
-    np.testing.assert_allclose(after["tension"], before["tension"], rtol=1e-9)
+    np.testing.assert_allclose(after["tension_N"], before["tension_N"], rtol=1e-9)
 
 
 def _tracked(archive: Path, out: Path) -> Path:

@@ -319,14 +319,14 @@ def test_result_tables_and_frequency_band():
     result = find_peaks(record)
     table = result.to_dataframe()
     assert list(table.columns[:6]) == [
-        "frequency",
-        "uncertainty",
-        "damping",
-        "damping_uncertainty",
+        "frequency_Hz",
+        "uncertainty_Hz",
+        "damping_ratio",
+        "damping_ratio_uncertainty",
         "snr_db",
         "channels",
     ]
-    assert "amplitude[A2]" in table.columns and len(table) == 3
+    assert "amplitude_m_per_s2[A2]" in table.columns and len(table) == 3
     summary = json.loads(json.dumps(result.summary()))
     assert summary["kind"] == "impulse" and len(summary["frequencies"]) == 3
     assert result.channel_spectra.shape == (result.frequency_axis.size, 3)

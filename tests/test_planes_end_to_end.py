@@ -142,6 +142,6 @@ def test_track_reads_a_triaxial_archive_of_csv_files_with_the_channel_table(simu
         rows = list(csv.DictReader(stream))
     assert len(rows) == 2, rows
     assert all("out" in row["planes"] and "in" in row["planes"] for row in rows), rows[0]
-    tensions = np.array([float(row["tension"]) for row in rows])
+    tensions = np.array([float(row["tension_N"]) for row in rows])
     # The simulated tension is T1's stated 2.0 MN; 1 %: far above the σ of one record (about 0.1 %)
     assert np.all(np.abs(tensions / 2.0e6 - 1) < 0.01), tensions

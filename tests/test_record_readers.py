@@ -235,8 +235,8 @@ def test_track_globs_and_reads_a_registered_format(tmp_path, npz):
     h5_rows, npz_rows = processed_table(tmp_path / "out-h5"), processed_table(tmp_path / "out-npz")
     assert list(npz_rows["record"]) == [first.relative_to(archive / "C1").as_posix(),
                                         toy.relative_to(archive / "C1").as_posix()]
-    assert list(npz_rows["status"]) == ["ok", "ok"] and np.all(npz_rows["tension"] > 0)
-    np.testing.assert_array_equal(npz_rows["tension"], h5_rows["tension"])  # the same samples: the same tension
+    assert list(npz_rows["status"]) == ["ok", "ok"] and np.all(npz_rows["tension_N"] > 0)
+    np.testing.assert_array_equal(npz_rows["tension_N"], h5_rows["tension_N"])  # the same samples: the same tension
 
 
 def test_the_command_line_identifies_from_a_csv_record_as_from_its_hdf5(simulated, tmp_path, capsys):

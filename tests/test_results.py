@@ -10,6 +10,7 @@ numerical library and exports the objects and the steps lazily.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -161,3 +162,101 @@ def test_the_face_exports_every_name_and_the_steps_stay_functions():
     assert issubclass(si.CampaignError, si.InputError) and issubclass(si.InputError, ValueError)
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         si.nothing  # noqa: B018
+
+
+# -- the columns of every table: a unit in each name, lists written alike ----------------------------------------
+
+#: Columns that have no unit, each named for what it is: names, labels and flags; counts (``n_``); statistics of a
+#: fit (χ², AICc, the prior's penalty, the MAC), which are numbers without a unit.
+UNITLESS = {"test", "setup", "mode", "plane", "cable", "record", "record_id", "record_kind", "parameter", "kind",
+            "member", "unit", "note", "method", "label", "tests", "reproduced", "worst_mode", "doubtful", "channels",
+            "mac", "status", "reason", "failure", "modes", "planes", "version", "start_time", "alarm_time", "coefficient_reason",
+            "state", "damper_state", "effects", "effect", "role", "rank", "cause", "parameters", "model", "source",
+            "chi2", "reduced_chi2", "aicc", "delta_aicc", "prior_penalty", "relative_model_error", "n_modes",
+            "n_parameters", "n_records", "n_processed", "n_failed", "n_events", "damper_n_events"}
+#: Columns of a long table, whose ``unit`` column gives each row's unit.
+LONG = {"value", "uncertainty", "nominal", "variable", "variable_uncertainty"}
+#: The units a name may end with (SI; ``_ratio`` and ``_percent`` say a dimensionless number is a ratio or in %,
+#: ``_z`` a normalised residual, ``_db`` decibels).
+SUFFIXES = ("_Hz", "_N", "_m", "_kg", "_Nm2", "_Ns_per_m", "_m_per_s2", "_s", "_ns", "_bytes", "_degC", "_per_degC",
+            "_ratio", "_ratio_uncertainty", "_ratio_sigma", "_percent", "_z", "_db")
+#: A numpy array's repr in a cell: "[" then a value (a number, True/False, a quoted string) and a space.
+NUMPY_REPR = re.compile(r"\[(?:True|False|-?\d[\d.e+-]*|'[^']*')\s")
+
+
+def unit_problems(name: str, frame: pd.DataFrame) -> list[str]:
+    """What is wrong with the columns of ``frame`` (the table called ``name``): no unit, or a numpy repr."""
+    problems = []
+    for column in frame.columns:
+        base = re.sub(r"\[[^\]]*\]$", "", str(column))  # a per-channel column: amplitude_m_per_s2[A1]
+        if not (base in UNITLESS or base.endswith(SUFFIXES) or (base in LONG and "unit" in frame.columns)):
+            problems.append(f"{name}: column {column!r} has no unit")
+        for cell in frame[column]:
+            if isinstance(cell, str) and NUMPY_REPR.search(cell):
+                problems.append(f"{name}: column {column!r} holds a numpy repr: {cell!r}")
+    return problems
+
+
+def test_unit_problems_finds_a_name_without_its_unit_and_a_numpy_repr():
+    frame = pd.DataFrame({"frequency": [1.0], "doubtful": [str(np.array([False, True]))],
+                          "frequency_Hz": [1.0], "parameters": ["ratio[T1] = 0.98"], "value": [2.0]})
+    assert unit_problems("t", frame) == ["t: column 'frequency' has no unit",
+                                         "t: column 'doubtful' holds a numpy repr: '[False  True]'",
+                                         "t: column 'value' has no unit"]  # a long table's value needs its unit column
+    assert unit_problems("t", frame.assign(unit="N").drop(columns=["frequency", "doubtful"])) == []
+
+
+def test_every_column_of_every_table_carries_its_unit(result):
+    problems = [p for name, frame in result.tables().items() for p in unit_problems(name, frame)]
+    assert problems == []
+
+
+def test_every_csv_file_carries_its_units_and_writes_lists_joined(simulated, tracked, tmp_path):
+    from stcs_ident.report.diagnose import write_report as diagnosis_report
+    from stcs_ident.report.identify_tables import write_tables
+    from stcs_ident.report.spectra_tables import write_modes_csv
+    from stcs_ident.report.track import write_report as track_report
+
+    diagnosis_report(simulated["diagnose"], tmp_path / "diagnose")
+    write_tables(simulated["identify"], tmp_path / "identify")
+    write_modes_csv([simulated["spectra"]], tmp_path)
+    (tmp_path / "track").mkdir()
+    track_report(tracked, tmp_path / "track")
+    written = sorted(tmp_path.rglob("*.csv"))
+    assert {p.name for p in written} >= {"ranking.csv", "frequencies.csv", "gain.csv", "nominal_comparison.csv",
+                                         "cause.csv", "parameters.csv", "modes.csv", "records.csv", "cables.csv",
+                                         "events.csv"}
+    problems = [p for path in written for p in unit_problems(str(path.relative_to(tmp_path)), pd.read_csv(path))]
+    assert problems == []
+    records = pd.read_csv(tmp_path / "track" / "records.csv")
+    for column in ("modes", "planes", "frequencies_Hz", "frequency_sigma_Hz", "doubtful", "damping_ratio"):
+        cells = [str(c).split(";") for c in records[column]]
+        assert [len(c) for c in cells] == tracked.table["n_modes"].tolist(), column
+    assert {f for c in records["doubtful"] for f in c.split(";")} <= {"True", "False"}
+    back = [[float(f) for f in c.split(";")] for c in records["frequencies_Hz"]]
+    assert back == [list(fs) for fs in tracked.table["frequencies_Hz"]]  # shortest repr: the same doubles
+    modes = pd.read_csv(tmp_path / "modes.csv")
+    assert modes["channels"].tolist() == [";".join(c) for c in simulated["spectra"].channels]
+
+
+def test_the_tables_of_the_quick_tension_a_damper_and_references_carry_their_units(simulated):
+    from stcs_ident.diagnose.tables import DAMPING_COLUMNS
+    from stcs_ident.track.result import CABLE_COLUMNS, DAMPER_CABLE_COLUMNS, EVENT_COLUMNS
+    from stcs_ident.track.store import ROW_COLUMNS
+
+    campaign = simulated["campaign"]
+    quick = si.quick_tension(CABLE.length, CABLE.mass_per_length, [8.1, 16.3, 24.6], EI=CABLE.EI)
+    record = si.tension_from_record(Path(campaign.directory) / campaign.tests[0].record, CABLE.length,
+                                    CABLE.mass_per_length, EI=CABLE.EI)
+    damped = si.Campaign("damped", CABLE, (si.Setup("d", (si.Damper("D", 0.5, coefficient=2e3),)),),
+                         (si.Test("T", "d", TENSION, frequencies=(8.1, 16.3), reference=(("paper", (8.0, 16.2)),)),))
+    forward = si.compare_forward(damped)
+    assert {"dsm_damping_ratio", "paper_Hz", "measured_Hz", "dsm_error_percent"} <= set(forward.to_dataframe())
+    constants = {"damping": DAMPING_COLUMNS, "events": EVENT_COLUMNS, "cables": CABLE_COLUMNS + DAMPER_CABLE_COLUMNS,
+                 "records.parquet": ROW_COLUMNS}
+    tables = {**{f"quick {k}": v for k, v in quick.tables().items()},
+              **{f"record {k}": v for k, v in record.tables().items()},
+              **{f"forward {k}": v for k, v in forward.tables().items()},
+              **{k: pd.DataFrame(columns=list(v)) for k, v in constants.items()}}
+    assert len(tables["record peaks"]) > 0 and len(tables["forward reference_checks"]) == 1
+    assert [p for name, frame in tables.items() for p in unit_problems(name, frame)] == []

@@ -73,7 +73,7 @@ def test_the_hidden_tension_loss_is_found_on_its_cable_only(archive, tracked):
     # Each record's tension against the truth: its 1σ covers the identification's error, not the scatter.
     table = pd.read_parquet(out / "records.parquet")
     true_tension = {(n, r["record"]): r["tension"] for n, c in truth["cables"].items() for r in c["records"]}
-    z = np.array([(row.tension - true_tension[(row.cable, row.record)]) / row.tension_sigma
+    z = np.array([(row.tension_N - true_tension[(row.cable, row.record)]) / row.tension_sigma_N
                   for row in table.itertuples()])
     assert 0.55 <= np.mean(np.abs(z) <= 1) <= 0.85 and np.mean(np.abs(z) <= 3) >= 0.97, np.percentile(np.abs(z), 68)
 
@@ -93,8 +93,8 @@ def test_a_dask_local_cluster_gives_the_same_rows(archive, tracked, tmp_path):
     local = local[local["cable"] == "C2"].reset_index(drop=True)
     dask = pd.read_parquet(tmp_path / "dask" / "records.parquet")
     assert len(dask) == 72
-    columns = ["cable", "record", "record_id", "start_time", "status", "modes", "frequencies", "frequency_sigma",
-               "tension", "tension_sigma", "temperature", "tension_normalised", "level"]
+    columns = ["cable", "record", "record_id", "start_time", "status", "modes", "frequencies_Hz", "frequency_sigma_Hz",
+               "tension_N", "tension_sigma_N", "temperature_degC", "tension_normalised_N", "tension_level_N"]
     pd.testing.assert_frame_equal(local[columns], dask[columns], check_exact=True)  # every row, to the last bit
     assert summary["cables"] == {"C2": tracked[0]["cables"]["C2"]}  # and so the same event
 
@@ -184,7 +184,7 @@ def test_a_cable_whose_every_record_failed_gets_its_report_with_the_reasons(tmp_
     report = (out / "report.md").read_text(encoding="utf-8")
     assert report.count("not an HDF5 file") == len(broken) >= 2
     cables = pd.read_csv(out / "cables.csv").set_index("cable")
-    assert cables.loc["C2", "failed"] == len(broken) and cables.loc["C1", "failed"] == 0
+    assert cables.loc["C2", "n_failed"] == len(broken) and cables.loc["C1", "n_failed"] == 0
     assert f"C2: 0 of {len(broken)} records with a tension, {len(broken)} failed" in capsys.readouterr().out
 
 

@@ -107,13 +107,13 @@ def test_process_record_of_a_damped_stay_gives_the_coefficient_within_3_sigma(tm
     row = process_record(spec, str(path), "x")
     assert row["status"] == "ok", row["reason"]
     assert row["coefficient_reason"] == ""
-    assert len(row["damping"]) == len(row["damping_sigma"]) == row["n_modes"]
-    assert np.isfinite(row["damping"]).sum() >= 3  # the coefficient rests on measured ratios
+    assert len(row["damping_ratio"]) == len(row["damping_ratio_sigma"]) == row["n_modes"]
+    assert np.isfinite(row["damping_ratio"]).sum() >= 3  # the coefficient rests on measured ratios
     # 3σ: a 0.3 % chance to fail for an honest 1σ.
-    assert abs(row["coefficient"] - COEFFICIENT) <= 3 * row["coefficient_sigma"], (row["coefficient"],
-                                                                                   row["coefficient_sigma"])
-    assert 0 < row["coefficient_sigma"] < 0.5 * COEFFICIENT  # a 2-minute record locates it, if broadly
-    assert abs(row["tension"] - 4.0e6) <= 3 * row["tension_sigma"]
+    coefficient, sigma = row["coefficient_Ns_per_m"], row["coefficient_sigma_Ns_per_m"]
+    assert abs(coefficient - COEFFICIENT) <= 3 * sigma, (coefficient, sigma)
+    assert 0 < row["coefficient_sigma_Ns_per_m"] < 0.5 * COEFFICIENT  # a 2-minute record locates it, if broadly
+    assert abs(row["tension_N"] - 4.0e6) <= 3 * row["tension_sigma_N"]
 
 
 def _fake_record(monkeypatch, process, identify) -> None:
@@ -150,16 +150,16 @@ def test_a_bare_cable_has_no_coefficient_and_a_joint_fit_at_a_bound_is_a_reason_
     _fake_record(monkeypatch, process, fake_identify)
     spec = CableSpec("stay", str(tmp_path), DAMPED, "S", 4.0e6)
     row = process_record(spec, str(tmp_path / "records" / "r.h5"), "x")
-    assert row["status"] == "ok" and row["tension"] == 4.1e6  # the tension kept
-    assert math.isnan(row["coefficient"]) and math.isnan(row["coefficient_sigma"])
+    assert row["status"] == "ok" and row["tension_N"] == 4.1e6  # the tension kept
+    assert math.isnan(row["coefficient_Ns_per_m"]) and math.isnan(row["coefficient_sigma_Ns_per_m"])
     assert "bound" in row["coefficient_reason"]
-    assert row["damping"][0] == 0.012 and math.isnan(row["damping"][1])
+    assert row["damping_ratio"][0] == 0.012 and math.isnan(row["damping_ratio"][1])
     assert calls == ["tension,coefficient", "tension"]
     bare = CableSpec("stay", str(tmp_path), Campaign("bare", STAY, setups=(Setup("S", ()),),
                                                      tests=(Test("T", "S", 4.0e6),)), "S", 4.0e6)
     calls.clear()
     row = process_record(bare, str(tmp_path / "records" / "r.h5"), "x")
-    assert calls == ["tension"] and math.isnan(row["coefficient"]) and row["coefficient_reason"] == ""
+    assert calls == ["tension"] and math.isnan(row["coefficient_Ns_per_m"]) and row["coefficient_reason"] == ""
     two = Campaign("two", STAY, setups=(Setup("S", (Damper("D1", 3.0, coefficient=1e5),
                                                     Damper("D2", 117.0, coefficient=1e5))),),
                    tests=(Test("T", "S", 4.0e6),))
@@ -190,26 +190,29 @@ def test_a_tension_without_a_finite_sigma_is_a_failed_record_not_an_answer(tmp_p
 def test_parts_written_before_the_damper_columns_still_read(tmp_path):
     old = [c for c in COLUMNS if c not in DAMPER_COLUMNS]
     row = {"cable": "C1", "record": "records/a.h5", "record_id": "id", "start_time": "2024-01-01T00:00:00+00:00",
-           "temperature": 10.0, "status": "ok", "reason": "", "n_modes": 2, "modes": [1, 2], "planes": ["in", "in"],
-           "frequencies": [1.0, 2.0], "frequency_sigma": [1e-3, 1e-3], "tension": 4e6, "tension_sigma": 5e3,
-           "version": "v", "size": 1, "mtime_ns": 2}
-    append_part(tmp_path, [dict(row, record="records/new.h5", damping=[0.01, np.nan], damping_sigma=[0.002, np.nan],
-                                coefficient=1e5, coefficient_sigma=1e4, coefficient_reason="")])
+           "temperature_degC": 10.0, "status": "ok", "reason": "", "n_modes": 2, "modes": [1, 2],
+           "planes": ["in", "in"], "frequencies_Hz": [1.0, 2.0], "frequency_sigma_Hz": [1e-3, 1e-3], "tension_N": 4e6,
+           "tension_sigma_N": 5e3,
+           "version": "v", "size_bytes": 1, "mtime_ns": 2}
+    append_part(tmp_path, [dict(row, record="records/new.h5", damping_ratio=[0.01, np.nan],
+                                damping_ratio_sigma=[0.002, np.nan], coefficient_Ns_per_m=1e5,
+                                coefficient_sigma_Ns_per_m=1e4, coefficient_reason="")])
     # A part as written before: the same writer, without the new columns.
     from stcs_ident.io.tables import write_parquet
     from stcs_ident.track.store import _frame, cable_key
 
-    frame = _frame([dict(row, damping=[], damping_sigma=[], coefficient=np.nan, coefficient_sigma=np.nan,
+    frame = _frame([dict(row, damping_ratio=[], damping_ratio_sigma=[], coefficient_Ns_per_m=np.nan,
+                         coefficient_sigma_Ns_per_m=np.nan,
                          coefficient_reason="")])
     # named as a part written long before the other (its time field orders the parts)
-    write_parquet(frame[[*old, "version", "size", "mtime_ns"]],
+    write_parquet(frame[[*old, "version", "size_bytes", "mtime_ns"]],
                   tmp_path / "parts" / f"{cable_key('C1')}-0000000000000001-00000000-1.parquet")
     table = processed_table(tmp_path)
     assert list(table["record"]) == ["records/a.h5", "records/new.h5"]
     before = table.iloc[0]
-    assert len(before["damping"]) == 2 and np.isnan(before["damping"]).all()
-    assert math.isnan(before["coefficient"]) and before["coefficient_reason"] == ""
-    assert table.iloc[1]["coefficient"] == 1e5
+    assert len(before["damping_ratio"]) == 2 and np.isnan(before["damping_ratio"]).all()
+    assert math.isnan(before["coefficient_Ns_per_m"]) and before["coefficient_reason"] == ""
+    assert table.iloc[1]["coefficient_Ns_per_m"] == 1e5
 
 
 @pytest.mark.slow  # four damped records' spectra
@@ -249,19 +252,20 @@ def test_the_report_of_a_damped_cable_with_a_damper_event_draws_its_panel(tmp_pa
     n = coefficient.size
     tension = 4e6 * (1 + 2e-3 * rng.standard_normal(n))
     table = pd.DataFrame({"cable": "stay", "record": [f"records/r{k}.h5" for k in range(n)], "start_time": start,
-                          "temperature": air, "status": "ok", "reason": "", "n_modes": 1, "modes": [[1]] * n,
-                          "planes": [["in"]] * n, "frequencies": [[1.1]] * n, "frequency_sigma": [[1e-3]] * n,
-                          "tension": tension, "tension_sigma": 5e3, "damping": [[0.012]] * n,
-                          "damping_sigma": [[0.002]] * n, "coefficient": coefficient, "coefficient_sigma": sigma,
+                          "temperature_degC": air, "status": "ok", "reason": "", "n_modes": 1, "modes": [[1]] * n,
+                          "planes": [["in"]] * n, "frequencies_Hz": [[1.1]] * n, "frequency_sigma_Hz": [[1e-3]] * n,
+                          "tension_N": tension, "tension_sigma_N": 5e3, "damping_ratio": [[0.012]] * n,
+                          "damping_ratio_sigma": [[0.002]] * n, "coefficient_Ns_per_m": coefficient,
+                          "coefficient_sigma_Ns_per_m": sigma,
                           "coefficient_reason": ""})
     spec = CableSpec("stay", str(tmp_path), DAMPED, "S", 4.0e6)
     history = analyse_history(tension, air, 4e6, times=seconds)
-    table["tension_normalised"], table["level"] = history.normalised, 4e6 * (1 + history.level)
+    table["tension_normalised_N"], table["tension_level_N"] = history.normalised, 4e6 * (1 + history.level)
     table, dampers = api._damper_histories([spec], table)
     assert len(dampers["stay"][1].events) == 1
     result = TrackResult(str(tmp_path), tmp_path, (spec,), table, {"stay": (table.index, history)}, dampers=dampers)
     events = result.tables()["events"]
-    assert list(events["kind"]) == ["damper"] and events["change"].iloc[0] == pytest.approx(-0.3, abs=0.06)
+    assert list(events["kind"]) == ["damper"] and events["change_ratio"].iloc[0] == pytest.approx(-0.3, abs=0.06)
     assert result.summary()["cables"]["stay"]["events"] == []  # the tension's events: none
     (tmp_path / "report").mkdir()
     out = write_report(result, tmp_path / "report")

@@ -67,16 +67,16 @@ def test_a_row_lists_the_planes_and_the_tension_comes_from_both(tmp_path, monkey
     assert row["status"] == "ok", row["reason"]
     assert row["planes"] == ["in"] * 4 + ["out"] * 4 and row["modes"] == [1, 2, 3, 4] * 2
     # exact frequencies: the fit's tolerance; numbered all in-plane the out-of-plane mode 1 would pull it ~1 % off
-    assert row["tension"] == pytest.approx(TENSION, rel=1e-7)
+    assert row["tension_N"] == pytest.approx(TENSION, rel=1e-7)
     assert seen["directions"] == {"acc2": "out"}  # the campaign's directions reach the reader
 
 
 def test_a_part_written_before_the_planes_reads_all_in_plane(tmp_path):
     row = {k: None for k in ROW_COLUMNS}
     row.update(cable="stay", record="a.h5", record_id="x", start_time=np.datetime64("2026-03-01T00:00:00"),
-               temperature=math.nan, status="ok", reason="", n_modes=2, modes=[1, 2], planes=["in", "in"],
-               frequencies=[0.36, 0.67], frequency_sigma=[1e-3, 1e-3], tension=4e6, tension_sigma=4e3, version="v",
-               size=1, mtime_ns=1)
+               temperature_degC=math.nan, status="ok", reason="", n_modes=2, modes=[1, 2], planes=["in", "in"],
+               frequencies_Hz=[0.36, 0.67], frequency_sigma_Hz=[1e-3, 1e-3], tension_N=4e6, tension_sigma_N=4e3,
+               version="v", size_bytes=1, mtime_ns=1)
     path = append_part(tmp_path, [row])
     assert "planes" in pd.read_parquet(path)
     old = pd.read_parquet(path).drop(columns="planes")  # as a part of the previous schema

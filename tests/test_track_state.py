@@ -23,13 +23,13 @@ from stcs_ident.core.errors import TrackWarning
 from stcs_ident.simulate.archive import ArchiveOptions, simulate_archive
 from stcs_ident.track.api import track
 from stcs_ident.track.archive import discover
-from stcs_ident.track.store import ROW_COLUMNS, append_part, cable_key
+from stcs_ident.track.store import OLD_NAMES, ROW_COLUMNS, append_part, cable_key
 from tests.test_track import _campaign
 
 #: Tiny records: 10 s at 50 Hz on one channel give the hanger's first modes and a tension in about 0.1 s.
 TINY = ArchiveOptions(days=3 / 48, interval=1800, duration=10, sampling_rate=50, sensors=(0.3,))
 #: The columns that say what a row is (its file's modification time aside: a copy of an archive has others).
-COMPARED = [c for c in ROW_COLUMNS if c != "mtime_ns"] + ["tension_normalised", "level"]
+COMPARED = [c for c in ROW_COLUMNS if c != "mtime_ns"] + ["tension_normalised_N", "tension_level_N"]
 NOTHING = {"new": 0, "changed": 0, "stale": 0, "removed": 0, "retried": 0}
 
 
@@ -68,7 +68,7 @@ def test_a_record_changed_in_place_replaces_its_row(archive, tmp_path):
     result = track(archive, out)
     assert result.counts == {**NOTHING, "changed": 1, "unchanged": 5}
     rows = result.table[result.table["cable"] == "C1"]
-    assert len(rows) == 3 and (rows["temperature"] == 31.5).sum() == 1
+    assert len(rows) == 3 and (rows["temperature_degC"] == 31.5).sum() == 1
     assert_same_table(result.table, _clean(archive, tmp_path))
 
 
@@ -97,7 +97,8 @@ def test_an_edited_campaign_makes_its_cable_stale(archive, tmp_path):
     after = result.table
     c1 = after["cable"] == "C1"
     # 5 % more mass: the tension of the same frequencies is about 5 % higher (EI is a small correction here).
-    assert (after.loc[c1, "tension"].to_numpy() > 1.03 * before.loc[before["cable"] == "C1", "tension"].to_numpy()).all()
+    before_c1 = before.loc[before["cable"] == "C1", "tension_N"].to_numpy()
+    assert (after.loc[c1, "tension_N"].to_numpy() > 1.03 * before_c1).all()
     assert result.summary()["cables"]["C1"]["EI"] == 1.0e5
     assert_same_table(after, _clean(archive, tmp_path))
     # A comment changes nothing that shapes a row: the cable stays current.
@@ -169,7 +170,7 @@ def test_a_rerun_of_one_cable_keeps_the_others_in_the_table_and_the_report(archi
     assert "track: 0 new, 1 changed, 0 stale, 0 removed, 0 retried, 2 unchanged" in capsys.readouterr().err
     table = pd.read_parquet(out / "records.parquet")
     c2 = table[table["cable"] == "C2"].reset_index(drop=True)
-    assert c2[["tension_normalised", "level"]].notna().all().all()
+    assert c2[["tension_normalised_N", "tension_level_N"]].notna().all().all()
     assert_same_table(c2, whole[whole["cable"] == "C2"])
     now = pd.read_csv(out / "cables.csv")
     assert list(now["cable"]) == ["C1", "C2"]
@@ -185,8 +186,8 @@ def test_a_failed_row_is_retried_when_its_cause_is_gone(archive, tmp_path):
     good = track(archive, out).table
     spec = track(archive, out).specs[0]
     row = good[good["cable"] == "C1"].iloc[0].to_dict()
-    row.update(status="failed", reason="cannot read: file not found", tension=float("nan"), n_modes=0, modes=[],
-               frequencies=[], frequency_sigma=[], version=spec.version)
+    row.update(status="failed", reason="cannot read: file not found", tension_N=float("nan"), n_modes=0, modes=[],
+               frequencies_Hz=[], frequency_sigma_Hz=[], version=spec.version)
     append_part(out, [{k: row[k] for k in ROW_COLUMNS}])  # the latest row of that path: failed
     result = track(archive, out)
     assert result.counts == {**NOTHING, "retried": 1, "unchanged": 5}
@@ -210,6 +211,23 @@ def test_a_relative_archive_path_on_dask_workers_started_elsewhere(archive, tmp_
         result = track("archive", tmp_path / "dask", scheduler=cluster.scheduler_address)
     assert (result.table["status"] == "ok").all()
     assert_same_table(result.table, first)
+
+
+def test_parts_written_before_the_names_carried_units_are_resumed_on(archive, tmp_path):
+    out = tmp_path / "out"
+    first = track(archive, out).table
+    parts = sorted((out / "parts").iterdir())
+    old = {new: name for name, new in OLD_NAMES.items()}
+    for part in parts:  # every part as a run before the renaming wrote it: the same rows, the old names
+        frame = pd.read_parquet(part)
+        assert set(old) <= set(frame.columns)
+        frame.rename(columns=old).to_parquet(part, index=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no part reported unreadable
+        result = track(archive, out)
+    assert result.counts == {**NOTHING, "unchanged": 6}  # nothing processed again
+    assert_same_table(result.table, first)
+    assert set(OLD_NAMES).isdisjoint(pd.read_parquet(out / "records.parquet").columns)
 
 
 @pytest.mark.parametrize("damage", ["truncated", "zero-byte", "other columns"])
@@ -252,7 +270,7 @@ def test_a_cable_without_records_has_its_row_and_section(archive, tmp_path, caps
     out = tmp_path / "out"
     assert main(["track", str(archive), "--out", str(out)]) == 0
     cables = pd.read_csv(out / "cables.csv").set_index("cable")
-    assert list(cables.index) == ["C1", "C2"] and (cables["records"] == 0).all()
+    assert list(cables.index) == ["C1", "C2"] and (cables["n_records"] == 0).all()
     report = (out / "report.md").read_text()
     assert "| C1 | 0 | 0 | 0 |" in report and "| C2 | 0 | 0 | 0 |" in report
     assert (out / "C1.png").exists() and (out / "C2.png").exists()
@@ -384,9 +402,10 @@ def test_every_cable_is_in_the_report_whatever_its_state(archive, tmp_path, caps
     assert main(["track", str(archive), "--out", str(out)]) == 0
     cables = pd.read_csv(out / "cables.csv").set_index("cable")
     assert list(cables.index) == ["C1", "C2", "C3"]
-    assert cables[["records", "processed", "failed"]].to_dict("index") == {
-        "C1": {"records": 1, "processed": 1, "failed": 0}, "C2": {"records": 3, "processed": 0, "failed": 3},
-        "C3": {"records": 0, "processed": 0, "failed": 0}}
+    assert cables[["n_records", "n_processed", "n_failed"]].to_dict("index") == {
+        "C1": {"n_records": 1, "n_processed": 1, "n_failed": 0},
+        "C2": {"n_records": 3, "n_processed": 0, "n_failed": 3},
+        "C3": {"n_records": 0, "n_processed": 0, "n_failed": 0}}
     report = (out / "report.md").read_text()
     for line in ("| C1 | 1 | 1 | 0 |", "| C2 | 3 | 0 | 3 |", "| C3 | 0 | 0 | 0 |", "[C3](C3.png)"):
         assert line in report

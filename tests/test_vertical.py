@@ -327,6 +327,6 @@ def test_every_command_on_a_vertical_hanger(hanger_records, tmp_path, capsys):
     history = json.loads((arch / "truth.json").read_text())["cables"]
     true = {(c, r["record"]): r["tension"] for c, v in history.items() for r in v["records"]}
     for row in rows:
-        t, sigma = float(row["tension"]), float(row["tension_sigma"])
+        t, sigma = float(row["tension_N"]), float(row["tension_sigma_N"])
         # each record's own σ (0.06 %) with 4σ: one draw each of twelve
         assert abs(t - true[(row["cable"], row["record"])]) < 4 * sigma, (row["record"], t, sigma)

@@ -24,8 +24,13 @@ from .fitting import data
 #: The tables of :func:`diagnosis_tables`, in order (each a CSV file of the report).
 TABLES = ("ranking", "frequencies", "gain", "nominal_comparison", "cause")
 #: Columns of :func:`damping_table`.
-DAMPING_COLUMNS = ("test", "setup", "mode", "plane", "measured", "uncertainty", "sigma", "nominal", "corrected",
-                   "nominal_z", "corrected_z")
+#: The damping ratios are ratios (not percent): ``measured_damping_ratio`` with its 1σ, the σ the diagnosis weighs it
+#: by, the nominal and the chosen model's ratios, and each one's z, (measured − model) / σ.
+DAMPING_COLUMNS = ("test", "setup", "mode", "plane", "measured_damping_ratio", "damping_ratio_uncertainty",
+                   "damping_ratio_sigma", "nominal_damping_ratio", "corrected_damping_ratio", "nominal_z",
+                   "corrected_z")
+#: The keys of :func:`damping_columns` for the columns of :data:`DAMPING_COLUMNS` after the first four.
+_DAMPING_KEYS = ("measured", "uncertainty", "sigma", "nominal", "corrected", "nominal_z", "corrected_z")
 
 
 def effects_label(effects) -> str:
@@ -90,18 +95,18 @@ def ranking_table(diagnosis) -> pd.DataFrame:
     for rank, f in enumerate(ranked, start=1):
         # A failed fit has no estimate: its figures are empty (not χ² inf, ε 0), its reason in ``failure``.
         failed = f.failure is not None
-        rows.append({"rank": rank, "effects": effects_label(f.effects), "k": f.n_parameters,
+        rows.append({"rank": rank, "effects": effects_label(f.effects), "n_parameters": f.n_parameters,
                      "chi2": math.nan if failed else f.chi2,
                      "reduced_chi2": math.nan if failed else _reduced_chi2(f, n),
                      "prior_penalty": math.nan if failed else f.penalty,
-                     "epsilon": math.nan if failed else f.epsilon,
+                     "relative_model_error": math.nan if failed else f.epsilon,
                      "aicc": math.nan if failed else f.aicc, "delta_aicc": math.nan if failed else f.aicc - best,
-                     "rms_error_%": f.rms_error,
-                     "cv_rms_error_%": math.nan if f.cv_rms_error is None else f.cv_rms_error,
+                     "rms_error_percent": f.rms_error,
+                     "cv_rms_error_percent": math.nan if f.cv_rms_error is None else f.cv_rms_error,
                      "cause": f.effects == d.selection.fitted,
                      "parameters": "" if failed else _short(parameter_rows(*d.parameters(f))),
                      "failure": f.failure or "",
-                     "seconds": d.timings.get(f.effects, math.nan)})
+                     "elapsed_s": d.timings.get(f.effects, math.nan)})
     return pd.DataFrame(rows)
 
 
@@ -118,7 +123,7 @@ def frequency_table(diagnosis) -> pd.DataFrame:
         for key, values in split.items():
             data[f"{key}_Hz"] = values[i] if values is not None else np.full(m.modes.size, np.nan)
         for key in models:
-            data[f"{key}_error_%"] = percent_error(data[f"{key}_Hz"], m.frequencies)
+            data[f"{key}_error_percent"] = percent_error(data[f"{key}_Hz"], m.frequencies)
         data["source"] = m.source
         data["plane"] = [str(p) for p in m.planes]
         frames.append(pd.DataFrame(data))
@@ -133,10 +138,11 @@ def gain_table(diagnosis) -> pd.DataFrame:
     for key, fit in (("nominal", d.nominal), ("baseline", d.baseline), ("corrected", d.corrected)):
         if fit is None:
             continue
-        rows.append({"model": key, "effects": effects_label(fit.effects), "k": fit.n_parameters, "chi2": fit.chi2,
-                     "reduced_chi2": _reduced_chi2(fit, n), "aicc": fit.aicc, "rms_error_%": fit.rms_error,
-                     "cv_rms_error_%": math.nan if fit.cv_rms_error is None else fit.cv_rms_error,
-                     "test_cv_rms_error_%": d.test_cv.get(key, math.nan)})
+        rows.append({"model": key, "effects": effects_label(fit.effects), "n_parameters": fit.n_parameters,
+                     "chi2": fit.chi2, "reduced_chi2": _reduced_chi2(fit, n), "aicc": fit.aicc,
+                     "rms_error_percent": fit.rms_error,
+                     "cv_rms_error_percent": math.nan if fit.cv_rms_error is None else fit.cv_rms_error,
+                     "test_cv_rms_error_percent": d.test_cv.get(key, math.nan)})
     return pd.DataFrame(rows)
 
 
@@ -214,7 +220,7 @@ def damping_table(diagnosis) -> pd.DataFrame:
     for m, entry in zip(d.measurements, columns):
         used = np.isfinite(entry["measured"])
         frame = {"test": m.name, "setup": m.test.setup, "mode": m.modes[used], "plane": [str(p) for p in m.planes[used]]}
-        frame |= {key: entry[key][used] for key in DAMPING_COLUMNS[4:]}
+        frame |= {column: entry[key][used] for column, key in zip(DAMPING_COLUMNS[4:], _DAMPING_KEYS)}
         frames.append(pd.DataFrame(frame, columns=list(DAMPING_COLUMNS)))
     return pd.concat(frames, ignore_index=True)
 

@@ -58,17 +58,20 @@ class TestComparison:
         return percent_error(getattr(self, column), self.measured)
 
     def to_dataframe(self) -> pd.DataFrame:
+        """One row per mode: ``measured_Hz`` (where measured), ``taut_string_Hz``, ``beam_pinned_Hz``, ``dsm_Hz``
+        each with its ``<model>_error_percent`` where measured, ``dsm_damping_ratio`` with a damper, and each
+        reference column as ``<label>_Hz``."""
         data = {"mode": list(self.modes)}
         if self.measured is not None:
-            data["measured"] = self.measured
+            data["measured_Hz"] = self.measured
         for col in ("taut_string", "beam_pinned", "dsm"):
-            data[col] = getattr(self, col)
+            data[f"{col}_Hz"] = getattr(self, col)
             if self.measured is not None:
-                data[f"{col}_error_%"] = self.error(col)
+                data[f"{col}_error_percent"] = self.error(col)
         if self.damping is not None:
-            data["dsm_damping_%"] = 100 * self.damping
+            data["dsm_damping_ratio"] = self.damping
         for label, values in self.reference.items():
-            data[label] = values
+            data[f"{label}_Hz"] = values
         return pd.DataFrame(data)
 
 
@@ -173,7 +176,7 @@ class ForwardResult(Result):
             frames.append(frame)
         frequencies = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame({"test": [], "mode": []})
         checks = pd.DataFrame(
-            [{"label": c.label, "setup": c.setup, "tests": " ".join(c.tests), "reproduced": c.reproduced,
+            [{"label": c.label, "setup": c.setup, "tests": ";".join(c.tests), "reproduced": c.reproduced,
               "step_Hz": c.step, "rms_nominal_Hz": c.rms_nominal, "max_nominal_Hz": c.max_nominal,
               "worst_mode": c.worst_mode, "EI_nominal_Nm2": c.EI_nominal, "EI_best_Nm2": c.EI_best,
               "rms_best_Hz": c.rms_best} for c in self.reference_checks],

@@ -108,8 +108,10 @@ class RecordTensionResult(Result):
         import pandas as pd
 
         tables = self.tension.tables()
-        tables["peaks"] = pd.DataFrame(list(self.peaks), columns=["frequency", "uncertainty", "mode", "doubtful",
-                                                                  "damping"])
+        # the JSON's keys with their units, as every table's columns
+        names = {"frequency": "frequency_Hz", "uncertainty": "uncertainty_Hz", "mode": "mode", "doubtful": "doubtful",
+                 "damping": "damping_ratio"}
+        tables["peaks"] = pd.DataFrame(list(self.peaks), columns=list(names)).rename(columns=names)
         return tables
 
 

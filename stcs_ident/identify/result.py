@@ -361,9 +361,9 @@ class IdentificationResult(Result):
         """Before/after table in the paper's Table 9/10 form: one row per test and mode.
 
         Columns ``test``, ``mode``, ``measured_Hz``, ``before_Hz``,
-        ``before_error_abs_%``, ``corrected_Hz``, ``corrected_error_abs_%``
+        ``before_error_abs_percent``, ``corrected_Hz``, ``corrected_error_abs_percent``
         (errors |computed − measured| / measured × 100), and for each of
-        :attr:`shown_references` ``<label>_Hz`` and ``<label>_error_abs_%``; last, ``plane`` (``in`` or
+        :attr:`shown_references` ``<label>_Hz`` and ``<label>_error_abs_percent``; last, ``plane`` (``in`` or
         ``out``, the plane of the mode).
         """
         frames = []
@@ -371,13 +371,13 @@ class IdentificationResult(Result):
         for t in self.tests:
             data = {
                 "test": t.name, "mode": list(t.modes), "measured_Hz": t.measured,
-                "before_Hz": t.before, "before_error_abs_%": np.abs(t.before_error),
-                "corrected_Hz": t.after, "corrected_error_abs_%": np.abs(t.after_error),
+                "before_Hz": t.before, "before_error_abs_percent": np.abs(t.before_error),
+                "corrected_Hz": t.after, "corrected_error_abs_percent": np.abs(t.after_error),
             }
             for label in labels:
                 values = t.reference.get(label, np.full(len(t.modes), np.nan))
                 data[f"{label}_Hz"] = values
-                data[f"{label}_error_abs_%"] = np.abs(percent_error(values, t.measured))
+                data[f"{label}_error_abs_percent"] = np.abs(percent_error(values, t.measured))
             data["plane"] = list(t.mode_planes)
             frames.append(pd.DataFrame(data))
         return pd.concat(frames, ignore_index=True)

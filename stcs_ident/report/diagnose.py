@@ -145,11 +145,11 @@ def _forward_section(forward, table: pd.DataFrame) -> list[str]:
     out = ["## Nominal model against the measurements", "",
            ("Taut string, pinned beam and the exact dynamic-stiffness model (DSM) with the nominal cable and "
            "tensions; errors are (model − measured) / measured in %."), ""]
-    columns = {"test": "test", "mode": "mode", "measured": "measured (Hz)", "taut_string": "string (Hz)",
-               "taut_string_error_%": "err %", "beam_pinned": "beam (Hz)", "beam_pinned_error_%": "err %",
-               "dsm": "DSM (Hz)", "dsm_error_%": "err %"}
+    columns = {"test": "test", "mode": "mode", "measured_Hz": "measured (Hz)", "taut_string_Hz": "string (Hz)",
+               "taut_string_error_percent": "err %", "beam_pinned_Hz": "beam (Hz)",
+               "beam_pinned_error_percent": "err %", "dsm_Hz": "DSM (Hz)", "dsm_error_percent": "err %"}
     columns = {c: h for c, h in columns.items() if c in table.columns}
-    fmt = {c: ("{:.2f}" if c.endswith("%") else "{:.3f}") for c in columns if c not in ("test", "mode")}
+    fmt = {c: ("{:.2f}" if c.endswith("_percent") else "{:.3f}") for c in columns if c not in ("test", "mode")}
     out.append(markdown_table(table, fmt, columns))
     errors = []
     for t in forward.tests:
@@ -174,13 +174,14 @@ def _ranking_section(d, ranking: pd.DataFrame) -> list[str]:
 
     n = d.measured.size
     gate = float(chi2_distribution.isf(ALPHA, n))
-    columns = {"rank": "#", "effects": "hypothesis", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
-               "prior_penalty": "prior", "epsilon": "ε", "delta_aicc": "ΔAICc", "rms_error_%": "rms %",
-               "cv_rms_error_%": "CV rms %", "cause": "chosen", "parameters": "key parameter values"}
+    columns = {"rank": "#", "effects": "hypothesis", "n_parameters": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
+               "prior_penalty": "prior", "relative_model_error": "ε", "delta_aicc": "ΔAICc",
+               "rms_error_percent": "rms %", "cv_rms_error_percent": "CV rms %", "cause": "chosen",
+               "parameters": "key parameter values"}
     if not d.selection.model_error:
-        del columns["epsilon"]
-    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "prior_penalty": "{:.2f}", "epsilon": "{:.2e}",
-           "delta_aicc": "{:.1f}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}"}
+        del columns["relative_model_error"]
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "prior_penalty": "{:.2f}", "relative_model_error": "{:.2e}",
+           "delta_aicc": "{:.1f}", "rms_error_percent": "{:.3f}", "cv_rms_error_percent": "{:.3f}"}
     failed = ranking["failure"] != ""
     listed = ["Failed fits (no estimate, not ranked):", ""] if failed.any() else []
     listed += [f"- {row.effects}: {row.failure}" for row in ranking[failed].itertuples()]
@@ -254,11 +255,11 @@ def _before_after_section(d, freq: pd.DataFrame, figures: dict) -> list[str]:
            "## Before and after, per test", ""]
     have_baseline = d.baseline is not None
     columns = {"mode": "mode", "measured_Hz": "measured", "uncertainty_Hz": "σ", "nominal_Hz": "nominal",
-               "nominal_error_%": "err %"}
+               "nominal_error_percent": "err %"}
     if have_baseline:
-        columns |= {"baseline_Hz": "baseline", "baseline_error_%": "err %"}
-    columns |= {"corrected_Hz": "corrected", "corrected_error_%": "err %"}
-    fmt = {c: ("{:.3f}" if c.endswith("%") else "{:.2g}" if c == "uncertainty_Hz" else "{:.4f}") for c in columns}
+        columns |= {"baseline_Hz": "baseline", "baseline_error_percent": "err %"}
+    columns |= {"corrected_Hz": "corrected", "corrected_error_percent": "err %"}
+    fmt = {c: ("{:.3f}" if c.endswith("_percent") else "{:.2g}" if c == "uncertainty_Hz" else "{:.4f}") for c in columns}
     fmt["mode"] = "{}"
     for m in d.measurements:
         out += [f"### {m.name}", "", markdown_table(freq[freq["test"] == m.name], fmt, columns)]
@@ -296,10 +297,11 @@ def _gain_section(d, gain: pd.DataFrame) -> list[str]:
         out += [(f"The corrected model lowers χ² (errors in Hz weighted by the uncertainties) but its relative "
                 f"rms error ({percent(d.corrected.rms_error)}) is larger than the nominal model's "
                 f"({percent(d.nominal.rms_error)})."), ""]
-    columns = {"model": "model", "effects": "effects", "k": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
-               "rms_error_%": "rms %", "cv_rms_error_%": "CV rms %", "test_cv_rms_error_%": "test CV rms %"}
-    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_%": "{:.3f}", "cv_rms_error_%": "{:.3f}",
-           "test_cv_rms_error_%": "{:.3f}"}
+    columns = {"model": "model", "effects": "effects", "n_parameters": "k", "chi2": "χ²", "reduced_chi2": "χ²/(n−k)",
+               "rms_error_percent": "rms %", "cv_rms_error_percent": "CV rms %",
+               "test_cv_rms_error_percent": "test CV rms %"}
+    fmt = {"chi2": "{:.4g}", "reduced_chi2": "{:.3g}", "rms_error_percent": "{:.3f}", "cv_rms_error_percent": "{:.3f}",
+           "test_cv_rms_error_percent": "{:.3f}"}
     return out + [markdown_table(gain, fmt, columns)]
 
 

@@ -32,8 +32,9 @@ def _measured(zeta: float, sigma: float) -> str:
 
 
 def _rows(frame: pd.DataFrame) -> list[list[str]]:
-    return [[str(int(r.mode)), r.plane, _measured(r.measured, r.uncertainty), number(100 * r.nominal, "{:.3f}"),
-             number(r.nominal_z, "{:+.2f}"), number(100 * r.corrected, "{:.3f}"), number(r.corrected_z, "{:+.2f}")]
+    return [[str(int(r.mode)), r.plane, _measured(r.measured_damping_ratio, r.damping_ratio_uncertainty),
+             number(100 * r.nominal_damping_ratio, "{:.3f}"), number(r.nominal_z, "{:+.2f}"),
+             number(100 * r.corrected_damping_ratio, "{:.3f}"), number(r.corrected_z, "{:+.2f}")]
             for r in frame.itertuples(index=False)]
 
 

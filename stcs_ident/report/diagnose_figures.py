@@ -239,7 +239,8 @@ def plot_damping(table, fig=None) -> Drawn:
     nrows = math.ceil(n / ncols)
     fig = fig or new_figure(figsize=(5.2 * ncols, 3.6 * nrows + 0.6), layout="constrained")
     panels = np.atleast_1d(fig.subfigures(nrows, ncols, squeeze=False).ravel())
-    same = np.array_equal(table["nominal"].to_numpy(), table["corrected"].to_numpy(), equal_nan=True)
+    same = np.array_equal(table["nominal_damping_ratio"].to_numpy(), table["corrected_damping_ratio"].to_numpy(),
+                          equal_nan=True)
     models = ["nominal"] if same else ["nominal", "corrected"]
     lines: dict[str, list] = {key: [] for key in models}
     measured, axes = [], []
@@ -247,7 +248,8 @@ def plot_damping(table, fig=None) -> Drawn:
         rows = table[table["test"] == test]
         modes, planes = rows["mode"].to_numpy(int), rows["plane"].to_numpy(str)
         k, _ = mode_axis(modes, planes)
-        zeta, sigma = 100 * rows["measured"].to_numpy(float), 100 * rows["uncertainty"].to_numpy(float)
+        zeta, sigma = (100 * rows["measured_damping_ratio"].to_numpy(float),
+                        100 * rows["damping_ratio_uncertainty"].to_numpy(float))
         ax, ax_d = panel.subplots(2, 1, sharex=True, height_ratios=(2, 1))
         measured.append(ax.errorbar(k, zeta, yerr=sigma, fmt="s", ms=5, color="tab:blue", capsize=3, lw=1.0,
                                     label="measured (±1σ)"))
@@ -257,7 +259,7 @@ def plot_damping(table, fig=None) -> Drawn:
         ax_d.use_sticky_edges = False  # the band's edges must not clip the points at zero
         for key in models:
             label, colour, marker, dx = DAMPING_STYLE[key]
-            model = 100 * rows[key].to_numpy(float)
+            model = 100 * rows[f"{key}_damping_ratio"].to_numpy(float)
             lines[key].append(ax.plot(k + dx, model, ls="none", marker=marker, color=colour, ms=5, label=label)[0])
             ax_d.plot(k + dx, model - zeta, ls="none", marker=marker, color=colour, ms=4)
         ax.set_title(f"{test} (setup {rows['setup'].iloc[0]})", fontsize=9)

@@ -22,13 +22,9 @@ from ..identify.problem import printed_step
 
 
 def parameters_table(result) -> pd.DataFrame:
-    """One row per parameter: nominal (SI), estimate and uncertainty (variable and SI)."""
-    rows = []
-    for p, x, s, v, vs in zip(result.parameters, result.estimate, result.uncertainty, result.values,
-                              result.value_uncertainty):
-        rows.append({"parameter": p.name, "estimate": float(x), "uncertainty": float(s), "nominal_SI": p.nominal,
-                     "value_SI": float(v), "uncertainty_SI": float(vs), "unit": p.unit})
-    return pd.DataFrame(rows)
+    """One row per parameter (``result.parameter_table()``): ``value``, ``uncertainty`` and ``nominal`` in the
+    row's ``unit``, and the fit's dimensionless ``variable`` with its ``variable_uncertainty``."""
+    return result.parameter_table()
 
 
 _HEAD = ("mode", "measured (Hz)", "before (Hz)", "|δ| (%)", "corrected (Hz)", "|δ*| (%)")

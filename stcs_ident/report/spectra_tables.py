@@ -20,8 +20,8 @@ __all__ = ["MODES_CSV", "damping_cell", "modes_table", "spectra_text", "write_mo
 
 #: File name of the table, in the ``--plot`` directory.
 MODES_CSV = "modes.csv"
-_COLUMNS = ["test", "record_kind", "mode", "frequency_Hz", "uncertainty_Hz", "damping", "damping_uncertainty",
-            "doubtful", "channels", "plane", "mac"]
+_COLUMNS = ["test", "record_kind", "mode", "frequency_Hz", "uncertainty_Hz", "damping_ratio",
+            "damping_ratio_uncertainty", "doubtful", "channels", "plane", "mac"]
 
 
 def modes_table(results) -> pd.DataFrame:
@@ -36,9 +36,9 @@ def modes_table(results) -> pd.DataFrame:
     -------
     pandas.DataFrame
         Columns ``test``, ``record_kind`` (``impulse`` or ``ambient``), ``mode``, ``frequency_Hz``,
-        ``uncertainty_Hz`` (1σ), ``damping`` (ratio, NaN where not estimated), ``damping_uncertainty``
-        (1σ), ``doubtful`` (the mode number is doubtful), ``channels`` (where the peak was seen,
-        space-separated), ``plane`` (``in`` or ``out``: mode numbers count per plane) and ``mac`` (of the
+        ``uncertainty_Hz`` (1σ), ``damping_ratio`` (a ratio, not percent; NaN where not estimated),
+        ``damping_ratio_uncertainty`` (1σ), ``doubtful`` (the mode number is doubtful), ``channels`` (where the
+        peak was seen, joined by ``;``), ``plane`` (``in`` or ``out``: mode numbers count per plane) and ``mac`` (of the
         operating shape against the model's, NaN where not meaningful).
     """
     frames = []
@@ -90,8 +90,8 @@ def spectra_text(campaign: str, results, skipped) -> str:
         width = 2 * _DAMPING_WIDTH + 3
         lines.append(f"{head}{'mode':>4} {'frequency':>11} {'uncertainty':>11} {'damping % ± 1σ':>{width}} {'MAC':>5}"
                      "  channels")
-        for k, f, u, z, s, ch, doubt, plane, m in zip(r.modes, r.frequencies, r.uncertainty, table["damping"],
-                                                      table["damping_uncertainty"], r.channels, r.doubtful,
+        for k, f, u, z, s, ch, doubt, plane, m in zip(r.modes, r.frequencies, r.uncertainty, table["damping_ratio"],
+                                                      table["damping_ratio_uncertainty"], r.channels, r.doubtful,
                                                       r.mode_planes, table["mac"]):
             flag = "?" if doubt else " "
             mac = "" if math.isnan(m) else f"{m:.2f}"

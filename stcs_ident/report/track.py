@@ -22,7 +22,7 @@ from ..core.files import write_atomic, write_csv, write_figure
 from ..core.model import Damper
 from .plots import Drawn, new_figure
 
-__all__ = ["plot_cable_history", "records_csv_table", "write_report"]
+__all__ = ["joined", "plot_cable_history", "records_csv_table", "write_report"]
 
 #: Markers of the frequency panel, one per ten modes (the colours repeat every ten: tab10).
 MODE_MARKERS = (".", "x", "+", "1", "d")
@@ -55,20 +55,26 @@ def write_report(result, out: str | Path | None = None) -> Path:
 def records_csv_table(table: pd.DataFrame) -> pd.DataFrame:
     """The records table (``records.parquet``) with plain cells for CSV.
 
-    The per-record lists (``modes``, ``planes``, ``frequencies``, ``frequency_sigma``, ``doubtful``, ``damping``,
-    ``damping_sigma``) become their values joined by
-    ``;`` (``doubtful`` as ``true``/``false``) and ``start_time`` an ISO 8601 string; every other column is as in
-    the Parquet table.
+    The per-record lists (``modes``, ``planes``, ``frequencies_Hz``, ``frequency_sigma_Hz``, ``doubtful``,
+    ``damping_ratio``, ``damping_ratio_sigma``) become their values joined by ``;`` (:func:`joined`: ``doubtful``
+    as ``True``/``False``, floats in their shortest exact form) and ``start_time`` an ISO 8601 string; every
+    other column is as in the Parquet table.
     """
     plain = table.copy()
-    for name, cast in (("modes", int), ("planes", str), ("frequencies", float), ("frequency_sigma", float),
-                       ("doubtful", lambda x: "true" if x else "false"), ("damping", float),
-                       ("damping_sigma", float)):
-        if name in plain:  # str of a float is its shortest round-trip form
-            plain[name] = [";".join(str(cast(x)) for x in values) for values in plain[name]]
+    for name, cast in (("modes", int), ("planes", str), ("frequencies_Hz", float), ("frequency_sigma_Hz", float),
+                       ("doubtful", bool), ("damping_ratio", float), ("damping_ratio_sigma", float)):
+        if name in plain:
+            plain[name] = [joined(values, cast) for values in plain[name]]
     if "start_time" in plain:
         plain["start_time"] = [None if pd.isna(t) else t.isoformat() for t in plain["start_time"]]
     return plain
+
+
+def joined(values, cast=None) -> str:
+    """A list as one CSV cell: its values joined by ``;``, each as Python writes it plainly (``str`` of a float
+    is its shortest exact form, of a bool ``True``/``False``), never a numpy repr; ``cast`` (``int``, ``float``,
+    ``bool``, ``str``) first makes each value a Python one."""
+    return ";".join(str(x if cast is None else cast(x)) for x in values)
 
 
 def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, damper=None) -> Drawn:
@@ -78,13 +84,14 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, dampe
     ----------
     spec : the cable's specification in the run (``name``, ``campaign``, ``reference_tension``)
     table : DataFrame
-        One row per record (``start_time``, ``tension``, ``tension_sigma``,
-        ``level``, ``temperature``, ``modes``, ``planes``, ``frequencies``).
+        One row per record (``start_time``, ``tension_N``, ``tension_sigma_N``,
+        ``tension_level_N``, ``temperature_degC``, ``modes``, ``planes``, ``frequencies_Hz``).
     rows : the labels of this cable's rows in ``table``
     history : the cable's tension history (``normalised``, ``mean_temperature``, ``events``)
     fig : matplotlib.figure.Figure, optional
     damper : (row labels, History), optional
-        The damper's coefficient history (``coefficient``, ``coefficient_sigma``, ``coefficient_level`` of
+        The damper's coefficient history (``coefficient_Ns_per_m``, ``coefficient_sigma_Ns_per_m``,
+        ``coefficient_level_Ns_per_m`` of
         ``table``): a fourth panel.
 
     Returns
@@ -95,7 +102,7 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, dampe
     the colours repeat with another marker.
     """
     data = table.loc[rows]
-    if not data["tension"].notna().any():  # every record failed: say so; the reasons are in report.md
+    if not data["tension_N"].notna().any():  # every record failed: say so; the reasons are in report.md
         fig = fig or new_figure(figsize=(10, 1.2), layout="constrained")
         ax = fig.subplots()
         ax.set_axis_off()
@@ -110,12 +117,12 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, dampe
         top, middle, bottom, lowest = fig.subplots(4, 1, sharex=True, height_ratios=(3, 1.2, 2, 2.5))
     t = data["start_time"].dt.tz_convert(None) if len(data) else data["start_time"]
     kN = 1e-3
-    tension, sigma = data["tension"].to_numpy() * kN, data["tension_sigma"].to_numpy() * kN
+    tension, sigma = data["tension_N"].to_numpy() * kN, data["tension_sigma_N"].to_numpy() * kN
     top.fill_between(t, tension - sigma, tension + sigma, color="tab:blue", alpha=0.25, lw=0, label="1σ")
     top.plot(t, tension, ".", ms=2.5, color="tab:blue", label="identified")
     top.plot(t, history.normalised * kN, ".", ms=2.5, color="tab:orange",
              label=_normalised_label(history))
-    top.plot(t, data["level"].to_numpy() * kN, "-", color="k", lw=1, label="level between changes")
+    top.plot(t, data["tension_level_N"].to_numpy() * kN, "-", color="k", lw=1, label="level between changes")
     for e in history.events:
         top.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
         top.annotate(f" {100 * e.change:+.2f} ± {100 * e.uncertainty:.2f} %", (t.iloc[e.index], 0.97),
@@ -124,11 +131,11 @@ def plot_cable_history(spec, table: pd.DataFrame, rows, history, fig=None, dampe
     top.set_title(f"{spec.name}: {len(data)} records with a tension; reference {spec.reference_tension * kN:.1f} kN, "
                   f"EI {spec.campaign.cable.EI:.4g} N m² (held)")
     top.legend(loc="lower left", fontsize=8, ncol=4)
-    if data["temperature"].notna().any():
-        middle.plot(t, data["temperature"], "-", color="tab:green", lw=0.8)
+    if data["temperature_degC"].notna().any():
+        middle.plot(t, data["temperature_degC"], "-", color="tab:green", lw=0.8)
     middle.set_ylabel("temperature (°C)")
     planes = data["planes"] if "planes" in data else [["in"] * len(ms) for ms in data["modes"]]
-    keyed = [dict(zip(zip(ps, ms), f)) for ms, ps, f in zip(data["modes"], planes, data["frequencies"])]
+    keyed = [dict(zip(zip(ps, ms), f)) for ms, ps, f in zip(data["modes"], planes, data["frequencies_Hz"])]
     modes = sorted({key for k in keyed for key in k}, key=lambda key: (key[0] != "in", key[1]))
     colours = [f"C{i}" for i in range(10)]
     drawn = {}
@@ -162,16 +169,16 @@ def _damper_panel(ax, spec, table: pd.DataFrame, rows, history) -> None:
         return
     t = data["start_time"].dt.tz_convert(None)
     k = 1e-3
-    ax.errorbar(t, data["coefficient"] * k, yerr=data["coefficient_sigma"] * k, fmt=".", ms=3, lw=0.4,
+    ax.errorbar(t, data["coefficient_Ns_per_m"] * k, yerr=data["coefficient_sigma_Ns_per_m"] * k, fmt=".", ms=3, lw=0.4,
                 color="tab:blue", alpha=0.35, label="fitted, 1σ")
     ax.plot(t, history.normalised * k, ".", ms=2.5, color="tab:purple",
             label=_normalised_label(history))
-    ax.plot(t, data["coefficient_level"] * k, "-", color="k", lw=1, label="level between changes")
+    ax.plot(t, data["coefficient_level_Ns_per_m"] * k, "-", color="k", lw=1, label="level between changes")
     for e in history.events:
         ax.axvline(t.iloc[e.index], color="tab:red", lw=1.2)
         ax.annotate(f" {100 * e.change:+.1f} ± {100 * e.uncertainty:.1f} %", (t.iloc[e.index], 0.97),
                     xycoords=("data", "axes fraction"), va="top", ha="left", color="tab:red", fontsize=8)
-    shown = np.concatenate([history.normalised, data["coefficient"].to_numpy()]) * k
+    shown = np.concatenate([history.normalised, data["coefficient_Ns_per_m"].to_numpy()]) * k
     low, high = np.nanpercentile(shown, [1, 99])
     ax.set_ylim(max(0.0, low - 0.5 * (high - low)), high + 0.5 * (high - low))  # a wild record off the scale
     ax.set_ylabel("damper (kN s/m)")
@@ -191,19 +198,20 @@ def _markdown(summary: dict, cables: pd.DataFrame, events: pd.DataFrame) -> str:
              "| cable | records | with a tension | failed | reference (kN) | per °C | scatter | events | state |",
              "|---|---|---|---|---|---|---|---|---|"]
     for _, c in cables.iterrows():
-        thermal = "" if pd.isna(c["thermal_coefficient_per_C"]) else f"{100 * c['thermal_coefficient_per_C']:+.3f} %"
-        scatter = "" if pd.isna(c["scatter"]) else f"{100 * c['scatter']:.2f} %"
+        thermal = ("" if pd.isna(c["thermal_coefficient_per_degC"])
+                   else f"{100 * c['thermal_coefficient_per_degC']:+.3f} %")
+        scatter = "" if pd.isna(c["scatter_ratio"]) else f"{100 * c['scatter_ratio']:.2f} %"
         state = summary["cables"][c["cable"]]["state_note"]  # the command's line says the same
-        lines.append(f"| {c['cable']} | {c['records']} | {c['processed']} | {c['failed']} | "
-                     f"{c['reference_tension_kN']:.1f} | {thermal} | {scatter} | {c['events']} | {state} |")
+        lines.append(f"| {c['cable']} | {c['n_records']} | {c['n_processed']} | {c['n_failed']} | "
+                     f"{c['reference_tension_N'] / 1e3:.1f} | {thermal} | {scatter} | {c['n_events']} | {state} |")
     lines += ["", "## Lasting changes", ""]
     if (events["kind"] != "damper").sum() == 0:
         lines.append("None found.")
     else:
         lines += ["| cable | from | change | 1σ | alarm at |", "|---|---|---|---|---|"]
         for _, e in events[events["kind"] != "damper"].iterrows():
-            lines.append(f"| {e['cable']} | {e['start_time']} | {100 * e['change']:+.2f} % | "
-                         f"{100 * e['uncertainty']:.2f} % | {e['alarm_time']} |")
+            lines.append(f"| {e['cable']} | {e['start_time']} | {100 * e['change_ratio']:+.2f} % | "
+                         f"{100 * e['uncertainty_ratio']:.2f} % | {e['alarm_time']} |")
     dampers = {name: c["damper"] for name, c in summary["cables"].items() if "damper" in c}
     if dampers:
         lines += _damper_markdown(dampers)

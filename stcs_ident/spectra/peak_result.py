@@ -138,21 +138,23 @@ class PeakResult(PickingResult):
                 f"{len(self.channel_names)} channels)")
 
     def to_dataframe(self) -> pd.DataFrame:
-        """One row per peak: frequency, uncertainty, damping, its 1σ, SNR, channels, amplitude per channel."""
+        """One row per peak: ``frequency_Hz``, ``uncertainty_Hz`` (1σ), ``damping_ratio`` and
+        ``damping_ratio_uncertainty`` (NaN where the fit failed), ``snr_db``, ``channels`` (joined by ``;``) and
+        the amplitude per channel, ``amplitude_m_per_s2[<channel>]``."""
         rows = []
         for p in self.peaks:
             row = {
-                "frequency": p.frequency,
-                "uncertainty": p.uncertainty,
-                "damping": p.damping,
-                "damping_uncertainty": p.damping_uncertainty,
+                "frequency_Hz": p.frequency,
+                "uncertainty_Hz": p.uncertainty,
+                "damping_ratio": p.damping,
+                "damping_ratio_uncertainty": p.damping_uncertainty,
                 "snr_db": p.snr_db,
-                "channels": ",".join(p.channels),
+                "channels": ";".join(p.channels),
             }
-            row.update({f"amplitude[{name}]": a for name, a in zip(self.channel_names, p.amplitude)})
+            row.update({f"amplitude_m_per_s2[{name}]": a for name, a in zip(self.channel_names, p.amplitude)})
             rows.append(row)
-        columns = ["frequency", "uncertainty", "damping", "damping_uncertainty", "snr_db", "channels"]
-        columns += [f"amplitude[{name}]" for name in self.channel_names]
+        columns = ["frequency_Hz", "uncertainty_Hz", "damping_ratio", "damping_ratio_uncertainty", "snr_db", "channels"]
+        columns += [f"amplitude_m_per_s2[{name}]" for name in self.channel_names]
         return pd.DataFrame(rows, columns=columns)
 
     def summary(self) -> dict:

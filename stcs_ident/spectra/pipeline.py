@@ -145,10 +145,13 @@ class TestSpectra(PickingResult):
         return f"{self.name}: {len(self.modes)} modes picked{modes} from an {self.peaks.kind} record{extra}"
 
     def to_dataframe(self) -> pd.DataFrame:
+        """One row per numbered mode: ``mode``, ``frequency_Hz``, ``uncertainty_Hz`` (1σ), ``damping_ratio`` (not
+        percent) and ``damping_ratio_uncertainty`` (NaN where not estimated), ``doubtful``, ``channels`` (joined by
+        ``;``), ``plane`` and ``mac``."""
         return pd.DataFrame({
             "mode": self.modes, "frequency_Hz": self.frequencies, "uncertainty_Hz": self.uncertainty,
-            "damping": self.damping, "damping_uncertainty": self.damping_sigmas(), "doubtful": self.doubtful,
-            "channels": [" ".join(c) for c in self.channels], "plane": self.mode_planes,
+            "damping_ratio": self.damping, "damping_ratio_uncertainty": self.damping_sigmas(),
+            "doubtful": self.doubtful, "channels": [";".join(c) for c in self.channels], "plane": self.mode_planes,
             "mac": self._macs(),
         })
 

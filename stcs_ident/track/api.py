@@ -69,7 +69,7 @@ def process_batch(spec: CableSpec, items: list[tuple[str, str, int, int]]) -> li
             except OSError:  # gone since the plan: the record's row says why it failed
                 record_id = ""
         row = process_record(spec, path, record_id)
-        row.update(version=spec.version, size=size, mtime_ns=mtime)
+        row.update(version=spec.version, size_bytes=size, mtime_ns=mtime)
         rows.append(row)
     return rows
 
@@ -264,18 +264,19 @@ def _progress_bar(total: int, progress) -> Callable:
 def _histories(specs: list[CableSpec], table: pd.DataFrame):
     """The table with each record's normalised tension and level, and each cable's History."""
     table = table.copy()
-    table["tension_normalised"] = np.nan
-    table["level"] = np.nan
+    table["tension_normalised_N"] = np.nan
+    table["tension_level_N"] = np.nan
     histories = {}
     for spec in specs:
         rows = table.index[(table["cable"] == spec.name) & (table["status"] == "ok")]
         rows = table.loc[rows].sort_values("start_time", kind="stable").index
         starts = table.loc[rows, "start_time"]
-        history = analyse_history(table.loc[rows, "tension"].to_numpy(), table.loc[rows, "temperature"].to_numpy(),
+        history = analyse_history(table.loc[rows, "tension_N"].to_numpy(),
+                                  table.loc[rows, "temperature_degC"].to_numpy(),
                                   spec.reference_tension,
                                   times=(starts - starts.min()).dt.total_seconds().to_numpy(dtype=float))
-        table.loc[rows, "tension_normalised"] = history.normalised
-        table.loc[rows, "level"] = spec.reference_tension * (1 + history.level)
+        table.loc[rows, "tension_normalised_N"] = history.normalised
+        table.loc[rows, "tension_level_N"] = spec.reference_tension * (1 + history.level)
         histories[spec.name] = (rows, history)
     return table, histories
 
@@ -284,23 +285,23 @@ def _damper_histories(specs: list[CableSpec], table: pd.DataFrame):
     """The table with each record's normalised coefficient and its level, and each damped cable's coefficient
     History (:mod:`.damper_history`): the cables whose setup has one damper."""
     table = table.copy()
-    table["coefficient_normalised"] = np.nan
-    table["coefficient_level"] = np.nan
+    table["coefficient_normalised_Ns_per_m"] = np.nan
+    table["coefficient_level_Ns_per_m"] = np.nan
     dampers = {}
     for spec in specs:
         damper = reference_damper(spec)
         if damper is None:
             continue
         mine = (table["cable"] == spec.name) & (table["status"] == "ok")
-        usable = mine & (table["coefficient"] > 0) & (table["coefficient_sigma"] > 0)
+        usable = mine & (table["coefficient_Ns_per_m"] > 0) & (table["coefficient_sigma_Ns_per_m"] > 0)
         rows = table.loc[table.index[usable]].sort_values("start_time", kind="stable").index
         starts = table.loc[rows, "start_time"]
-        history = analyse_coefficient(table.loc[rows, "coefficient"].to_numpy(),
-                                      table.loc[rows, "coefficient_sigma"].to_numpy(),
-                                      table.loc[rows, "temperature"].to_numpy(), damper.coefficient,
+        history = analyse_coefficient(table.loc[rows, "coefficient_Ns_per_m"].to_numpy(),
+                                      table.loc[rows, "coefficient_sigma_Ns_per_m"].to_numpy(),
+                                      table.loc[rows, "temperature_degC"].to_numpy(), damper.coefficient,
                                       times=(starts - starts.min()).dt.total_seconds().to_numpy(dtype=float))
-        table.loc[rows, "coefficient_normalised"] = history.normalised
-        table.loc[rows, "coefficient_level"] = damper.coefficient * (1 + history.level)
+        table.loc[rows, "coefficient_normalised_Ns_per_m"] = history.normalised
+        table.loc[rows, "coefficient_level_Ns_per_m"] = damper.coefficient * (1 + history.level)
         dampers[spec.name] = (rows, history)
     return table, dampers
 

@@ -16,13 +16,13 @@ held at the campaign's values) by weighted least squares on the picked frequenci
 (:func:`~stcs_ident.identify.identify`, each mode against its plane's
 model), its 1σ from the fit.
 
-Each mode's damping ratio and its 1σ (``damping``, ``damping_sigma``, aligned
+Each mode's damping ratio and its 1σ (``damping_ratio``, ``damping_ratio_sigma``, aligned
 with ``modes``; NaN where the spectra estimated none) are kept as the spectra
 gave them. For a cable whose setup has one :class:`~stcs_ident.core.model.Damper`,
 its coefficient is then fitted jointly with the tension from the
 frequencies and the damping ratios (``identify(..., "tension,coefficient")``,
 as ``identify --params tension,coefficient`` does), with its 1σ
-(``coefficient``, ``coefficient_sigma``); the tension of that joint fit is
+(``coefficient_Ns_per_m``, ``coefficient_sigma_Ns_per_m``); the tension of that joint fit is
 the row's. A joint fit that stops at a bound, is not identifiable or fails
 otherwise leaves the coefficient NaN with its reason
 (``coefficient_reason``) and the tension of the tension-only fit. A setup
@@ -54,18 +54,21 @@ from .archive import CableSpec
 
 __all__ = ["COLUMNS", "process_record"]
 
-#: The columns of a row, in order.
 #: Modes picked per record: a tension needs a few well-located modes, not the tens a long stay shows below
 #: the Nyquist frequency (15 give a 1σ of about 0.04 % on a 120 m stay, far below the record-to-record
 #: scatter of a tension, and take half the time of 30).
 MAX_MODES = 15
 
-COLUMNS = ("cable", "record", "record_id", "start_time", "temperature", "status", "reason", "n_modes", "modes",
-           "planes", "frequencies", "frequency_sigma", "doubtful", "tension", "tension_sigma", "damping", "damping_sigma",
-           "coefficient", "coefficient_sigma", "coefficient_reason")
+#: The columns of a row, in order; a quantity's name ends with its unit (``_degC``, ``_Hz``, ``_N``, ``_Ns_per_m``;
+#: ``_ratio`` for a damping ratio). ``modes`` … ``damping_ratio_sigma`` hold one value per mode.
+COLUMNS = ("cable", "record", "record_id", "start_time", "temperature_degC", "status", "reason", "n_modes", "modes",
+           "planes", "frequencies_Hz", "frequency_sigma_Hz", "doubtful", "tension_N", "tension_sigma_N",
+           "damping_ratio", "damping_ratio_sigma", "coefficient_Ns_per_m", "coefficient_sigma_Ns_per_m",
+           "coefficient_reason")
 #: The columns added with the damper's history: a part written before them reads with these defaults
 #: (:mod:`.store`).
-DAMPER_COLUMNS = {"damping": list, "damping_sigma": list, "coefficient": math.nan, "coefficient_sigma": math.nan,
+DAMPER_COLUMNS = {"damping_ratio": list, "damping_ratio_sigma": list, "coefficient_Ns_per_m": math.nan,
+                  "coefficient_sigma_Ns_per_m": math.nan,
                   "coefficient_reason": ""}
 
 
@@ -73,9 +76,10 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
     """The row of the record at ``path`` (see the module docstring)."""
     relative = Path(path).relative_to(spec.directory).as_posix()
     row = {"cable": spec.name, "record": relative, "record_id": record_id, "start_time": None,
-           "temperature": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
-           "planes": [], "frequencies": [], "frequency_sigma": [], "doubtful": [], "tension": math.nan, "tension_sigma": math.nan,
-           "damping": [], "damping_sigma": [], "coefficient": math.nan, "coefficient_sigma": math.nan,
+           "temperature_degC": math.nan, "status": "failed", "reason": "", "n_modes": 0, "modes": [],
+           "planes": [], "frequencies_Hz": [], "frequency_sigma_Hz": [], "doubtful": [], "tension_N": math.nan,
+           "tension_sigma_N": math.nan, "damping_ratio": [], "damping_ratio_sigma": [],
+           "coefficient_Ns_per_m": math.nan, "coefficient_sigma_Ns_per_m": math.nan,
            "coefficient_reason": ""}
     try:
         # The record as a test of the cable's campaign: its setup, the reference tension, its path in the campaign.
@@ -85,7 +89,7 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
         campaign = replace(spec.campaign, tests=(test,), directory=spec.directory)
         path, record = open_test_record(campaign, test)
         row["start_time"] = record.start_time
-        row["temperature"] = math.nan if record.temperature is None else float(record.temperature)
+        row["temperature_degC"] = math.nan if record.temperature is None else float(record.temperature)
         if record.start_time is None:
             raise InputError("has no start_time: a record of an archive needs one", field="start_time", file=path)
         spectra = analyse_record(campaign, test, record, path, max_modes=MAX_MODES)
@@ -95,11 +99,11 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
             raise ComputationError("no mode found in the record")
         row.update(n_modes=len(spectra.modes), modes=[int(m) for m in spectra.modes],
                    planes=[str(p) for p in spectra.mode_planes],
-                   frequencies=[float(f) for f in spectra.frequencies],
-                   frequency_sigma=[float(s) for s in spectra.uncertainty],
+                   frequencies_Hz=[float(f) for f in spectra.frequencies],
+                   frequency_sigma_Hz=[float(s) for s in spectra.uncertainty],
                    doubtful=_flags(getattr(spectra, "doubtful", None), len(spectra.modes)),
-                   damping=_floats(getattr(spectra, "damping", None), len(spectra.modes)),
-                   damping_sigma=_floats(getattr(spectra, "damping_uncertainty", None), len(spectra.modes)))
+                   damping_ratio=_floats(getattr(spectra, "damping", None), len(spectra.modes)),
+                   damping_ratio_sigma=_floats(getattr(spectra, "damping_uncertainty", None), len(spectra.modes)))
         _some_sure(row)
         # Per record: the plausibility check is off (a cable that lost half its tension is a finding to report,
         # not a unit slip to refuse), and the tolerances of EI and the length stay out of the record's σ: they
@@ -110,13 +114,14 @@ def process_record(spec: CableSpec, path: str, record_id: str) -> dict:
         elif dampers:
             row["coefficient_reason"] = (f"{len(dampers)} dampers ({', '.join(d.name for d in dampers)}): "
                                          "a coefficient is tracked on a cable with one damper")
-        if math.isnan(row["coefficient"]):
+        if math.isnan(row["coefficient_Ns_per_m"]):
             result = identify(campaign, [test.name], "tension", picked={test.name: spectra}, tolerances=False,
                               check_plausibility=False)
-            row["tension"], row["tension_sigma"] = result.value("tension")
-        if not (math.isfinite(row["tension"]) and math.isfinite(row["tension_sigma"]) and row["tension_sigma"] > 0):
+            row["tension_N"], row["tension_sigma_N"] = result.value("tension")
+        if not (math.isfinite(row["tension_N"]) and math.isfinite(row["tension_sigma_N"])
+                and row["tension_sigma_N"] > 0):
             # the start value with an infinite σ is no answer (the model could not be evaluated around it)
-            raise ComputationError(f"no tension: the fit gave {row['tension']:.6g} ± {row['tension_sigma']:.3g} N")
+            raise ComputationError(f"no tension: the fit gave {row['tension_N']:.6g} ± {row['tension_sigma_N']:.3g} N")
         row["status"] = "ok"
     except (InputError, ComputationError, FloatingPointError) as err:
         row["reason"] = one_line(str(err))
@@ -130,7 +135,7 @@ def _some_sure(row: dict) -> None:
     tension, fits the peaks almost as well): its tension would be one of several, each stated with a small σ.
     With some sure, :func:`~stcs_ident.identify.identify` leaves the doubtful ones out of its fit itself."""
     if row["doubtful"] and all(row["doubtful"]):
-        peaks = ", ".join(f"{f:.3f}" for f in row["frequencies"])
+        peaks = ", ".join(f"{f:.3f}" for f in row["frequencies_Hz"])
         raise ComputationError(f"the mode number of every peak ({peaks} Hz) is doubtful: another family of modes "
                                "fits almost as well, at another tension")
 
@@ -166,5 +171,5 @@ def _joint_fit(campaign, test: str, spectra) -> dict:
             raise ComputationError(f"no finite coefficient ({coefficient:g} ± {sigma:g})")
     except (InputError, ComputationError, FloatingPointError) as err:  # a bound included (BoundError)
         return {"coefficient_reason": one_line(str(err))}
-    return {"tension": tension, "tension_sigma": tension_sigma, "coefficient": coefficient,
-            "coefficient_sigma": sigma}
+    return {"tension_N": tension, "tension_sigma_N": tension_sigma, "coefficient_Ns_per_m": coefficient,
+            "coefficient_sigma_Ns_per_m": sigma}

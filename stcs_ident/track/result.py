@@ -23,9 +23,17 @@ from .events import History, state_note
 
 __all__ = ["TrackResult"]
 
-#: Columns of the ``events`` table: ``kind`` is ``tension`` or ``damper`` (a lasting change of the damper's
-#: coefficient, after / before − 1).
-EVENT_COLUMNS = ["cable", "start_time", "change", "uncertainty", "alarm_time", "kind"]
+#: Columns of the ``events`` table: ``change_ratio`` (after / before − 1) and its 1σ ``uncertainty_ratio``;
+#: ``kind`` is ``tension`` or ``damper`` (a lasting change of the damper's coefficient).
+EVENT_COLUMNS = ["cable", "start_time", "change_ratio", "uncertainty_ratio", "alarm_time", "kind"]
+
+#: Columns of the ``cables`` table: counts of records, the reference tension, the EI held, the thermal coefficient
+#: (relative change per °C) and the scatter (relative), the events found and the state.
+CABLE_COLUMNS = ["cable", "n_records", "n_processed", "n_failed", "reference_tension_N", "EI_Nm2",
+                 "thermal_coefficient_per_degC", "scatter_ratio", "n_events", "state"]
+#: Columns added to ``cables`` when a cable of the run has one damper (empty for the others).
+DAMPER_CABLE_COLUMNS = ["reference_coefficient_Ns_per_m", "damper_thermal_coefficient_per_degC",
+                        "damper_scatter_ratio", "damper_n_events", "damper_state"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -43,11 +51,13 @@ class TrackResult(Result):
         The cables tracked, in order.
     table : DataFrame
         One row per record of these cables (``track.process.COLUMNS``, with
-        ``size`` and ``mtime_ns``), with each record's
-        ``tension_normalised`` (to the cable's mean temperature) and the
-        ``level`` between lasting changes (N; NaN for a record without a
-        tension), and for a damped cable ``coefficient_normalised`` and
-        ``coefficient_level`` (N s/m; NaN for a record without a coefficient).
+        ``version``, ``size_bytes`` and ``mtime_ns``), with each record's
+        ``tension_normalised_N`` (to the cable's mean temperature) and the
+        ``tension_level_N`` between lasting changes (NaN for a record without a
+        tension), and for a damped cable ``coefficient_normalised_Ns_per_m`` and
+        ``coefficient_level_Ns_per_m`` (NaN for a record without a coefficient).
+        List cells (``modes``, ``frequencies_Hz``, ...) hold one value per mode;
+        ``records.csv`` writes them joined by ``;``.
     histories : dict
         {cable: (row labels of ``table`` with a tension, in time order,
         :class:`~stcs_ident.track.events.History`)}.
@@ -106,7 +116,7 @@ class TrackResult(Result):
     def _damper_summary(self, spec: CableSpec) -> dict:
         rows, history = self.dampers[spec.name]
         mine = self.table[(self.table["cable"] == spec.name) & (self.table["status"] == "ok")]
-        missing = mine[~(mine["coefficient"] > 0)]
+        missing = mine[~(mine["coefficient_Ns_per_m"] > 0)]
         return {
             "reference_coefficient": _reference_coefficient(spec),
             "records": len(rows),
@@ -134,12 +144,15 @@ class TrackResult(Result):
         ``records`` (one row per record: :attr:`table`)."""
         cables = self.cables
         summary = pd.DataFrame([
-            {"cable": name, "records": c["records"], "processed": c["processed"], "failed": c["failed"],
-             "reference_tension_kN": c["reference_tension"] / 1e3, "EI_Nm2": c["EI"],
-             "thermal_coefficient_per_C": c["thermal_coefficient"], "scatter": c["scatter"],
-             "events": len(c["events"]), "state": c["state"], **_damper_columns(c, bool(self.dampers))}
-            for name, c in cables.items()])
-        events = pd.DataFrame([{"cable": name, **e} for name, c in cables.items()
+            {"cable": name, "n_records": c["records"], "n_processed": c["processed"], "n_failed": c["failed"],
+             "reference_tension_N": c["reference_tension"], "EI_Nm2": c["EI"],
+             "thermal_coefficient_per_degC": c["thermal_coefficient"], "scatter_ratio": c["scatter"],
+             "n_events": len(c["events"]), "state": c["state"], **_damper_columns(c, bool(self.dampers))}
+            for name, c in cables.items()], columns=CABLE_COLUMNS + (DAMPER_CABLE_COLUMNS if self.dampers else []))
+        events = pd.DataFrame([{"cable": name, "start_time": e["start_time"], "change_ratio": e["change"],
+                                "uncertainty_ratio": e["uncertainty"], "alarm_time": e["alarm_time"],
+                                "kind": e["kind"]}
+                               for name, c in cables.items()
                                for e in c["events"] + c.get("damper", {}).get("events", [])],
                               columns=EVENT_COLUMNS)
         return {"cables": summary, "events": events, "records": self.table}
@@ -166,9 +179,10 @@ def _damper_columns(cable: dict, any_damper: bool) -> dict:
     if not any_damper:
         return {}
     d = cable.get("damper", {})
-    return {"reference_coefficient_Nsm": d.get("reference_coefficient"),
-            "damper_thermal_coefficient_per_C": d.get("thermal_coefficient"), "damper_scatter": d.get("scatter"),
-            "damper_events": len(d["events"]) if d else None, "damper_state": d.get("state")}
+    return {"reference_coefficient_Ns_per_m": d.get("reference_coefficient"),
+            "damper_thermal_coefficient_per_degC": d.get("thermal_coefficient"),
+            "damper_scatter_ratio": d.get("scatter"), "damper_n_events": len(d["events"]) if d else None,
+            "damper_state": d.get("state")}
 
 
 def _events(history: History, times, kind: str) -> list[dict]:

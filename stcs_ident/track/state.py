@@ -65,7 +65,7 @@ def plan_cable(spec: CableSpec, known: pd.DataFrame) -> CablePlan:
         by_slot.setdefault(row.record, []).insert(0, row)  # latest first
     current = [r for r in mine.itertuples(index=False) if r.version == spec.version and r.status == "ok"]
     reusable = {r.record_id for r in current}
-    sizes = {int(r.size) if pd.notna(r.size) else -1 for r in current}  # -1: a row of unknown size
+    sizes = {int(r.size_bytes) if pd.notna(r.size_bytes) else -1 for r in current}  # -1: a row of unknown size
     for path in record_paths(spec):
         st = path.stat()
         relative = path.relative_to(spec.directory).as_posix()
@@ -76,7 +76,7 @@ def plan_cable(spec: CableSpec, known: pd.DataFrame) -> CablePlan:
             plan.dirty = True
             plan.pending.append((str(path), "", int(st.st_size), int(st.st_mtime_ns)))
             continue
-        cached = next((r.record_id for r in rows if r.size == st.st_size and r.mtime_ns == st.st_mtime_ns), None)
+        cached = next((r.record_id for r in rows if r.size_bytes == st.st_size and r.mtime_ns == st.st_mtime_ns), None)
         record_id = cached or content_id(path)
         plan.slots[relative] = (record_id, int(st.st_size), int(st.st_mtime_ns))
         same = [r for r in rows if r.record_id == record_id and r.version == spec.version]
@@ -119,6 +119,6 @@ def current_rows(plan: CablePlan, known: pd.DataFrame) -> pd.DataFrame:
             slots.append((relative, size, mtime))
     rows = known.loc[labels].copy()
     rows["record"] = [s[0] for s in slots]
-    rows["size"] = [s[1] for s in slots]
+    rows["size_bytes"] = [s[1] for s in slots]
     rows["mtime_ns"] = [s[2] for s in slots]
     return rows.reset_index(drop=True)

@@ -14,11 +14,16 @@ records are simply not known: they are processed again.
 ``records.parquet`` is the table, rewritten whole at the end of each run,
 for the user to open (pandas, pyarrow, DuckDB, Spark, ...). Parquet keeps
 the types (times, lists of modes, planes and frequencies) and is read column
-by column. A part written before the ``planes`` column reads with every mode
+by column. Every column of a quantity carries its unit in its name
+(``tension_N``, ``frequencies_Hz``, ...): a part written before they did
+(``tension``, ``frequencies``, ...) reads with its columns renamed
+(:data:`OLD_NAMES`), so a run resumes on it without processing its records
+again. A part written before the ``planes`` column reads with every mode
 in-plane (what it was processed as); one written before the damper's columns
-(``damping``, ``damping_sigma``, ``coefficient``, ``coefficient_sigma``,
-``coefficient_reason``) reads with NaN damping ratios, one per mode, and no
-coefficient (nothing was fitted). The files are written and read by :mod:`~stcs_ident.io.tables`;
+(``damping_ratio``, ``damping_ratio_sigma``, ``coefficient_Ns_per_m``,
+``coefficient_sigma_Ns_per_m``, ``coefficient_reason``) reads with NaN damping
+ratios, one per mode, and no coefficient (nothing was fitted). The files are
+written and read by :mod:`~stcs_ident.io.tables`;
 this module keeps the rows' types, the parts' names and their order.
 """
 
@@ -45,7 +50,12 @@ TABLE = "records.parquet"
 #: A row's columns: the record's (:data:`~stcs_ident.track.process.COLUMNS`), the version of what shaped it
 #: (the cable's campaign, the settings, the toolkit) and its file's size and modification time (ns) when
 #: processed, which spare hashing it again on a rerun.
-ROW_COLUMNS = (*COLUMNS, "version", "size", "mtime_ns")
+ROW_COLUMNS = (*COLUMNS, "version", "size_bytes", "mtime_ns")
+#: The columns of parts written before the names carried their units, and their names now.
+OLD_NAMES = {"temperature": "temperature_degC", "frequencies": "frequencies_Hz",
+             "frequency_sigma": "frequency_sigma_Hz", "tension": "tension_N", "tension_sigma": "tension_sigma_N",
+             "damping": "damping_ratio", "damping_sigma": "damping_ratio_sigma", "coefficient": "coefficient_Ns_per_m",
+             "coefficient_sigma": "coefficient_sigma_Ns_per_m", "size": "size_bytes"}
 #: The name of a part of ours.
 PART = re.compile(r"^(?P<cable>[0-9a-f]{12})-(?P<time>[0-9a-f]{16})-[0-9a-f]{8}-[0-9]+\.parquet$")
 
@@ -58,9 +68,10 @@ def cable_key(cable: str) -> str:
 def _frame(rows: list[dict]) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(ROW_COLUMNS))
     frame["start_time"] = instant_column(frame["start_time"])  # the readers' rule for times (core/times.py)
-    for name in ("temperature", "tension", "tension_sigma", "coefficient", "coefficient_sigma"):
+    for name in ("temperature_degC", "tension_N", "tension_sigma_N", "coefficient_Ns_per_m",
+                 "coefficient_sigma_Ns_per_m"):
         frame[name] = frame[name].astype(float)
-    for name in ("n_modes", "size", "mtime_ns"):
+    for name in ("n_modes", "size_bytes", "mtime_ns"):
         frame[name] = frame[name].astype("int64")
     frame["version"] = frame["version"].astype(str)
     frame["coefficient_reason"] = frame["coefficient_reason"].fillna("").astype(str)
@@ -95,6 +106,7 @@ def read_parts(out: str | os.PathLike) -> tuple[pd.DataFrame, list[Path], list[P
     frames, unreadable = read_parquet_files([directory / n for n in names])
     read = []
     for path, frame in frames:
+        frame = frame.rename(columns={old: new for old, new in OLD_NAMES.items() if old in frame and new not in frame})
         if "planes" not in frame and "modes" in frame:  # a part written before the planes: every mode in-plane
             frame = frame.assign(planes=[["in"] * len(m) for m in frame["modes"]])
         if "modes" in frame:  # a part written before the damper's columns: no damping ratio, no coefficient
