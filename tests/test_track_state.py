@@ -174,7 +174,8 @@ def test_a_rerun_of_one_cable_keeps_the_others_in_the_table_and_the_report(archi
     assert_same_table(c2, whole[whole["cable"] == "C2"])
     now = pd.read_csv(out / "cables.csv")
     assert list(now["cable"]) == ["C1", "C2"]
-    assert now.iloc[1].to_dict() == pd.read_csv(pd.io.common.StringIO(cables)).iloc[1].to_dict()
+    # (a NaN cell, a thermal coefficient not fitted yet, equal to itself)
+    pd.testing.assert_series_equal(now.iloc[1], pd.read_csv(pd.io.common.StringIO(cables)).iloc[1])
     report = (out / "report.md").read_text()
     assert "| C2 | 3 | 3 | 0 |" in report and "[C2](C2.png)" in report
 

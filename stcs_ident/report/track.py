@@ -253,6 +253,6 @@ def _normalised_label(history) -> str:
     shorter than its training window, whose temperature terms wait for a whole day: :mod:`..track.events`)."""
     if not np.isfinite(history.mean_temperature):
         return "no temperature: not normalised"
-    if history.thermal_coefficient == 0.0 and history.thermal_lag == 0.0:
+    if not np.isfinite(history.thermal_coefficient):
         return "not normalised yet (less than a day)"
     return f"normalised to {history.mean_temperature:.1f} °C"

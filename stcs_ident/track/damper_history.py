@@ -109,6 +109,6 @@ def analyse_coefficient(coefficient: np.ndarray, sigma: np.ndarray | None, tempe
     r, levels, beta, mean_theta, scatter, events, state, monitored = analyse_series(
         np.log(c / reference), temperature, training=training, times=times, weights=weights, logarithmic=True)
     b = float(beta[0]) if beta.size else 0.0
-    lag = float(-beta[1] / b) if beta.size and b != 0 else 0.0
+    lag = float(-beta[1] / b) if beta.size and b != 0 else 0.0  # (NaN with b not fitted yet)
     return History(reference * np.exp(r), np.expm1(levels), b, mean_theta, scatter, events, state, monitored, lag,
                    *records_needed(c.size, times, training=training))

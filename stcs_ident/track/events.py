@@ -149,7 +149,7 @@ class History:
 
     normalised: np.ndarray  # N, at the mean temperature
     level: np.ndarray  # relative level μ of each record's segment
-    thermal_coefficient: float  # b, per °C (0 without temperatures)
+    thermal_coefficient: float  # b, per °C (0 without temperatures; NaN before a whole day: not fitted yet)
     mean_temperature: float
     scatter: float  # s, relative
     events: tuple[Event, ...]
@@ -287,8 +287,10 @@ def analyse_series(y: np.ndarray, temperature: np.ndarray, *, training: int = TR
         levels = np.full(y.size, level) if y.size else y
         fitted = np.array([_weighted_mean(r[segments == j], w[segments == j])
                            for j in range(int(segments.max()) + 1)])[segments] if y.size else y
-        # s around the levels fitted (a step included): the record-to-record scatter, not half the step
-        return r, levels, beta, mean_theta, _scale((r - fitted) / w), (), NOT_ENOUGH_HISTORY, int(y.size)
+        # s around the levels fitted (a step included): the record-to-record scatter, not half the step. Terms
+        # not fitted (less than a whole cycle) are NaN, not 0: a coefficient of 0 would read as a measured one.
+        return (r, levels, beta if whole else np.full(x.shape[1], np.nan), mean_theta, _scale((r - fitted) / w), (),
+                NOT_ENOUGH_HISTORY, int(y.size))
     beta = _thermal(y[:training], x[:training], np.zeros(training, dtype=int), w[:training])
     events = _detect(y, x, beta, training, w, logarithmic)
     if use_temperature:  # b again, from the whole history with a level per segment

@@ -104,7 +104,8 @@ class TrackResult(Result):
         return {
             "records": len(mine), "processed": int((~failed).sum()), "failed": int(failed.sum()),
             "reference_tension": spec.reference_tension, "EI": spec.campaign.cable.EI,
-            "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
+            "thermal_coefficient": None if math.isnan(history.mean_temperature) or math.isnan(
+                history.thermal_coefficient) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
             "state": history.state, "state_note": state_note(history), "records_needed": history.records_needed,
             "events": _events(history, times, "tension"),
@@ -120,7 +121,8 @@ class TrackResult(Result):
         return {
             "reference_coefficient": _reference_coefficient(spec),
             "records": len(rows),
-            "thermal_coefficient": None if math.isnan(history.mean_temperature) else history.thermal_coefficient,
+            "thermal_coefficient": None if math.isnan(history.mean_temperature) or math.isnan(
+                history.thermal_coefficient) else history.thermal_coefficient,
             "scatter": None if math.isnan(history.scatter) else history.scatter,
             "state": history.state, "state_note": state_note(history), "records_needed": history.records_needed,
             "events": _events(history, self.table.loc[rows, "start_time"].to_numpy(), "damper"),
