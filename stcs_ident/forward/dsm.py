@@ -6,6 +6,8 @@ Public entry points:
 - :func:`batch_frequencies`: the first N frequencies of many parameter sets
   at once (tension, EI, length, attachment positions, masses and springs,
   end stiffnesses as arrays), vectorised: the engine of identification;
+- :class:`PreparedModel`: :func:`batch_frequencies` of one nominal configuration called many times
+  (a fit's trial points), its invariants computed once;
 - :func:`count_below`: the Wittrick–Williams count J(f).
 """
 
@@ -19,7 +21,7 @@ import numpy as np
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable
 from ..core.planes import plane_overrides, plane_view
-from .batch import CHUNK, build_batch, mode_items
+from .batch import CHUNK, NominalBatch, build_batch, mode_items
 from .damped import batch_complex_modes
 from .roots import solve_modes
 
@@ -88,6 +90,48 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
             if progress is not None:
                 progress(done, total)
     return out.reshape(shape + (n_modes,))
+
+
+class PreparedModel:
+    """:func:`batch_frequencies` of one nominal configuration, for many calls with few parameter sets each.
+
+    What does not change between calls (the plane's view of the attachments, their order, the nominal
+    values and their checks, the topology) is worked out once; a call with the parameter sets along one
+    axis then builds its batch directly (:class:`~.batch.NominalBatch`). The same batch, so the same
+    frequencies bit for bit; any other call (a dashpot, mixed topologies, a value out of range, a batch
+    beyond one chunk) goes through :func:`batch_frequencies` itself.
+    """
+
+    def __init__(self, cable: Cable, attachments: Sequence[Attachment], *, tension_model: str = "uniform",
+                 plane: str | None = "in"):
+        self.cable, self.attachments = cable, tuple(attachments)
+        self.tension_model, self.plane = tension_model, plane
+        viewed = (cable, self.attachments) if plane is None else plane_view(cable, self.attachments, plane)
+        self._damped = _damped(viewed[1], {})
+        self._nominal = None if self._damped else NominalBatch(*viewed, tension_model)
+        # plane_overrides changes a per-attachment override only for a damper or an out-of-plane spring
+        self._plane_keys = () if plane is None else (
+            ("masses", "coefficients", "stiffnesses")
+            if any(getattr(a, "angle", None) is not None for a in self.attachments) else
+            ("stiffnesses",) if plane != "in" and any(getattr(a, "stiffness_out", None) is not None
+                                                      for a in self.attachments) else ())
+
+    def __call__(self, tension: np.ndarray, n_modes: int, overrides: dict) -> np.ndarray:
+        """Frequencies (Hz), shape (n, n_modes), of the sets ``tension`` (n,) and ``overrides`` (as
+        :func:`batch_frequencies` takes them)."""
+        batch = None
+        if self._nominal is not None and "coefficients" not in overrides and 1 <= int(n_modes) \
+                and tension.shape[0] <= CHUNK:
+            given = overrides
+            if self._plane_keys and any(k in overrides for k in self._plane_keys):
+                given = plane_overrides(self.attachments, overrides, self.plane)
+            batch = self._nominal.build(tension, given)
+        if batch is None:
+            return batch_frequencies(self.cable, self.attachments, tension, n_modes, tension_model=self.tension_model,
+                                     plane=self.plane, **overrides)
+        n, n_modes = tension.shape[0], int(n_modes)
+        config, mode = mode_items(0, n, n_modes)
+        return solve_modes(batch, config, mode).reshape(n, n_modes) / (2 * math.pi)
 
 
 def _damped(attachments, overrides) -> bool:

@@ -22,8 +22,8 @@ from ..core.memo import BoundedCache, model_key
 from ..core.model import Campaign, has_dampers
 from ..core.parameters import Parameter, overrides_for
 from ..core.planes import PLANES
-from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
+from ..forward.dsm import PreparedModel
 from .measurement import (  # noqa: F401 (re-exported: the measurements' home before the planes)
     Measurement,
     as_measurement,
@@ -126,6 +126,8 @@ class Problem:
         self.lower = np.array([q.lower for q in self.parameters])
         self.upper = np.array([q.upper for q in self.parameters])
         self.start = np.array([q.start for q in self.parameters])
+        self._plans: list | None = None  # the undamped path's per-setup plans (_group_plans), on first use
+        self._solvers: dict = {}  # a PreparedModel per (setup's attachments, plane, modes)
 
     @property
     def n_data(self) -> int:
@@ -153,6 +155,14 @@ class Problem:
         single = X.ndim == 1
         X = np.atleast_2d(X)
         k = X.shape[0]
+        if not self.use_damping:
+            if self._plans is None:
+                self._plans = [_GroupPlan(self, group) for group in self._groups]
+            if all(plan.usable for plan in self._plans):
+                F = np.full((k, self.n_frequencies), np.nan)
+                for plan in self._plans:
+                    plan.fill(self, X, F)
+                return F[0] if single else F
         cable = self.campaign.cable
         out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
         zeta = [np.full((k, int(u.sum())), np.nan) for u in self._zeta_used]
@@ -261,8 +271,11 @@ class Problem:
                         _LAST_ROOTS.put(k, kept)
                     _SOLVED.put(point, s.copy())
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
-            return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                     plane=plane, **overrides), None
+            solver = self._solvers.get((id(atts), plane))
+            if solver is None:
+                solver = self._solvers[id(atts), plane] = PreparedModel(cable, atts, tension_model=self.tension_model,
+                                                                        plane=plane)
+            return solver(tension, n_modes, overrides), None
         except ComputationError:
             if tension.size == 1:
                 return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
@@ -322,6 +335,106 @@ class Problem:
         r = (self.predict(np.atleast_2d(X)) - self.measured) / self.sigma
         c = np.sum(r**2, axis=1)
         return np.where(np.isfinite(c), c, np.inf)
+
+
+class _GroupPlan:
+    """What :meth:`Problem.predict` works out per call for one setup's tests, worked out once (the undamped
+    path): which parameter writes which override of which test, whether the rows can be invalid, and
+    where each plane's frequencies go. :meth:`fill` then does what ``predict``'s generic loop does, with
+    the same overrides and so the same frequencies, without repeating the bookkeeping."""
+
+    def __init__(self, problem: Problem, group: list[int]):
+        self.group = group
+        ms = [problem.measurements[i] for i in group]
+        self.atts = problem._atts[ms[0].name]
+        self.n_attachments = len(self.atts)
+        self.nominal = problem._nominal_atts[ms[0].name]
+        self.tensions = [m.test.tension for m in ms]
+        self.writes = [[(j, q, q.spec, q.slot(m.test.setup)) for j, q in enumerate(problem.parameters)
+                        if q.applies_to(m.test)] for m in ms]
+        keys = []
+        for writes in self.writes:
+            here = ["tension"]
+            for _, q, spec, _ in writes:
+                if spec.belongs_to == "end":
+                    here += ["end_a", "end_b"] if q.member == "AB" else ["end_a" if q.member == "A" else "end_b"]
+                else:
+                    here.append(spec.override)
+            keys.append(list(dict.fromkeys(here)))
+        self.keys = keys[0]
+        # The generic path where the tests' overrides differ in kind, or a dashpot may be on.
+        self.usable = all(set(k) == set(self.keys) for k in keys) and "coefficients" not in self.keys \
+            and not _dashpots(self.atts, {})
+        self.always_valid = None
+        if "positions" not in self.keys and "length" not in self.keys:  # every row alike: checked once
+            self.always_valid = bool(valid_rows({"tension": np.ones(1)}, problem.campaign.cable.length,
+                                                self.nominal["positions"])[0])
+        offsets = np.cumsum([0] + [m.modes.size for m in problem.measurements])
+        self.planes = []
+        for plane in PLANES:
+            members = [(j, i) for j, i in enumerate(group) if np.any(problem.measurements[i].planes == plane)]
+            if not members:
+                continue
+            n_modes = max(int(problem.measurements[i].modes[problem.measurements[i].planes == plane].max())
+                          for _, i in members)
+            targets = []
+            for j, i in members:
+                m = problem.measurements[i]
+                here = m.planes == plane
+                targets.append((j, offsets[i] + np.flatnonzero(here), m.modes[here] - 1))
+            self.planes.append((plane, n_modes, targets))
+
+    def overrides(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        """The group's overrides at the rows ``X`` (k, p), its tests one after the other (as ``overrides_for``
+        gives each test's, concatenated)."""
+        k = X.shape[0]
+        n = k * len(self.tensions)
+        out: dict[str, np.ndarray] = {}
+        for key in self.keys:
+            out[key] = np.empty((n, self.n_attachments)) if key in self.nominal else np.empty(n)
+        for t, (tension, writes) in enumerate(zip(self.tensions, self.writes)):
+            rows = slice(t * k, (t + 1) * k)
+            out["tension"][rows] = tension
+            for key in self.keys:
+                if key in self.nominal:
+                    out[key][rows] = self.nominal[key]
+            for j, q, spec, slot in writes:
+                value = q.to_value(X[:, j])
+                if spec.belongs_to == "end":
+                    for end in ("end_a", "end_b") if q.member == "AB" else ("end_a" if q.member == "A" else "end_b",):
+                        out[end][rows] = value
+                elif spec.belongs_to == "attachment":
+                    out[spec.override][rows, slot] = value
+                else:
+                    out[spec.override][rows] = value
+        return out
+
+    def fill(self, problem: Problem, X: np.ndarray, F: np.ndarray) -> None:
+        """Write the group's frequencies at the rows ``X`` into their columns of ``F`` (k, n_frequencies)."""
+        k = X.shape[0]
+        ov = self.overrides(X)
+        if self.always_valid is None:
+            ok = valid_rows(ov, problem.campaign.cable.length, self.nominal["positions"])
+            every = bool(ok.all())
+            if not ok.any():
+                return
+        elif not self.always_valid:
+            return
+        else:
+            every = True
+        sub = ov if every else {key: v[ok] for key, v in ov.items()}
+        tension = sub.pop("tension")
+        for plane, n_modes, targets in self.planes:
+            try:
+                full, _ = problem._solve(self.atts, tension, n_modes, sub, False, plane)
+            except ModelError as err:
+                raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
+            if not every:
+                full_ = np.full((ok.size, n_modes), np.nan)
+                full_[ok] = full
+                full = full_
+            for j, columns, modes in targets:
+                F[:, columns] = full[j * k:(j + 1) * k, modes]
 
 
 #: The tensions and complex roots of the last damped rows solved (one call's) per (cable, attachments, plane, modes,
