@@ -155,14 +155,11 @@ class Problem:
         single = X.ndim == 1
         X = np.atleast_2d(X)
         k = X.shape[0]
-        if not self.use_damping:
-            if self._plans is None:
-                self._plans = [_GroupPlan(self, group) for group in self._groups]
-            if all(plan.usable for plan in self._plans):
-                F = np.full((k, self.n_frequencies), np.nan)
-                for plan in self._plans:
-                    plan.fill(self, X, F)
-                return F[0] if single else F
+        if self._pure():  # the undamped path: each setup's overrides and solves as planned once
+            F = np.full((k, self.n_frequencies), np.nan)
+            for plan in self._plans:
+                plan.fill(self, X, F)
+            return F[0] if single else F
         cable = self.campaign.cable
         out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
         zeta = [np.full((k, int(u.sum())), np.nan) for u in self._zeta_used]
@@ -284,6 +281,15 @@ class Problem:
                 for i in range(tension.size)]
         return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows]) if damped else None
 
+    def _pure(self) -> bool:
+        """Whether each row of :meth:`predict` depends on that row alone (the undamped path): then a row solved
+        alone or in any batch gives the same frequencies, bit for bit."""
+        if self.use_damping:
+            return False
+        if self._plans is None:
+            self._plans = [_GroupPlan(self, group) for group in self._groups]
+        return all(plan.usable for plan in self._plans)
+
     def residuals(self, x) -> np.ndarray:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""
         return (self.predict(x) - self.measured) / self.sigma
@@ -303,15 +309,19 @@ class Problem:
         h = JACOBIAN_STEP * self.typical(x)
         up = np.minimum(x + h, self.upper)
         down = np.maximum(x - h, self.lower)
-        rows = np.repeat(x[None, :], 2 * p + 1, axis=0)
+        # The point itself only where a step is lost, solved apart, when a row's frequencies depend on that row
+        # alone (the undamped path; the damped one warm-starts from the rows of its last call).
+        base = 0 if self._pure() else 1
+        rows = np.repeat(x[None, :], 2 * p + base, axis=0)
         rows[np.arange(p), np.arange(p)] = up
         rows[p + np.arange(p), np.arange(p)] = down
         F = self.predict(rows)
-        F_up, F_down, F0 = F[:p], F[p:2 * p], F[2 * p]
+        F_up, F_down = F[:p], F[p:2 * p]
         J = (F_up - F_down) / (up - down)[:, None]
         # A step the model cannot take (an attachment pushed onto another): one-sided from the other.
         lost_up, lost_down = ~np.isfinite(F_up), ~np.isfinite(F_down)
         if lost_up.any() or lost_down.any():
+            F0 = F[2 * p] if base else self.predict(x)
             with np.errstate(invalid="ignore", divide="ignore"):
                 forward = (F_up - F0) / (up - x)[:, None]
                 backward = (F0 - F_down) / (x - down)[:, None]
