@@ -166,6 +166,13 @@ class NominalBatch:
     def build(self, tension: np.ndarray, overrides: dict) -> CableBatch | None:
         """The batch of the sets ``tension`` (n,) and ``overrides`` (arrays (n,), per attachment (n,
         n_attachments)), as :func:`build_batch` builds it, or None where that path is needed."""
+        part = self.flatten(tension, overrides)
+        return None if part is None else merged_batch([part])
+
+    def flatten(self, tension: np.ndarray, overrides: dict) -> tuple | None:
+        """The sets ``tension`` (n,) and ``overrides`` as the arrays of a batch, checked, attachments in
+        ascending order: (key, topology, arrays), where parts of one key can be solved as one batch
+        (:func:`merged_batch`); None where :func:`build_batch` is needed."""
         n = tension.shape[0]
         na = self.n_attachments
         if not self._valid or n == 0 or tension.ndim != 1:
@@ -215,14 +222,25 @@ class NominalBatch:
                 return None  # several topologies
             ca, cb, st = (bool(f[0]) for f in flags)
             topology = _topology(na, ca or st, cb or st, st, self._model)
-        m = flat["mass_per_length"]
-        return CableBatch(
-            topology,
-            length=flat["length"], mass_per_length=m, EI=flat["EI"], tension=flat["tension"],
-            EA=_filled(n, self._EA), weight=m * self._gcos, gcos=_filled(n, self._gcos),
-            positions=flat["positions"], masses=flat["masses"], springs=flat["stiffnesses"],
-            end_a=flat["end_a"], end_b=flat["end_b"], dashpots=flat["coefficients"],
-        )
+        return (topology, self._gcos, self._EA), topology, flat
+
+
+def merged_batch(parts: Sequence[tuple]) -> CableBatch:
+    """One batch of the parts :meth:`NominalBatch.flatten` gave with one key, their sets one after the other:
+    each set's arrays, and so its frequencies, are those of its part's batch alone (the batch's arithmetic
+    is set by set)."""
+    (_, gcos, EA), topology, flat = parts[0]
+    if len(parts) > 1:
+        flat = {k: np.concatenate([part[2][k] for part in parts]) for k in flat}
+    n = flat["tension"].shape[0]
+    m = flat["mass_per_length"]
+    return CableBatch(
+        topology,
+        length=flat["length"], mass_per_length=m, EI=flat["EI"], tension=flat["tension"],
+        EA=_filled(n, EA), weight=m * gcos, gcos=_filled(n, gcos),
+        positions=flat["positions"], masses=flat["masses"], springs=flat["stiffnesses"],
+        end_a=flat["end_a"], end_b=flat["end_b"], dashpots=flat["coefficients"],
+    )
 
 
 @functools.lru_cache(maxsize=256)

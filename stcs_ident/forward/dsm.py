@@ -21,7 +21,7 @@ import numpy as np
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable
 from ..core.planes import plane_overrides, plane_view
-from .batch import CHUNK, NominalBatch, build_batch, mode_items
+from .batch import CHUNK, NominalBatch, build_batch, merged_batch, mode_items
 from .damped import batch_complex_modes
 from .roots import solve_modes
 
@@ -119,19 +119,41 @@ class PreparedModel:
     def __call__(self, tension: np.ndarray, n_modes: int, overrides: dict) -> np.ndarray:
         """Frequencies (Hz), shape (n, n_modes), of the sets ``tension`` (n,) and ``overrides`` (as
         :func:`batch_frequencies` takes them)."""
-        batch = None
-        if self._nominal is not None and "coefficients" not in overrides and 1 <= int(n_modes) \
-                and tension.shape[0] <= CHUNK:
-            given = overrides
-            if self._plane_keys and any(k in overrides for k in self._plane_keys):
-                given = plane_overrides(self.attachments, overrides, self.plane)
-            batch = self._nominal.build(tension, given)
-        if batch is None:
+        part = self.part(tension, overrides) if int(n_modes) >= 1 else None
+        if part is None:
             return batch_frequencies(self.cable, self.attachments, tension, n_modes, tension_model=self.tension_model,
                                      plane=self.plane, **overrides)
-        n, n_modes = tension.shape[0], int(n_modes)
-        config, mode = mode_items(0, n, n_modes)
-        return solve_modes(batch, config, mode).reshape(n, n_modes) / (2 * math.pi)
+        return solve_parts([part], [n_modes])[0]
+
+    def part(self, tension: np.ndarray, overrides: dict) -> tuple | None:
+        """The sets ``tension`` (n,) and ``overrides`` ready for :func:`solve_parts` (its first item the key of
+        the parts that can be solved together), or None where only :meth:`__call__` can solve them."""
+        if self._nominal is None or "coefficients" in overrides or tension.shape[0] > CHUNK:
+            return None
+        if self._plane_keys and any(k in overrides for k in self._plane_keys):
+            overrides = plane_overrides(self.attachments, overrides, self.plane)
+        return self._nominal.flatten(tension, overrides)
+
+
+def solve_parts(parts: Sequence[tuple], n_modes: Sequence[int]) -> list[np.ndarray]:
+    """The first ``n_modes[i]`` frequencies (Hz), (n_i, n_modes[i]), of each of ``parts`` (of one key, from
+    :meth:`PreparedModel.part`; several models' parts, of one cable) in one solve: each set's frequencies are
+    those it has solved alone, bit for bit."""
+    batch = merged_batch(parts)
+    sizes = [part[2]["tension"].shape[0] for part in parts]
+    if len(parts) == 1:
+        config, mode = mode_items(0, sizes[0], int(n_modes[0]))
+    else:
+        starts = np.cumsum([0, *sizes])
+        config = np.concatenate([np.repeat(np.arange(a, a + n, dtype=np.int64), int(q))
+                                 for a, n, q in zip(starts, sizes, n_modes)])
+        mode = np.concatenate([np.tile(np.arange(1, int(q) + 1, dtype=np.int64), n) for n, q in zip(sizes, n_modes)])
+    omega = solve_modes(batch, config, mode) / (2 * math.pi)
+    out, k = [], 0
+    for n, q in zip(sizes, n_modes):
+        out.append(omega[k:k + n * int(q)].reshape(n, int(q)))
+        k += n * int(q)
+    return out
 
 
 def _damped(attachments, overrides) -> bool:

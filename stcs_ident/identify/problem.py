@@ -23,7 +23,7 @@ from ..core.model import Campaign, has_dampers
 from ..core.parameters import Parameter, overrides_for
 from ..core.planes import PLANES
 from ..forward.damped import batch_complex_modes
-from ..forward.dsm import PreparedModel
+from ..forward.dsm import PreparedModel, solve_parts
 from .measurement import (  # noqa: F401 (re-exported: the measurements' home before the planes)
     Measurement,
     as_measurement,
@@ -127,7 +127,7 @@ class Problem:
         self.upper = np.array([q.upper for q in self.parameters])
         self.start = np.array([q.start for q in self.parameters])
         self._plans: list | None = None  # the undamped path's per-setup plans (_group_plans), on first use
-        self._solvers: dict = {}  # a PreparedModel per (setup's attachments, plane, modes)
+        self._solvers: dict = {}  # a PreparedModel per (setup's attachments, plane): _solver
 
     @property
     def n_data(self) -> int:
@@ -155,10 +155,19 @@ class Problem:
         single = X.ndim == 1
         X = np.atleast_2d(X)
         k = X.shape[0]
-        if self._pure():  # the undamped path: each setup's overrides and solves as planned once
+        if self._pure():  # the undamped path: each setup's overrides as planned once, setups alike solved together
             F = np.full((k, self.n_frequencies), np.nan)
+            together: dict = {}
             for plan in self._plans:
-                plan.fill(self, X, F)
+                plan.fill(self, X, F, together)
+            for entries in together.values():
+                try:
+                    fulls = solve_parts([e[0] for e in entries], [e[1] for e in entries])
+                except ComputationError:  # each apart, as _solve solves it (row by row where a row fails)
+                    fulls = [self._solve(plan.atts, tension, n_modes, sub, False, plane)[0]
+                             for _, n_modes, plan, plane, tension, sub, _ in entries]
+                for (_, n_modes, plan, _, _, _, where), full in zip(entries, fulls):
+                    plan.scatter(F, full, n_modes, *where)
             return F[0] if single else F
         cable = self.campaign.cable
         out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
@@ -268,11 +277,7 @@ class Problem:
                         _LAST_ROOTS.put(k, kept)
                     _SOLVED.put(point, s.copy())
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
-            solver = self._solvers.get((id(atts), plane))
-            if solver is None:
-                solver = self._solvers[id(atts), plane] = PreparedModel(cable, atts, tension_model=self.tension_model,
-                                                                        plane=plane)
-            return solver(tension, n_modes, overrides), None
+            return self._solver(atts, plane)(tension, n_modes, overrides), None
         except ComputationError:
             if tension.size == 1:
                 return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
@@ -289,6 +294,14 @@ class Problem:
         if self._plans is None:
             self._plans = [_GroupPlan(self, group) for group in self._groups]
         return all(plan.usable for plan in self._plans)
+
+    def _solver(self, atts, plane: str) -> PreparedModel:
+        """The undamped solver of a setup's attachments ``atts`` (one of this problem's) in ``plane``."""
+        solver = self._solvers.get((id(atts), plane))
+        if solver is None:
+            solver = self._solvers[id(atts), plane] = PreparedModel(self.campaign.cable, atts,
+                                                                    tension_model=self.tension_model, plane=plane)
+        return solver
 
     def residuals(self, x) -> np.ndarray:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""
@@ -419,8 +432,10 @@ class _GroupPlan:
                     out[spec.override][rows] = value
         return out
 
-    def fill(self, problem: Problem, X: np.ndarray, F: np.ndarray) -> None:
-        """Write the group's frequencies at the rows ``X`` into their columns of ``F`` (k, n_frequencies)."""
+    def fill(self, problem: Problem, X: np.ndarray, F: np.ndarray, together: dict) -> None:
+        """Write the group's frequencies at the rows ``X`` into their columns of ``F`` (k, n_frequencies), or
+        leave a plane's sets in ``together`` (by the key of the parts that can be solved as one batch: the
+        entries (part, modes, this plan, plane, tension, overrides, where), for :meth:`scatter`)."""
         k = X.shape[0]
         ov = self.overrides(X)
         if self.always_valid is None:
@@ -435,16 +450,26 @@ class _GroupPlan:
         sub = ov if every else {key: v[ok] for key, v in ov.items()}
         tension = sub.pop("tension")
         for plane, n_modes, targets in self.planes:
+            where = (targets, None if every else ok, k)
+            part = problem._solver(self.atts, plane).part(tension, sub)
+            if part is not None:
+                together.setdefault(part[0], []).append((part, n_modes, self, plane, tension, sub, where))
+                continue
             try:
                 full, _ = problem._solve(self.atts, tension, n_modes, sub, False, plane)
             except ModelError as err:
                 raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
-            if not every:
-                full_ = np.full((ok.size, n_modes), np.nan)
-                full_[ok] = full
-                full = full_
-            for j, columns, modes in targets:
-                F[:, columns] = full[j * k:(j + 1) * k, modes]
+            self.scatter(F, full, n_modes, *where)
+
+    @staticmethod
+    def scatter(F: np.ndarray, full: np.ndarray, n_modes: int, targets: list, ok: np.ndarray | None, k: int) -> None:
+        """Write a plane's frequencies ``full`` of the group's valid rows (``ok``, None: all) into ``F``."""
+        if ok is not None:
+            every = np.full((ok.size, n_modes), np.nan)
+            every[ok] = full
+            full = every
+        for j, columns, modes in targets:
+            F[:, columns] = full[j * k:(j + 1) * k, modes]
 
 
 #: The tensions and complex roots of the last damped rows solved (one call's) per (cable, attachments, plane, modes,
