@@ -13,6 +13,7 @@ Public entry points:
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 
@@ -144,16 +145,24 @@ def solve_parts(parts: Sequence[tuple], n_modes: Sequence[int]) -> list[np.ndarr
     if len(parts) == 1:
         config, mode = mode_items(0, sizes[0], int(n_modes[0]))
     else:
-        starts = np.cumsum([0, *sizes])
-        config = np.concatenate([np.repeat(np.arange(a, a + n, dtype=np.int64), int(q))
-                                 for a, n, q in zip(starts, sizes, n_modes)])
-        mode = np.concatenate([np.tile(np.arange(1, int(q) + 1, dtype=np.int64), n) for n, q in zip(sizes, n_modes)])
+        config, mode = _merged_items(tuple(sizes), tuple(int(q) for q in n_modes))
     omega = solve_modes(batch, config, mode) / (2 * math.pi)
     out, k = [], 0
     for n, q in zip(sizes, n_modes):
         out.append(omega[k:k + n * int(q)].reshape(n, int(q)))
         k += n * int(q)
     return out
+
+
+@functools.lru_cache(maxsize=256)
+def _merged_items(sizes: tuple[int, ...], n_modes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The (configuration, mode) items of parts of ``sizes`` sets one after the other, each part's modes 1 to
+    its ``n_modes`` (shared between calls, so read-only)."""
+    starts = np.cumsum([0, *sizes])
+    config = np.concatenate([np.repeat(np.arange(a, a + n, dtype=np.int64), q) for a, n, q in zip(starts, sizes, n_modes)])
+    mode = np.concatenate([np.tile(np.arange(1, q + 1, dtype=np.int64), n) for n, q in zip(sizes, n_modes)])
+    config.flags.writeable = mode.flags.writeable = False
+    return config, mode
 
 
 def _damped(attachments, overrides) -> bool:

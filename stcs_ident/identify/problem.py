@@ -373,12 +373,13 @@ class _GroupPlan:
         self.n_attachments = len(self.atts)
         self.nominal = problem._nominal_atts[ms[0].name]
         self.tensions = [m.test.tension for m in ms]
-        self.writes = [[(j, q, q.spec, q.slot(m.test.setup)) for j, q in enumerate(problem.parameters)
-                        if q.applies_to(m.test)] for m in ms]
+        # (column, parameter, kind, attachment slot, scale: the value is the variable times it; None: to_value)
+        self.writes = [[(j, q, q.spec, q.slot(m.test.setup), None if q.is_fixity else q.scale)
+                        for j, q in enumerate(problem.parameters) if q.applies_to(m.test)] for m in ms]
         keys = []
         for writes in self.writes:
             here = ["tension"]
-            for _, q, spec, _ in writes:
+            for _, q, spec, _, _ in writes:
                 if spec.belongs_to == "end":
                     here += ["end_a", "end_b"] if q.member == "AB" else ["end_a" if q.member == "A" else "end_b"]
                 else:
@@ -421,8 +422,8 @@ class _GroupPlan:
             for key in self.keys:
                 if key in self.nominal:
                     out[key][rows] = self.nominal[key]
-            for j, q, spec, slot in writes:
-                value = q.to_value(X[:, j])
+            for j, q, spec, slot, scale in writes:
+                value = q.to_value(X[:, j]) if scale is None else X[:, j] * scale  # to_value's product
                 if spec.belongs_to == "end":
                     for end in ("end_a", "end_b") if q.member == "AB" else ("end_a" if q.member == "A" else "end_b",):
                         out[end][rows] = value
@@ -531,12 +532,15 @@ def valid_rows(ov: dict[str, np.ndarray], length: float, nominal_positions: np.n
     """Rows whose attachments lie strictly inside the span, at places at least :data:`MIN_GAP` of the
     length apart (or as close as the nominal configuration's closest pair, if that is closer)."""
     k = ov["tension"].shape[0]
-    pos = ov.get("positions", np.broadcast_to(nominal_positions, (k, nominal_positions.size)))
-    span = ov.get("length", np.full(k, length))
-    ok = np.all((pos > 0) & (pos < span[:, None]), axis=1)
+    pos = ov.get("positions")
+    if pos is None:
+        pos = np.broadcast_to(nominal_positions, (k, nominal_positions.size))
+    span = ov.get("length")
+    ok = ((pos > 0) & (pos < (length if span is None else span[:, None]))).all(axis=1)
     if pos.shape[1] > 1:
         nominal_gap = np.min(np.diff(np.sort(nominal_positions)), initial=np.inf)
-        gap = np.minimum(MIN_GAP * span, nominal_gap)
-        ok &= np.all(np.diff(np.sort(pos, axis=1), axis=1) >= gap[:, None], axis=1)
-        ok &= np.all(np.diff(np.sort(pos, axis=1), axis=1) > 0, axis=1)
+        gap = min(MIN_GAP * length, nominal_gap) if span is None else np.minimum(MIN_GAP * span, nominal_gap)[:, None]
+        ordered = np.sort(pos, axis=1)
+        step = ordered[:, 1:] - ordered[:, :-1]
+        ok &= (step >= gap).all(axis=1) & (step > 0).all(axis=1)
     return ok
