@@ -5,8 +5,10 @@ test's measured modes with a standard uncertainty and a plane per mode.
 
 :class:`Problem` ties measurements and free parameters to the forward
 solver. :meth:`Problem.predict` evaluates the model at many parameter
-vectors in one vectorised call per test: the residuals, the Jacobian, the
-multi-start scan and the contour grids all go through it.
+vectors in one vectorised call per setup (undamped: per topology, the setups
+alike in one batch, what a call does not change worked out once per problem):
+the residuals, the Jacobian, the multi-start scan and the contour grids all
+go through it.
 """
 
 from __future__ import annotations
