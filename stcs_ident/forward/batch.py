@@ -124,6 +124,125 @@ def build_batch(cable: Cable, attachments: Sequence[Attachment], tension, *, ten
     return shape, groups
 
 
+class NominalBatch:
+    """A nominal configuration's invariants for :func:`build_batch`, computed once: what builds a batch of
+    it at many parameter sets without re-deriving them (a fit evaluates one model thousands of times, a
+    few sets a call; the generic path's checks and broadcasts cost more than the solve there).
+
+    :meth:`build` gives the batch :func:`build_batch` gives for the same sets, array for array, in the
+    common case: parameter sets along one axis, one topology, values every check accepts. Otherwise
+    (mixed topologies, a value out of range) it returns None and the caller uses :func:`build_batch`,
+    which says what is wrong.
+    """
+
+    def __init__(self, cable: Cable, attachments: Sequence[Attachment], tension_model: str = "uniform"):
+        _check_tension_model(tension_model)
+        atts = sorted(attachments, key=lambda a: a.position)
+        self.n_attachments = na = len(atts)
+        self._scalars = {
+            "EI": cable.EI, "length": cable.length, "mass_per_length": cable.mass_per_length,
+            "end_a": cable.boundary_a.rotational_stiffness, "end_b": cable.boundary_b.rotational_stiffness,
+        }
+        self._per_att = {
+            "positions": np.array([a.position for a in atts], float).reshape(na),
+            "masses": np.array([a.mass for a in atts], float).reshape(na),
+            "stiffnesses": np.array([a.stiffness for a in atts], float).reshape(na),
+            "coefficients": np.array([getattr(a, "coefficient", 0.0) for a in atts], float).reshape(na),
+        }
+        self._gcos = gcos = cable.gravity * cable.chord_cosine
+        self._EA = cable.EA if cable.EA is not None else np.inf
+        self._model = tension_model if cable.EA is not None and gcos != 0 else "none"
+        ends = [np.asarray(self._scalars[k], float) for k in ("end_a", "end_b", "EI")]
+        self._nominal_topology = _topology(na, bool(np.isinf(ends[0])) or bool(ends[2] == 0),
+                                           bool(np.isinf(ends[1])) or bool(ends[2] == 0), bool(ends[2] == 0),
+                                           self._model)
+        try:  # the nominal values as build_batch checks them (a fault is then its to name)
+            self._valid = bool(_validate_inputs({"tension": np.asarray(1.0),
+                                                 **{k: np.asarray(v, float) for k, v in self._scalars.items()}},
+                                                self._per_att))
+        except ModelError:
+            self._valid = False
+
+    def build(self, tension: np.ndarray, overrides: dict) -> CableBatch | None:
+        """The batch of the sets ``tension`` (n,) and ``overrides`` (arrays (n,), per attachment (n,
+        n_attachments)), as :func:`build_batch` builds it, or None where that path is needed."""
+        part = self.flatten(tension, overrides)
+        return None if part is None else merged_batch([part])
+
+    def flatten(self, tension: np.ndarray, overrides: dict) -> tuple | None:
+        """The sets ``tension`` (n,) and ``overrides`` as the arrays of a batch, checked, attachments in
+        ascending order: (key, topology, arrays), where parts of one key can be solved as one batch
+        (:func:`merged_batch`); None where :func:`build_batch` is needed."""
+        n = tension.shape[0]
+        na = self.n_attachments
+        if not self._valid or n == 0 or tension.ndim != 1:
+            return None
+        flat = {"tension": tension}
+        for key, v in overrides.items():
+            if key in self._per_att:
+                if v.shape != (n, na):
+                    return None
+            elif key not in self._scalars or v.shape != (n,):
+                return None
+            flat[key] = v
+        if not _at_least(tension, 0.0, True):
+            return None
+        for key in ("length", "mass_per_length"):
+            if key in overrides and not _at_least(overrides[key], 0.0, True):
+                return None
+        for key in ("EI", "masses", "stiffnesses", "coefficients"):
+            if key in overrides and not _at_least(overrides[key], 0.0, False):
+                return None
+        for key in ("end_a", "end_b"):
+            if key in overrides and not overrides[key].min() >= 0:  # NaN fails
+                return None
+        for key, value in self._scalars.items():
+            if key not in flat:
+                flat[key] = _filled(n, value)
+        for key, value in self._per_att.items():
+            if key not in flat:
+                out = np.empty((n, na))
+                out[...] = value
+                flat[key] = out
+        if na and ("positions" in overrides or "length" in overrides):
+            pos = flat["positions"]
+            if not ((pos > 0).all() and (pos < flat["length"][:, None]).all()):
+                return None
+            if na > 1 and not (pos[:, 1:] - pos[:, :-1] > 0).all():
+                if np.any(np.diff(np.sort(pos, axis=1), axis=1) <= 0):
+                    return None
+                order = np.argsort(pos, axis=1)
+                for k in self._per_att:
+                    flat[k] = np.take_along_axis(flat[k], order, axis=1)
+        topology = self._nominal_topology
+        if "EI" in overrides or "end_a" in overrides or "end_b" in overrides:
+            string = flat["EI"] == 0
+            flags = (np.isinf(flat["end_a"]), np.isinf(flat["end_b"]), string)
+            if not all(f.all() or not f.any() for f in flags):
+                return None  # several topologies
+            ca, cb, st = (bool(f[0]) for f in flags)
+            topology = _topology(na, ca or st, cb or st, st, self._model)
+        return (topology, self._gcos, self._EA), topology, flat
+
+
+def merged_batch(parts: Sequence[tuple]) -> CableBatch:
+    """One batch of the parts :meth:`NominalBatch.flatten` gave with one key, their sets one after the other:
+    each set's arrays, and so its frequencies, are those of its part's batch alone (the batch's arithmetic
+    is set by set)."""
+    (_, gcos, EA), topology, flat = parts[0]
+    if len(parts) > 1:
+        flat = {k: np.concatenate([part[2][k] for part in parts]) for k in flat}
+    n = flat["tension"].shape[0]
+    m = flat["mass_per_length"]
+    return CableBatch(
+        topology,
+        length=flat["length"], mass_per_length=m, EI=flat["EI"], tension=flat["tension"],
+        EA=_filled(n, EA), weight=m * gcos, gcos=_filled(n, gcos),
+        positions=flat["positions"], masses=flat["masses"], springs=flat["stiffnesses"],
+        end_a=flat["end_a"], end_b=flat["end_b"], dashpots=flat["coefficients"],
+    )
+
+
 @functools.lru_cache(maxsize=256)
 def _topology(n_attachments, clamped_a, clamped_b, string, tension_model):
     return Topology(n_attachments, clamped_a, clamped_b, string, tension_model)

@@ -6,11 +6,14 @@ Public entry points:
 - :func:`batch_frequencies`: the first N frequencies of many parameter sets
   at once (tension, EI, length, attachment positions, masses and springs,
   end stiffnesses as arrays), vectorised: the engine of identification;
+- :class:`PreparedModel`: :func:`batch_frequencies` of one nominal configuration called many times
+  (a fit's trial points), its invariants computed once;
 - :func:`count_below`: the Wittrick–Williams count J(f).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 
@@ -19,7 +22,7 @@ import numpy as np
 from ..core.errors import ModelError
 from ..core.model import Attachment, Cable
 from ..core.planes import plane_overrides, plane_view
-from .batch import CHUNK, build_batch, mode_items
+from .batch import CHUNK, NominalBatch, build_batch, merged_batch, mode_items
 from .damped import batch_complex_modes
 from .roots import solve_modes
 
@@ -88,6 +91,78 @@ def batch_frequencies(cable: Cable, attachments: Sequence[Attachment], tension, 
             if progress is not None:
                 progress(done, total)
     return out.reshape(shape + (n_modes,))
+
+
+class PreparedModel:
+    """:func:`batch_frequencies` of one nominal configuration, for many calls with few parameter sets each.
+
+    What does not change between calls (the plane's view of the attachments, their order, the nominal
+    values and their checks, the topology) is worked out once; a call with the parameter sets along one
+    axis then builds its batch directly (:class:`~.batch.NominalBatch`). The same batch, so the same
+    frequencies bit for bit; any other call (a dashpot, mixed topologies, a value out of range, a batch
+    beyond one chunk) goes through :func:`batch_frequencies` itself.
+    """
+
+    def __init__(self, cable: Cable, attachments: Sequence[Attachment], *, tension_model: str = "uniform",
+                 plane: str | None = "in"):
+        self.cable, self.attachments = cable, tuple(attachments)
+        self.tension_model, self.plane = tension_model, plane
+        viewed = (cable, self.attachments) if plane is None else plane_view(cable, self.attachments, plane)
+        self._damped = _damped(viewed[1], {})
+        self._nominal = None if self._damped else NominalBatch(*viewed, tension_model)
+        # plane_overrides changes a per-attachment override only for a damper or an out-of-plane spring
+        self._plane_keys = () if plane is None else (
+            ("masses", "coefficients", "stiffnesses")
+            if any(getattr(a, "angle", None) is not None for a in self.attachments) else
+            ("stiffnesses",) if plane != "in" and any(getattr(a, "stiffness_out", None) is not None
+                                                      for a in self.attachments) else ())
+
+    def __call__(self, tension: np.ndarray, n_modes: int, overrides: dict) -> np.ndarray:
+        """Frequencies (Hz), shape (n, n_modes), of the sets ``tension`` (n,) and ``overrides`` (as
+        :func:`batch_frequencies` takes them)."""
+        part = self.part(tension, overrides) if int(n_modes) >= 1 else None
+        if part is None:
+            return batch_frequencies(self.cable, self.attachments, tension, n_modes, tension_model=self.tension_model,
+                                     plane=self.plane, **overrides)
+        return solve_parts([part], [n_modes])[0]
+
+    def part(self, tension: np.ndarray, overrides: dict) -> tuple | None:
+        """The sets ``tension`` (n,) and ``overrides`` ready for :func:`solve_parts` (its first item the key of
+        the parts that can be solved together), or None where only :meth:`__call__` can solve them."""
+        if self._nominal is None or "coefficients" in overrides or tension.shape[0] > CHUNK:
+            return None
+        if self._plane_keys and any(k in overrides for k in self._plane_keys):
+            overrides = plane_overrides(self.attachments, overrides, self.plane)
+        return self._nominal.flatten(tension, overrides)
+
+
+def solve_parts(parts: Sequence[tuple], n_modes: Sequence[int]) -> list[np.ndarray]:
+    """The first ``n_modes[i]`` frequencies (Hz), (n_i, n_modes[i]), of each of ``parts`` (of one key, from
+    :meth:`PreparedModel.part`; several models' parts, of one cable) in one solve: each set's frequencies are
+    those it has solved alone, bit for bit."""
+    batch = merged_batch(parts)
+    sizes = [part[2]["tension"].shape[0] for part in parts]
+    if len(parts) == 1:
+        config, mode = mode_items(0, sizes[0], int(n_modes[0]))
+    else:
+        config, mode = _merged_items(tuple(sizes), tuple(int(q) for q in n_modes))
+    omega = solve_modes(batch, config, mode) / (2 * math.pi)
+    out, k = [], 0
+    for n, q in zip(sizes, n_modes):
+        out.append(omega[k:k + n * int(q)].reshape(n, int(q)))
+        k += n * int(q)
+    return out
+
+
+@functools.lru_cache(maxsize=256)
+def _merged_items(sizes: tuple[int, ...], n_modes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The (configuration, mode) items of parts of ``sizes`` sets one after the other, each part's modes 1 to
+    its ``n_modes`` (shared between calls, so read-only)."""
+    starts = np.cumsum([0, *sizes])
+    config = np.concatenate([np.repeat(np.arange(a, a + n, dtype=np.int64), q) for a, n, q in zip(starts, sizes, n_modes)])
+    mode = np.concatenate([np.tile(np.arange(1, q + 1, dtype=np.int64), n) for n, q in zip(sizes, n_modes)])
+    config.flags.writeable = mode.flags.writeable = False
+    return config, mode
 
 
 def _damped(attachments, overrides) -> bool:

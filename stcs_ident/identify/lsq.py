@@ -2,7 +2,7 @@
 
 Minimises Σ ((f_model − f_measured)/σ)² over the free variables within
 their bounds (SciPy's trust-region reflective method, Jacobian by central
-differences in one batch call of the forward solver per test). Attachment
+differences in one batch of the forward solver). Attachment
 positions make the problem multimodal (a mass and its mirror image give the
 same frequencies on a symmetric cable; two equal masses can trade places),
 so with position parameters the fit starts from the best points of a scan

@@ -5,8 +5,10 @@ test's measured modes with a standard uncertainty and a plane per mode.
 
 :class:`Problem` ties measurements and free parameters to the forward
 solver. :meth:`Problem.predict` evaluates the model at many parameter
-vectors in one vectorised call per test: the residuals, the Jacobian, the
-multi-start scan and the contour grids all go through it.
+vectors in one vectorised call per setup (undamped: per topology, the setups
+alike in one batch, what a call does not change worked out once per problem):
+the residuals, the Jacobian, the multi-start scan and the contour grids all
+go through it.
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ from ..core.memo import BoundedCache, model_key
 from ..core.model import Campaign, has_dampers
 from ..core.parameters import Parameter, overrides_for
 from ..core.planes import PLANES
-from ..forward import batch_frequencies
 from ..forward.damped import batch_complex_modes
+from ..forward.dsm import PreparedModel, solve_parts
 from .measurement import (  # noqa: F401 (re-exported: the measurements' home before the planes)
     Measurement,
     as_measurement,
@@ -126,6 +128,8 @@ class Problem:
         self.lower = np.array([q.lower for q in self.parameters])
         self.upper = np.array([q.upper for q in self.parameters])
         self.start = np.array([q.start for q in self.parameters])
+        self._plans: list | None = None  # the undamped path's per-setup plans (_group_plans), on first use
+        self._solvers: dict = {}  # a PreparedModel per (setup's attachments, plane): _solver
 
     @property
     def n_data(self) -> int:
@@ -153,6 +157,20 @@ class Problem:
         single = X.ndim == 1
         X = np.atleast_2d(X)
         k = X.shape[0]
+        if self._pure():  # the undamped path: each setup's overrides as planned once, setups alike solved together
+            F = np.full((k, self.n_frequencies), np.nan)
+            together: dict = {}
+            for plan in self._plans:
+                plan.fill(self, X, F, together)
+            for entries in together.values():
+                try:
+                    fulls = solve_parts([e[0] for e in entries], [e[1] for e in entries])
+                except ComputationError:  # each apart, as _solve solves it (row by row where a row fails)
+                    fulls = [self._solve(plan.atts, tension, n_modes, sub, False, plane)[0]
+                             for _, n_modes, plan, plane, tension, sub, _ in entries]
+                for (_, n_modes, plan, _, _, _, where), full in zip(entries, fulls):
+                    plan.scatter(F, full, n_modes, *where)
+            return F[0] if single else F
         cable = self.campaign.cable
         out = [np.full((k, m.modes.size), np.nan) for m in self.measurements]
         zeta = [np.full((k, int(u.sum())), np.nan) for u in self._zeta_used]
@@ -261,8 +279,7 @@ class Problem:
                         _LAST_ROOTS.put(k, kept)
                     _SOLVED.put(point, s.copy())
                 return np.abs(s) / (2 * math.pi), (-s.real / np.abs(s)) if damped else None
-            return batch_frequencies(cable, atts, tension, n_modes, tension_model=self.tension_model,
-                                     plane=plane, **overrides), None
+            return self._solver(atts, plane)(tension, n_modes, overrides), None
         except ComputationError:
             if tension.size == 1:
                 return np.full((1, n_modes), np.nan), np.full((1, n_modes), np.nan) if damped else None
@@ -270,6 +287,23 @@ class Problem:
                             plane)
                 for i in range(tension.size)]
         return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows]) if damped else None
+
+    def _pure(self) -> bool:
+        """Whether each row of :meth:`predict` depends on that row alone (the undamped path): then a row solved
+        alone or in any batch gives the same frequencies, bit for bit."""
+        if self.use_damping:
+            return False
+        if self._plans is None:
+            self._plans = [_GroupPlan(self, group) for group in self._groups]
+        return all(plan.usable for plan in self._plans)
+
+    def _solver(self, atts, plane: str) -> PreparedModel:
+        """The undamped solver of a setup's attachments ``atts`` (one of this problem's) in ``plane``."""
+        solver = self._solvers.get((id(atts), plane))
+        if solver is None:
+            solver = self._solvers[id(atts), plane] = PreparedModel(self.campaign.cable, atts,
+                                                                    tension_model=self.tension_model, plane=plane)
+        return solver
 
     def residuals(self, x) -> np.ndarray:
         """Weighted residuals (f_model − f_measured) / σ at one parameter vector."""
@@ -290,15 +324,19 @@ class Problem:
         h = JACOBIAN_STEP * self.typical(x)
         up = np.minimum(x + h, self.upper)
         down = np.maximum(x - h, self.lower)
-        rows = np.repeat(x[None, :], 2 * p + 1, axis=0)
+        # The point itself only where a step is lost, solved apart, when a row's frequencies depend on that row
+        # alone (the undamped path; the damped one warm-starts from the rows of its last call).
+        base = 0 if self._pure() else 1
+        rows = np.repeat(x[None, :], 2 * p + base, axis=0)
         rows[np.arange(p), np.arange(p)] = up
         rows[p + np.arange(p), np.arange(p)] = down
         F = self.predict(rows)
-        F_up, F_down, F0 = F[:p], F[p:2 * p], F[2 * p]
+        F_up, F_down = F[:p], F[p:2 * p]
         J = (F_up - F_down) / (up - down)[:, None]
         # A step the model cannot take (an attachment pushed onto another): one-sided from the other.
         lost_up, lost_down = ~np.isfinite(F_up), ~np.isfinite(F_down)
         if lost_up.any() or lost_down.any():
+            F0 = F[2 * p] if base else self.predict(x)
             with np.errstate(invalid="ignore", divide="ignore"):
                 forward = (F_up - F0) / (up - x)[:, None]
                 backward = (F0 - F_down) / (x - down)[:, None]
@@ -322,6 +360,119 @@ class Problem:
         r = (self.predict(np.atleast_2d(X)) - self.measured) / self.sigma
         c = np.sum(r**2, axis=1)
         return np.where(np.isfinite(c), c, np.inf)
+
+
+class _GroupPlan:
+    """What :meth:`Problem.predict` works out per call for one setup's tests, worked out once (the undamped
+    path): which parameter writes which override of which test, whether the rows can be invalid, and
+    where each plane's frequencies go. :meth:`fill` then does what ``predict``'s generic loop does, with
+    the same overrides and so the same frequencies, without repeating the bookkeeping."""
+
+    def __init__(self, problem: Problem, group: list[int]):
+        self.group = group
+        ms = [problem.measurements[i] for i in group]
+        self.atts = problem._atts[ms[0].name]
+        self.n_attachments = len(self.atts)
+        self.nominal = problem._nominal_atts[ms[0].name]
+        self.tensions = [m.test.tension for m in ms]
+        # (column, parameter, kind, attachment slot, scale: the value is the variable times it; None: to_value)
+        self.writes = [[(j, q, q.spec, q.slot(m.test.setup), None if q.is_fixity else q.scale)
+                        for j, q in enumerate(problem.parameters) if q.applies_to(m.test)] for m in ms]
+        keys = []
+        for writes in self.writes:
+            here = ["tension"]
+            for _, q, spec, _, _ in writes:
+                if spec.belongs_to == "end":
+                    here += ["end_a", "end_b"] if q.member == "AB" else ["end_a" if q.member == "A" else "end_b"]
+                else:
+                    here.append(spec.override)
+            keys.append(list(dict.fromkeys(here)))
+        self.keys = keys[0]
+        # The generic path where the tests' overrides differ in kind, or a dashpot may be on.
+        self.usable = all(set(k) == set(self.keys) for k in keys) and "coefficients" not in self.keys \
+            and not _dashpots(self.atts, {})
+        self.always_valid = None
+        if "positions" not in self.keys and "length" not in self.keys:  # every row alike: checked once
+            self.always_valid = bool(valid_rows({"tension": np.ones(1)}, problem.campaign.cable.length,
+                                                self.nominal["positions"])[0])
+        offsets = np.cumsum([0] + [m.modes.size for m in problem.measurements])
+        self.planes = []
+        for plane in PLANES:
+            members = [(j, i) for j, i in enumerate(group) if np.any(problem.measurements[i].planes == plane)]
+            if not members:
+                continue
+            n_modes = max(int(problem.measurements[i].modes[problem.measurements[i].planes == plane].max())
+                          for _, i in members)
+            targets = []
+            for j, i in members:
+                m = problem.measurements[i]
+                here = m.planes == plane
+                targets.append((j, offsets[i] + np.flatnonzero(here), m.modes[here] - 1))
+            self.planes.append((plane, n_modes, targets))
+
+    def overrides(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        """The group's overrides at the rows ``X`` (k, p), its tests one after the other (as ``overrides_for``
+        gives each test's, concatenated)."""
+        k = X.shape[0]
+        n = k * len(self.tensions)
+        out: dict[str, np.ndarray] = {}
+        for key in self.keys:
+            out[key] = np.empty((n, self.n_attachments)) if key in self.nominal else np.empty(n)
+        for t, (tension, writes) in enumerate(zip(self.tensions, self.writes)):
+            rows = slice(t * k, (t + 1) * k)
+            out["tension"][rows] = tension
+            for key in self.keys:
+                if key in self.nominal:
+                    out[key][rows] = self.nominal[key]
+            for j, q, spec, slot, scale in writes:
+                value = q.to_value(X[:, j]) if scale is None else X[:, j] * scale  # to_value's product
+                if spec.belongs_to == "end":
+                    for end in ("end_a", "end_b") if q.member == "AB" else ("end_a" if q.member == "A" else "end_b",):
+                        out[end][rows] = value
+                elif spec.belongs_to == "attachment":
+                    out[spec.override][rows, slot] = value
+                else:
+                    out[spec.override][rows] = value
+        return out
+
+    def fill(self, problem: Problem, X: np.ndarray, F: np.ndarray, together: dict) -> None:
+        """Write the group's frequencies at the rows ``X`` into their columns of ``F`` (k, n_frequencies), or
+        leave a plane's sets in ``together`` (by the key of the parts that can be solved as one batch: the
+        entries (part, modes, this plan, plane, tension, overrides, where), for :meth:`scatter`)."""
+        k = X.shape[0]
+        ov = self.overrides(X)
+        if self.always_valid is None:
+            ok = valid_rows(ov, problem.campaign.cable.length, self.nominal["positions"])
+            every = bool(ok.all())
+            if not ok.any():
+                return
+        elif not self.always_valid:
+            return
+        else:
+            every = True
+        sub = ov if every else {key: v[ok] for key, v in ov.items()}
+        tension = sub.pop("tension")
+        for plane, n_modes, targets in self.planes:
+            where = (targets, None if every else ok, k)
+            part = problem._solver(self.atts, plane).part(tension, sub)
+            if part is not None:
+                together.setdefault(part[0], []).append((part, n_modes, self, plane, tension, sub, where))
+                continue
+            try:
+                full, _ = problem._solve(self.atts, tension, n_modes, sub, False, plane)
+            except ModelError as err:
+                raise InputError(f"the model refused a parameter value: {err.message}", field=err.field) from err
+            self.scatter(F, full, n_modes, *where)
+
+    @staticmethod
+    def scatter(F: np.ndarray, full: np.ndarray, n_modes: int, targets: list, ok: np.ndarray | None, k: int) -> None:
+        """Write a plane's frequencies ``full`` of the group's valid rows (``ok``, None: all) into ``F``."""
+        if ok is not None:
+            every = np.full((ok.size, n_modes), np.nan)
+            every[ok] = full
+            full = every
+        for j, columns, modes in targets:
+            F[:, columns] = full[j * k:(j + 1) * k, modes]
 
 
 #: The tensions and complex roots of the last damped rows solved (one call's) per (cable, attachments, plane, modes,
@@ -383,12 +534,15 @@ def valid_rows(ov: dict[str, np.ndarray], length: float, nominal_positions: np.n
     """Rows whose attachments lie strictly inside the span, at places at least :data:`MIN_GAP` of the
     length apart (or as close as the nominal configuration's closest pair, if that is closer)."""
     k = ov["tension"].shape[0]
-    pos = ov.get("positions", np.broadcast_to(nominal_positions, (k, nominal_positions.size)))
-    span = ov.get("length", np.full(k, length))
-    ok = np.all((pos > 0) & (pos < span[:, None]), axis=1)
+    pos = ov.get("positions")
+    if pos is None:
+        pos = np.broadcast_to(nominal_positions, (k, nominal_positions.size))
+    span = ov.get("length")
+    ok = ((pos > 0) & (pos < (length if span is None else span[:, None]))).all(axis=1)
     if pos.shape[1] > 1:
         nominal_gap = np.min(np.diff(np.sort(nominal_positions)), initial=np.inf)
-        gap = np.minimum(MIN_GAP * span, nominal_gap)
-        ok &= np.all(np.diff(np.sort(pos, axis=1), axis=1) >= gap[:, None], axis=1)
-        ok &= np.all(np.diff(np.sort(pos, axis=1), axis=1) > 0, axis=1)
+        gap = min(MIN_GAP * length, nominal_gap) if span is None else np.minimum(MIN_GAP * span, nominal_gap)[:, None]
+        ordered = np.sort(pos, axis=1)
+        step = ordered[:, 1:] - ordered[:, :-1]
+        ok &= (step >= gap).all(axis=1) & (step > 0).all(axis=1)
     return ok
