@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
@@ -30,7 +31,6 @@ from ..identify.measurement import with_record_spectra, without_doubtful
 from ..identify.plausibility import check_plausibility as plausible
 from ..identify.plausibility import check_records
 from ..identify.problem import Measurement, gather_measurements, picked_planes, reset_warm_starts
-from ..spectra.pipeline import TestSpectra
 from .cross_validation import cross_validate, cross_validate_tests
 from .fitting import (
     HypothesisFit,
@@ -208,7 +208,14 @@ def diagnose(campaign: Campaign, tests: Sequence[str] | None = None, *, effects:
                      symmetric=symmetric, skipped=tuple(skipped), notes=tuple(notes), timings=timings,
                      elapsed=time.perf_counter() - started, considered=tuple(usable), settings=settings,
                      comparison=comparison, test_cv=test_cv,
-                     spectra=tuple(p for p in given.values() if isinstance(p, TestSpectra)))
+                     spectra=_record_spectra(given))
+
+
+def _record_spectra(given: Mapping) -> tuple:
+    """The picked spectra of records among ``given`` (the report draws them). A TestSpectra exists only once its
+    module is loaded: a table-only diagnosis does not load the peak picking (0.4 s of SciPy) to find none."""
+    pipeline = sys.modules.get("stcs_ident.spectra.pipeline")
+    return () if pipeline is None else tuple(p for p in given.values() if isinstance(p, pipeline.TestSpectra))
 
 
 def with_model_error(fit: HypothesisFit, measured: np.ndarray, sigma: np.ndarray) -> None:
