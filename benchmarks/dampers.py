@@ -26,9 +26,11 @@ import subprocess
 import sys
 import tempfile
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
+import tomli_w
 from common import print_header, timed
 
 from stcs_ident.core.model import Attachment, Cable, Campaign, Damper, Setup, Test
@@ -158,10 +160,12 @@ def identification(seeds, work: Path) -> list[dict]:
         # the damper ignored: the same picked frequencies, a campaign without it
         plain = case / "plain"
         plain.mkdir()
-        text = (case / "sim" / "campaign.toml").read_text()
-        start = text.index("  [[setup.damper]]")
-        end = text.index("[[test]]")
-        (plain / "campaign.toml").write_text(text[:start] + "\n" + text[end:])
+        # The campaign as simulate wrote it, its dampers left out (read and written as TOML, not cut as text:
+        # the writer's layout is tomli-w's to choose).
+        data = tomllib.loads((case / "sim" / "campaign.toml").read_text())
+        for setup in data.get("setup", []):
+            setup.pop("damper", None)
+        (plain / "campaign.toml").write_text(tomli_w.dumps(data))
         (plain / "records").symlink_to((case / "sim" / "records").resolve())
         run("identify", plain, "--params", "tension,EI", "--json", case / "id_plain.json")
         ignored = json.loads((case / "id_plain.json").read_text())["values"]["tension"]["t1"]
