@@ -144,4 +144,8 @@ if __name__ == "__main__":
     parser.add_argument("--out", type=Path, default=ROOT / "reports", help="where (default: reports/)")
     parser.add_argument("--only", default=",".join(REPORTS), help=f"comma-separated, of {', '.join(REPORTS)}")
     args = parser.parse_args()
-    sys.exit(run(args.out, tuple(args.only.split(","))))
+    only = tuple(args.only.split(","))
+    unknown = [name for name in only if name not in REPORTS]
+    if unknown:
+        parser.error(f"--only: no shipped report {', '.join(unknown)} (of {', '.join(REPORTS)})")
+    sys.exit(run(args.out, only))

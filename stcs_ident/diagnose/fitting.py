@@ -213,7 +213,7 @@ def position_uncertainty(campaign: Campaign, measurements: Sequence[Measurement]
                  if unmodeled_name(e) and ("position", unmodeled_name(e)) in values}
     wider = build(campaign, tests, registry.in_order((*hypothesis.effects, moving)), positions)
     problem = hypothesis_problem(wider, measurements, tension_model)
-    x = _starts_from(problem, [values], nominal=False)[0]
+    x = starts_from(problem, [values], nominal=False)[0]
     J = problem.jacobian(x)
     if not np.all(np.isfinite(J)):
         return {}
@@ -322,7 +322,7 @@ def in_si_units(note: Note, parameters: Sequence) -> Note:
     if not note.points:
         return note
     return note.with_points([convert(a) for a in pt] for pt in note.points)
-def _starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None], float]],
+def starts_from(problem: Problem, seeds: Sequence[Mapping[tuple[str, str | None], float]],
                  nominal: bool = True) -> np.ndarray:
     """Variable vectors of ``problem`` from SI values by (kind, member); missing ones nominal.
 
@@ -393,7 +393,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
             amount = (registry.get(scanned).amount_kind, unmodeled_name(scanned))
             fresh = [{**(previous or {}), amount: a}
                      for a in registry.get(scanned).amount_starts(campaign, tests, float(x))]
-            starts = _starts_from(problem, carried + fresh, nominal=not previous)
+            starts = starts_from(problem, carried + fresh, nominal=not previous)
             xb, c = quietly(lambda problem=problem, starts=starts: min(
                 (local_fit(problem, x0, PROFILE_NFEV, TOL) for x0 in starts), key=lambda r: r[1]), [])
             values = {(p.kind, p.member): float(p.to_value(v)) for p, v in zip(problem.parameters, xb)}
@@ -414,7 +414,7 @@ def fit_hypothesis(campaign: Campaign, measurements: Sequence[Measurement], effe
         seeds = minima + seeds
     hyp = build(campaign, tests, effects, positions)
     problem = hypothesis_problem(hyp, measurements, tension_model)
-    starts = _starts_from(problem, seeds)
+    starts = starts_from(problem, seeds)
     has_position = any(p.kind == "position" and not p.slots for p in problem.parameters)
     options = {} if has_position else {"n_starts": 0}
     result = quietly(lambda: fit_lsq(problem, starts=None if has_position and not seeds else starts,

@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import effects as registry
 from ..identify.lsq import local_fit
-from .fitting import TOL, hypothesis_problem
+from .fitting import TOL, hypothesis_problem, profile_points, starts_from
 from .hypotheses import build, free_positions, unmodeled_name
 
 #: Points of the grid over the span, at least (the estimate and, when symmetric, its mirror besides).
@@ -66,16 +66,6 @@ def _chi2(problem, x) -> float:
     return float(np.sum(((predicted - problem.measured) / problem.sigma) ** 2))
 
 
-def _variables(problem, values: dict) -> np.ndarray:
-    """Variables of ``problem`` from SI values by (kind, member) (missing ones at their start), inside the bounds."""
-    x = problem.start.copy()
-    for j, p in enumerate(problem.parameters):
-        v = values.get((p.kind, p.member))
-        if v is not None:
-            x[j] = p.to_variable(v)
-    return np.clip(x, problem.lower, problem.upper)
-
-
 def cause_profile(diagnosis, effect: str, points: int | None = None) -> PositionProfile:
     """The profile of the position of ``effect`` (an unmodeled attachment of the chosen hypothesis).
 
@@ -96,8 +86,7 @@ def cause_profile(diagnosis, effect: str, points: int | None = None) -> Position
     x_hat = estimate[("position", member)]
     positions = {e: estimate[("position", unmodeled_name(e))] for e in fit.effects
                  if unmodeled_name(e) and ("position", unmodeled_name(e)) in estimate}
-    highest = max((int(np.max(m.modes)) for m in measurements if len(m.modes)), default=0)
-    n = points or max(MIN_POINTS, 2 * highest + 1)
+    n = points or max(MIN_POINTS, profile_points(measurements))
     length = campaign.cable.length
     grid = free_positions(campaign, tests, n)
     while grid.size < n:  # points next to recorded attachments are left out: ask for more
@@ -114,10 +103,9 @@ def cause_profile(diagnosis, effect: str, points: int | None = None) -> Position
         for i in side:
             hyp = build(campaign, tests, fit.effects, {**positions, effect: float(grid[i])}, fixed=(effect,))
             problem = hypothesis_problem(hyp, measurements, tension_model)
-            starts = {tuple(_variables(problem, s)) for s in (previous, estimate)}
             best = None
-            for x0 in starts:
-                xb, _ = local_fit(problem, np.array(x0), POINT_NFEV, TOL)
+            for x0 in starts_from(problem, [previous, estimate], nominal=False):
+                xb, _ = local_fit(problem, x0, POINT_NFEV, TOL)
                 c = _chi2(problem, xb)
                 if best is None or c < best[1]:
                     best = (xb, c)
